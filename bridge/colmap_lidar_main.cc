@@ -1,0 +1,97 @@
+// The colmap-lidar command-line dispatcher: `colmap-lidar COMMAND [--options]`, as COLMAP's `colmap`.
+// This executable (not the bridge library) is the only place that links the simulator.
+#include "bridge/commands.h"
+#include "tests/simulator/simulator_commands.h"
+
+#include "colmap/util/logging.h"
+#include "colmap/util/version.h"
+
+#include <ceres/version.h>
+#include <opencv2/core/version.hpp>
+#include <pcl/pcl_config.h>
+
+#include <cstring>
+#include <exception>
+#include <iomanip>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace colmap_lidar {
+namespace {
+
+using CommandFunc = int (*)(int, char**);
+
+struct Command {
+  const char* name;
+  CommandFunc func;
+  const char* help;
+};
+
+int RunHelp(int argc, char** argv);
+int RunVersion(int argc, char** argv);
+
+const std::vector<Command>& Commands() {
+  static const std::vector<Command> kCommands = {
+      {"help", &RunHelp, "List the commands"},
+      {"version", &RunVersion, "Print colmap-lidar's version and the COLMAP it links"},
+      {"database_creator", &RunDatabaseCreator,
+       "Create a COLMAP database (or extend one) with colmap-lidar's tables"},
+      {"database_info", &RunDatabaseInfo,
+       "Summarise a database: COLMAP's tables and depth priors, LiDAR frames, rig"},
+      {"simulate_dataset", &RunSimulateDataset,
+       "Simulate a stereo + LiDAR station dataset with ground truth"},
+  };
+  return kCommands;
+}
+
+std::string VersionString() {
+  return "colmap-lidar " COLMAP_LIDAR_VERSION " (" + colmap::GetVersionInfo() +
+         ", Ceres " CERES_VERSION_STRING ", PCL " PCL_VERSION_PRETTY
+         ", OpenCV " CV_VERSION ")";
+}
+
+int RunHelp(int, char**) {
+  std::cout << VersionString() << "\n\n"
+            << "Usage: colmap-lidar COMMAND [--option value ...]\n"
+            << "       colmap-lidar COMMAND --help   (options of a command)\n"
+            << "Options may also come from an .ini file: --project_path FILE\n\n"
+            << "Commands:\n";
+  for (const Command& command : Commands()) {
+    std::cout << "  " << std::left << std::setw(24) << command.name
+              << command.help << "\n";
+  }
+  return EXIT_SUCCESS;
+}
+
+int RunVersion(int, char**) {
+  std::cout << VersionString() << std::endl;
+  return EXIT_SUCCESS;
+}
+
+}  // namespace
+}  // namespace colmap_lidar
+
+int main(int argc, char** argv) {
+  using colmap_lidar::Commands;
+  colmap::InitializeGlog(argv);
+  FLAGS_alsologtostderr = true;
+  if (argc < 2) {
+    colmap_lidar::Commands()[0].func(argc, argv);
+    return EXIT_FAILURE;
+  }
+  const std::string name = argv[1];
+  for (const auto& command : Commands()) {
+    if (name == command.name) {
+      try {
+        return command.func(argc - 1, argv + 1);
+      } catch (const std::exception& error) {
+        std::cerr << "ERROR: " << name << ": " << error.what() << std::endl;
+        return EXIT_FAILURE;
+      }
+    }
+  }
+  std::cerr << "ERROR: unknown command '" << name
+            << "'. Run `colmap-lidar help` for the list." << std::endl;
+  return EXIT_FAILURE;
+}

@@ -1,0 +1,15 @@
+// The colmap-lidar commands implemented in bridge/. Each is `int RunX(int argc, char** argv)` in COLMAP's
+// style: argv[0] is the command name, options are parsed with colmap::OptionManager (so `--project_path
+// file.ini` works as in COLMAP), and the return value is the process exit code. Errors are thrown as
+// exceptions; the dispatcher turns them into one "ERROR: ..." line and a non-zero exit.
+#pragma once
+
+namespace colmap_lidar {
+
+// Creates a COLMAP database (or opens an existing one) and adds colmap-lidar's tables.
+int RunDatabaseCreator(int argc, char** argv);
+
+// Prints what a database holds: COLMAP's images/keypoints/matches and our depth priors, LiDAR frames, rig.
+int RunDatabaseInfo(int argc, char** argv);
+
+}  // namespace colmap_lidar

@@ -1,0 +1,326 @@
+#include "colmap_ext/station_dataset.h"
+
+#include "colmap/sensor/models.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+[[noreturn]] void Fail(const std::string& path, const std::string& problem) {
+  throw std::runtime_error(path + ": " + problem);
+}
+
+const json& Require(const json& object,
+                    const std::string& key,
+                    const std::string& path,
+                    const std::string& where) {
+  if (!object.is_object() || !object.contains(key)) {
+    Fail(path, "missing key '" + where + key + "'");
+  }
+  return object.at(key);
+}
+
+std::vector<double> NumberArray(const json& value,
+                                size_t expected_size,
+                                const std::string& path,
+                                const std::string& key) {
+  if (!value.is_array() || (expected_size && value.size() != expected_size)) {
+    Fail(path, "'" + key + "' must be an array of " +
+                   std::to_string(expected_size) + " numbers");
+  }
+  std::vector<double> numbers;
+  for (const json& v : value) {
+    if (!v.is_number() || !std::isfinite(v.get<double>())) {
+      Fail(path, "'" + key + "' holds a value that is not a finite number");
+    }
+    numbers.push_back(v.get<double>());
+  }
+  return numbers;
+}
+
+colmap::Camera ParseCamera(const json& value,
+                           const std::string& path,
+                           const std::string& key) {
+  const std::string where = key + ".";
+  const json& model = Require(value, "model", path, where);
+  if (!model.is_string() ||
+      !colmap::ExistsCameraModelWithName(model.get<std::string>())) {
+    Fail(path, "'" + where + "model' is not a COLMAP camera model name: " +
+                   model.dump());
+  }
+  colmap::Camera camera;
+  camera.model_id = colmap::CameraModelNameToId(model.get<std::string>());
+  for (const char* dim : {"width", "height"}) {
+    const json& v = Require(value, dim, path, where);
+    if (!v.is_number_integer() || v.get<int64_t>() <= 0) {
+      Fail(path, "'" + where + dim + "' must be a positive integer");
+    }
+  }
+  camera.width = value["width"].get<size_t>();
+  camera.height = value["height"].get<size_t>();
+  const size_t num_params = colmap::CameraModelNumParams(camera.model_id);
+  const json& params = Require(value, "params", path, where);
+  if (!params.is_array() || params.size() != num_params) {
+    Fail(path, "'" + where + "params' must hold " + std::to_string(num_params) +
+                   " values for model " + camera.ModelName() + " (" +
+                   camera.ParamsInfo() + "), got " +
+                   std::to_string(params.is_array() ? params.size() : 0));
+  }
+  camera.params = NumberArray(params, num_params, path, where + "params");
+  if (camera.FocalLengthX() <= 0 || camera.FocalLengthY() <= 0) {
+    Fail(path, "'" + where + "params' has a non-positive focal length");
+  }
+  return camera;
+}
+
+colmap::Rigid3d ParseRigid(const json& value,
+                           const std::string& path,
+                           const std::string& key) {
+  const std::vector<double> q = NumberArray(
+      Require(value, "rotation", path, key + "."), 4, path, key + ".rotation");
+  const std::vector<double> t =
+      NumberArray(Require(value, "translation", path, key + "."), 3, path,
+                  key + ".translation");
+  const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);  // w first
+  if (std::abs(rotation.norm() - 1) > 1e-3) {
+    Fail(path, "'" + key + ".rotation' is not a unit quaternion [qw,qx,qy,qz]");
+  }
+  return colmap::Rigid3d(rotation.normalized(),
+                         Eigen::Vector3d(t[0], t[1], t[2]));
+}
+
+json CameraToJson(const colmap::Camera& camera) {
+  return {{"model", camera.ModelName()},
+          {"width", camera.width},
+          {"height", camera.height},
+          {"params", camera.params}};
+}
+
+json RigidToJson(const colmap::Rigid3d& pose) {
+  const Eigen::Quaterniond& q = pose.rotation;
+  return {{"rotation", {q.w(), q.x(), q.y(), q.z()}},
+          {"translation",
+           {pose.translation.x(), pose.translation.y(), pose.translation.z()}}};
+}
+
+std::string PoseLine(const colmap::Rigid3d& pose) {
+  std::ostringstream line;
+  line << std::setprecision(17);
+  const Eigen::Quaterniond& q = pose.rotation;
+  line << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " "
+       << pose.translation.x() << " " << pose.translation.y() << " "
+       << pose.translation.z();
+  return line.str();
+}
+
+colmap::Rigid3d ParsePose(std::istream& tokens,
+                          const std::string& path,
+                          size_t line_number) {
+  double v[7];
+  for (double& x : v) {
+    if (!(tokens >> x) || !std::isfinite(x)) {
+      Fail(path, "line " + std::to_string(line_number) +
+                     ": expected qw qx qy qz tx ty tz");
+    }
+  }
+  const Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
+  if (std::abs(q.norm() - 1) > 1e-3) {
+    Fail(path, "line " + std::to_string(line_number) +
+                   ": rotation is not a unit quaternion (qw first)");
+  }
+  return colmap::Rigid3d(q.normalized(), Eigen::Vector3d(v[4], v[5], v[6]));
+}
+
+}  // namespace
+
+void WriteFileAtomically(const std::string& path, const std::string& contents) {
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  {
+    std::ofstream file(tmp, std::ios::binary);
+    if (!file) throw std::runtime_error("Cannot write " + path);
+    file << contents;
+    file.flush();
+    if (!file) {
+      fs::remove(tmp);
+      throw std::runtime_error("Cannot write " + path + " (disk full?)");
+    }
+  }
+  fs::rename(tmp, path);
+}
+
+StationRig ReadRigJson(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) Fail(path, "cannot open rig.json");
+  json root;
+  try {
+    root = json::parse(file);
+  } catch (const json::exception& error) {
+    Fail(path, std::string("not valid JSON: ") + error.what());
+  }
+  StationRig rig;
+  rig.left = ParseCamera(Require(root, "left", path, ""), path, "left");
+  rig.right = ParseCamera(Require(root, "right", path, ""), path, "right");
+  rig.right_from_left = ParseRigid(Require(root, "right_from_left", path, ""),
+                                   path, "right_from_left");
+  if (rig.BaselineMeters() < 1e-3) {
+    Fail(path, "'right_from_left.translation' gives a baseline below 1 mm");
+  }
+  if (root.contains("cam_from_lidar_guess") &&
+      !root["cam_from_lidar_guess"].is_null()) {
+    rig.cam_from_lidar_guess = ParseRigid(root["cam_from_lidar_guess"], path,
+                                          "cam_from_lidar_guess");
+  }
+  if (root.contains("lidar")) {
+    const json& lidar = root["lidar"];
+    if (lidar.contains("model")) rig.lidar_model = lidar["model"].get<std::string>();
+    if (lidar.contains("range_noise_m")) {
+      rig.lidar_range_noise_m = lidar["range_noise_m"].get<double>();
+    }
+  }
+  return rig;
+}
+
+void WriteRigJson(const std::string& path, const StationRig& rig) {
+  json root;
+  root["comment"] =
+      "colmap-lidar station rig. Cameras are COLMAP camera models (params in "
+      "COLMAP's order). Transforms are target_from_source "
+      "(x_target = R x_source + t), rotation as a unit quaternion "
+      "[qw, qx, qy, qz] (w first), translation in metres.";
+  root["left"] = CameraToJson(rig.left);
+  root["right"] = CameraToJson(rig.right);
+  root["right_from_left"] = RigidToJson(rig.right_from_left);
+  if (rig.cam_from_lidar_guess) {
+    root["cam_from_lidar_guess"] = RigidToJson(*rig.cam_from_lidar_guess);
+  }
+  if (!rig.lidar_model.empty()) {
+    root["lidar"] = {{"model", rig.lidar_model},
+                     {"range_noise_m", rig.lidar_range_noise_m}};
+  }
+  WriteFileAtomically(path, root.dump(2) + "\n");
+}
+
+std::string StationDataset::LeftImagePath(size_t i) const {
+  return (fs::path(root) / "images" / LeftImageName(i)).string();
+}
+
+std::string StationDataset::RightImagePath(size_t i) const {
+  return (fs::path(root) / "images" / "right" / (stations.at(i) + ".png"))
+      .string();
+}
+
+std::string StationDataset::LeftImageName(size_t i) const {
+  return "left/" + stations.at(i) + ".png";
+}
+
+std::string StationDataset::GroundTruthPath(const std::string& name) const {
+  return (fs::path(root) / "ground_truth" / name).string();
+}
+
+bool StationDataset::HasGroundTruth() const {
+  return fs::is_regular_file(GroundTruthPath("cam_from_world.txt"));
+}
+
+StationDataset ReadStationDataset(const std::string& root) {
+  if (!fs::is_directory(root)) Fail(root, "dataset directory does not exist");
+  StationDataset dataset;
+  dataset.root = root;
+  dataset.rig = ReadRigJson((fs::path(root) / "rig.json").string());
+  const fs::path left_dir = fs::path(root) / "images" / "left";
+  if (!fs::is_directory(left_dir)) {
+    Fail(left_dir.string(), "directory of left images does not exist");
+  }
+  for (const auto& entry : fs::directory_iterator(left_dir)) {
+    if (entry.path().extension() == ".png") {
+      dataset.stations.push_back(entry.path().stem().string());
+    }
+  }
+  std::sort(dataset.stations.begin(), dataset.stations.end());
+  if (dataset.stations.empty()) Fail(left_dir.string(), "no .png images");
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    if (!fs::is_regular_file(dataset.RightImagePath(i))) {
+      Fail(dataset.RightImagePath(i),
+           "missing right image of station " + dataset.stations[i]);
+    }
+    std::string cloud;
+    for (const char* ext : {".pcd", ".ply", ".bin"}) {
+      const fs::path candidate =
+          fs::path(root) / "lidar" / (dataset.stations[i] + ext);
+      if (fs::is_regular_file(candidate)) {
+        cloud = candidate.string();
+        break;
+      }
+    }
+    if (cloud.empty()) {
+      Fail((fs::path(root) / "lidar" / (dataset.stations[i] + ".pcd")).string(),
+           "missing LiDAR cloud of station " + dataset.stations[i]);
+    }
+    dataset.cloud_paths.push_back(cloud);
+  }
+  return dataset;
+}
+
+std::map<std::string, colmap::Rigid3d> ReadNamedPoses(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) Fail(path, "cannot open pose file");
+  std::map<std::string, colmap::Rigid3d> poses;
+  std::string line;
+  size_t line_number = 0;
+  while (std::getline(file, line)) {
+    ++line_number;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream tokens(line);
+    std::string name;
+    tokens >> name;
+    poses[name] = ParsePose(tokens, path, line_number);
+  }
+  return poses;
+}
+
+void WriteNamedPoses(const std::string& path,
+                     const std::string& header_comment,
+                     const std::map<std::string, colmap::Rigid3d>& poses) {
+  std::ostringstream out;
+  out << "# " << header_comment << "\n"
+      << "# <station> qw qx qy qz tx ty tz   (target_from_source, quaternion w "
+         "first, metres)\n";
+  for (const auto& [name, pose] : poses) out << name << " " << PoseLine(pose) << "\n";
+  WriteFileAtomically(path, out.str());
+}
+
+colmap::Rigid3d ReadPoseFile(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) Fail(path, "cannot open pose file");
+  std::string line;
+  size_t line_number = 0;
+  while (std::getline(file, line)) {
+    ++line_number;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream tokens(line);
+    return ParsePose(tokens, path, line_number);
+  }
+  Fail(path, "no pose line (expected qw qx qy qz tx ty tz)");
+}
+
+void WritePoseFile(const std::string& path,
+                   const std::string& header_comment,
+                   const colmap::Rigid3d& target_from_source) {
+  WriteFileAtomically(path, "# " + header_comment +
+                                "\n# qw qx qy qz tx ty tz   (quaternion w "
+                                "first, metres)\n" +
+                                PoseLine(target_from_source) + "\n");
+}
+
+}  // namespace colmap_lidar

@@ -1,0 +1,72 @@
+// The station dataset format (docs/dataset_format.md):
+//
+//   DATASET/rig.json
+//   DATASET/images/left/<station>.png, DATASET/images/right/<station>.png
+//   DATASET/lidar/<station>.pcd (or .ply, KITTI .bin)       cloud in the station's LiDAR frame
+//   DATASET/ground_truth/{cam_from_world.txt, cam_from_lidar.txt, surface.ply, depth/<station>.bin}
+//
+// Conventions: every transform is target_from_source (x_target = R x_source + t), translations in metres.
+// Quaternions are written w first (qw qx qy qz) in rig.json and the .txt files; in memory they are Eigen
+// quaternions (xyzw storage) inside colmap::Rigid3d.
+#pragma once
+
+#include "colmap/geometry/rigid3.h"
+#include "colmap/scene/camera.h"
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace colmap_lidar {
+
+struct StationRig {
+  colmap::Camera left;
+  colmap::Camera right;
+  colmap::Rigid3d right_from_left;
+  std::optional<colmap::Rigid3d> cam_from_lidar_guess;
+  std::string lidar_model;          // e.g. "VLP-16"; empty if not given
+  double lidar_range_noise_m = 0;   // 0 if not given
+
+  double BaselineMeters() const { return right_from_left.translation.norm(); }
+};
+
+// Throws std::runtime_error naming the file and the offending key (missing key, unknown camera model,
+// wrong number of parameters, non-finite values, zero baseline, ...).
+StationRig ReadRigJson(const std::string& path);
+void WriteRigJson(const std::string& path, const StationRig& rig);
+
+struct StationDataset {
+  std::string root;
+  StationRig rig;
+  std::vector<std::string> stations;  // sorted file stems, e.g. "000"
+  std::vector<std::string> cloud_paths;  // absolute, one per station
+
+  std::string LeftImagePath(size_t i) const;
+  std::string RightImagePath(size_t i) const;
+  // "left/<station>.png" etc.: the image name as stored in COLMAP's database.
+  std::string LeftImageName(size_t i) const;
+  std::string GroundTruthPath(const std::string& name) const;
+  bool HasGroundTruth() const;
+};
+
+// Reads and validates a dataset: rig.json, every left image has a right image and a cloud. Throws
+// std::runtime_error naming the missing or bad file.
+StationDataset ReadStationDataset(const std::string& root);
+
+// "<station> qw qx qy qz tx ty tz" per line (cam_from_world.txt, lidar_poses.txt, ...). '#' starts a comment.
+std::map<std::string, colmap::Rigid3d> ReadNamedPoses(const std::string& path);
+void WriteNamedPoses(const std::string& path,
+                     const std::string& header_comment,
+                     const std::map<std::string, colmap::Rigid3d>& poses);
+
+// A single "qw qx qy qz tx ty tz" line (cam_from_lidar.txt).
+colmap::Rigid3d ReadPoseFile(const std::string& path);
+void WritePoseFile(const std::string& path,
+                   const std::string& header_comment,
+                   const colmap::Rigid3d& target_from_source);
+
+// Writes `contents` to `path` through a temporary file and a rename: never half-written.
+void WriteFileAtomically(const std::string& path, const std::string& contents);
+
+}  // namespace colmap_lidar

@@ -1,0 +1,525 @@
+#include "lidar/cloud_io.h"
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/io/pcd_io.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void Fail(const std::string& path, const std::string& problem) {
+  throw std::runtime_error("Cannot read point cloud " + path + ": " + problem);
+}
+
+std::string LowerExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext;
+}
+
+// Accumulates points, dropping non-finite ones and counting them.
+class CloudBuilder {
+ public:
+  CloudBuilder(bool normals, bool colors, bool intensities)
+      : normals_(normals), colors_(colors), intensities_(intensities) {}
+
+  void Add(const Eigen::Vector3d& point,
+           const Eigen::Vector3d& normal,
+           const Color3ub& color,
+           float intensity) {
+    ++num_read_;
+    if (!point.allFinite() || (normals_ && !normal.allFinite())) {
+      ++num_dropped_;
+      return;
+    }
+    cloud_.points.push_back(point);
+    if (normals_) cloud_.normals.push_back(normal);
+    if (colors_) cloud_.colors.push_back(color);
+    if (intensities_) cloud_.intensities.push_back(intensity);
+  }
+
+  PointCloud Finish(const std::string& path, CloudReadStats* stats) {
+    if (num_read_ == 0) Fail(path, "the file holds no points");
+    if (cloud_.Empty()) {
+      Fail(path, "all " + std::to_string(num_read_) +
+                     " points are NaN or infinite");
+    }
+    if (stats) {
+      stats->num_read = num_read_;
+      stats->num_dropped_non_finite = num_dropped_;
+    }
+    return std::move(cloud_);
+  }
+
+ private:
+  bool normals_, colors_, intensities_;
+  size_t num_read_ = 0;
+  size_t num_dropped_ = 0;
+  PointCloud cloud_;
+};
+
+// ---------------------------------------------------------------- PCD (PCL)
+
+double ReadPcdValue(const pcl::PCLPointField& field, const uint8_t* data) {
+  switch (field.datatype) {
+    case pcl::PCLPointField::FLOAT32: {
+      float v;
+      std::memcpy(&v, data, 4);
+      return v;
+    }
+    case pcl::PCLPointField::FLOAT64: {
+      double v;
+      std::memcpy(&v, data, 8);
+      return v;
+    }
+    case pcl::PCLPointField::UINT8:
+      return *data;
+    case pcl::PCLPointField::INT8:
+      return static_cast<int8_t>(*data);
+    case pcl::PCLPointField::UINT16: {
+      uint16_t v;
+      std::memcpy(&v, data, 2);
+      return v;
+    }
+    case pcl::PCLPointField::INT16: {
+      int16_t v;
+      std::memcpy(&v, data, 2);
+      return v;
+    }
+    case pcl::PCLPointField::UINT32: {
+      uint32_t v;
+      std::memcpy(&v, data, 4);
+      return v;
+    }
+    case pcl::PCLPointField::INT32: {
+      int32_t v;
+      std::memcpy(&v, data, 4);
+      return v;
+    }
+    default:
+      return std::nan("");
+  }
+}
+
+PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
+  pcl::PCLPointCloud2 blob;
+  pcl::PCDReader reader;
+  if (reader.read(path, blob) < 0) {
+    Fail(path, "PCL's PCD reader rejected it (truncated or malformed; see "
+               "the message above)");
+  }
+  auto find = [&](const std::string& name) -> const pcl::PCLPointField* {
+    for (const auto& f : blob.fields) {
+      if (f.name == name) return &f;
+    }
+    return nullptr;
+  };
+  const pcl::PCLPointField* fx = find("x");
+  const pcl::PCLPointField* fy = find("y");
+  const pcl::PCLPointField* fz = find("z");
+  if (!fx || !fy || !fz) Fail(path, "no x, y, z fields");
+  const pcl::PCLPointField* fi = find("intensity");
+  const pcl::PCLPointField* fnx = find("normal_x");
+  const pcl::PCLPointField* fny = find("normal_y");
+  const pcl::PCLPointField* fnz = find("normal_z");
+  const pcl::PCLPointField* frgb = find("rgb");
+  if (!frgb) frgb = find("rgba");
+  const bool normals = fnx && fny && fnz;
+  const size_t num_points = static_cast<size_t>(blob.width) * blob.height;
+  if (blob.data.size() < num_points * blob.point_step) {
+    Fail(path, "truncated data section");
+  }
+  CloudBuilder builder(normals, frgb != nullptr, fi != nullptr);
+  for (size_t i = 0; i < num_points; ++i) {
+    const uint8_t* p = blob.data.data() + i * blob.point_step;
+    const Eigen::Vector3d point(ReadPcdValue(*fx, p + fx->offset),
+                                ReadPcdValue(*fy, p + fy->offset),
+                                ReadPcdValue(*fz, p + fz->offset));
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    if (normals) {
+      normal = Eigen::Vector3d(ReadPcdValue(*fnx, p + fnx->offset),
+                               ReadPcdValue(*fny, p + fny->offset),
+                               ReadPcdValue(*fnz, p + fnz->offset));
+    }
+    Color3ub color(0, 0, 0);
+    if (frgb) {
+      uint32_t rgb;
+      std::memcpy(&rgb, p + frgb->offset, 4);
+      color = Color3ub((rgb >> 16) & 0xff, (rgb >> 8) & 0xff, rgb & 0xff);
+    }
+    const float intensity =
+        fi ? static_cast<float>(ReadPcdValue(*fi, p + fi->offset)) : 0.f;
+    builder.Add(point, normal, color, intensity);
+  }
+  return builder.Finish(path, stats);
+}
+
+// ---------------------------------------------------------------- PLY
+
+struct PlyProperty {
+  std::string name;
+  std::string type;
+  int size = 0;
+};
+
+int PlyTypeSize(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8")
+    return 1;
+  if (type == "short" || type == "ushort" || type == "int16" ||
+      type == "uint16")
+    return 2;
+  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" ||
+      type == "float" || type == "float32")
+    return 4;
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
+
+double DecodePly(const std::string& type, const char* data, bool swap) {
+  char buffer[8];
+  const int size = PlyTypeSize(type);
+  std::memcpy(buffer, data, size);
+  if (swap) std::reverse(buffer, buffer + size);
+  if (type == "float" || type == "float32") {
+    float v;
+    std::memcpy(&v, buffer, 4);
+    return v;
+  }
+  if (type == "double" || type == "float64") {
+    double v;
+    std::memcpy(&v, buffer, 8);
+    return v;
+  }
+  if (type == "uchar" || type == "uint8") return static_cast<uint8_t>(buffer[0]);
+  if (type == "char" || type == "int8") return static_cast<int8_t>(buffer[0]);
+  if (type == "ushort" || type == "uint16") {
+    uint16_t v;
+    std::memcpy(&v, buffer, 2);
+    return v;
+  }
+  if (type == "short" || type == "int16") {
+    int16_t v;
+    std::memcpy(&v, buffer, 2);
+    return v;
+  }
+  if (type == "uint" || type == "uint32") {
+    uint32_t v;
+    std::memcpy(&v, buffer, 4);
+    return v;
+  }
+  int32_t v;
+  std::memcpy(&v, buffer, 4);
+  return v;
+}
+
+PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) Fail(path, "cannot open the file");
+  std::string line;
+  std::getline(file, line);
+  if (line.rfind("ply", 0) != 0) Fail(path, "not a PLY file (no 'ply' magic)");
+  std::string format;
+  size_t num_vertices = 0;
+  bool in_vertex = false;
+  bool vertex_seen = false;
+  std::vector<PlyProperty> properties;
+  while (std::getline(file, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream tokens(line);
+    std::string keyword;
+    tokens >> keyword;
+    if (keyword == "format") {
+      tokens >> format;
+    } else if (keyword == "element") {
+      std::string name;
+      size_t count = 0;
+      tokens >> name >> count;
+      if (name == "vertex") {
+        in_vertex = true;
+        vertex_seen = true;
+        num_vertices = count;
+      } else {
+        if (!vertex_seen) {
+          Fail(path, "element '" + name + "' before 'vertex' is not supported");
+        }
+        in_vertex = false;
+      }
+    } else if (keyword == "property" && in_vertex) {
+      PlyProperty property;
+      tokens >> property.type;
+      if (property.type == "list") Fail(path, "list property in vertex element");
+      tokens >> property.name;
+      property.size = PlyTypeSize(property.type);
+      if (property.size == 0) {
+        Fail(path, "unknown property type '" + property.type + "'");
+      }
+      properties.push_back(property);
+    } else if (keyword == "end_header") {
+      break;
+    }
+  }
+  if (line.rfind("end_header", 0) != 0) Fail(path, "no end_header");
+  if (format != "ascii" && format != "binary_little_endian" &&
+      format != "binary_big_endian") {
+    Fail(path, "unknown format '" + format + "'");
+  }
+  auto index_of = [&](std::initializer_list<const char*> names) {
+    for (size_t i = 0; i < properties.size(); ++i) {
+      for (const char* n : names) {
+        if (properties[i].name == n) return static_cast<int>(i);
+      }
+    }
+    return -1;
+  };
+  const int ix = index_of({"x"}), iy = index_of({"y"}), iz = index_of({"z"});
+  if (ix < 0 || iy < 0 || iz < 0) Fail(path, "no x, y, z vertex properties");
+  const int inx = index_of({"nx", "normal_x"});
+  const int iny = index_of({"ny", "normal_y"});
+  const int inz = index_of({"nz", "normal_z"});
+  const int ir = index_of({"red", "r"});
+  const int ig = index_of({"green", "g"});
+  const int ib = index_of({"blue", "b"});
+  const int ii = index_of({"intensity", "scalar_intensity", "scalar_Intensity"});
+  const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
+  const bool colors = ir >= 0 && ig >= 0 && ib >= 0;
+  CloudBuilder builder(normals, colors, ii >= 0);
+  std::vector<double> values(properties.size());
+  size_t record_size = 0;
+  for (const auto& p : properties) record_size += p.size;
+  std::vector<char> record(record_size);
+  const bool swap = format == "binary_big_endian";
+  for (size_t v = 0; v < num_vertices; ++v) {
+    if (format == "ascii") {
+      if (!std::getline(file, line)) {
+        Fail(path, "truncated: " + std::to_string(v) + " of " +
+                       std::to_string(num_vertices) + " vertices");
+      }
+      std::istringstream tokens(line);
+      for (double& value : values) {
+        std::string token;
+        if (!(tokens >> token)) {
+          Fail(path, "vertex " + std::to_string(v) + " has too few values");
+        }
+        try {
+          value = std::stod(token);
+        } catch (const std::exception&) {
+          if (token == "nan" || token == "-nan") {
+            value = std::nan("");
+          } else {
+            Fail(path, "vertex " + std::to_string(v) + ": '" + token +
+                           "' is not a number");
+          }
+        }
+      }
+    } else {
+      if (!file.read(record.data(), record_size)) {
+        Fail(path, "truncated: " + std::to_string(v) + " of " +
+                       std::to_string(num_vertices) + " vertices");
+      }
+      size_t offset = 0;
+      for (size_t i = 0; i < properties.size(); ++i) {
+        values[i] = DecodePly(properties[i].type, record.data() + offset, swap);
+        offset += properties[i].size;
+      }
+    }
+    const Eigen::Vector3d point(values[ix], values[iy], values[iz]);
+    const Eigen::Vector3d normal =
+        normals ? Eigen::Vector3d(values[inx], values[iny], values[inz])
+                : Eigen::Vector3d::Zero();
+    const Color3ub color =
+        colors ? Color3ub(static_cast<uint8_t>(values[ir]),
+                          static_cast<uint8_t>(values[ig]),
+                          static_cast<uint8_t>(values[ib]))
+               : Color3ub(0, 0, 0);
+    builder.Add(point, normal, color,
+                ii >= 0 ? static_cast<float>(values[ii]) : 0.f);
+  }
+  return builder.Finish(path, stats);
+}
+
+// ---------------------------------------------------------------- KITTI / text
+
+PointCloud ReadKittiBin(const std::string& path, CloudReadStats* stats) {
+  const auto num_bytes = fs::file_size(path);
+  if (num_bytes % (4 * sizeof(float)) != 0) {
+    Fail(path, "size " + std::to_string(num_bytes) +
+                   " bytes is not a multiple of 16 (float32 x y z i): "
+                   "truncated or not a KITTI .bin");
+  }
+  std::ifstream file(path, std::ios::binary);
+  std::vector<float> data(num_bytes / sizeof(float));
+  if (!file.read(reinterpret_cast<char*>(data.data()), num_bytes)) {
+    Fail(path, "read error");
+  }
+  CloudBuilder builder(false, false, true);
+  for (size_t i = 0; i + 3 < data.size(); i += 4) {
+    builder.Add(Eigen::Vector3d(data[i], data[i + 1], data[i + 2]),
+                Eigen::Vector3d::Zero(), Color3ub(0, 0, 0), data[i + 3]);
+  }
+  return builder.Finish(path, stats);
+}
+
+PointCloud ReadXyzText(const std::string& path, CloudReadStats* stats) {
+  std::ifstream file(path);
+  if (!file) Fail(path, "cannot open the file");
+  std::string line;
+  size_t line_number = 0;
+  CloudBuilder* builder = nullptr;
+  CloudBuilder with_i(false, false, true), without_i(false, false, false);
+  while (std::getline(file, line)) {
+    ++line_number;
+    if (line.empty() || line[0] == '#' || line[0] == '/') continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream tokens(line);
+    std::vector<double> values;
+    std::string token;
+    while (tokens >> token) {
+      try {
+        values.push_back(std::stod(token));
+      } catch (const std::exception&) {
+        Fail(path, "line " + std::to_string(line_number) + ": '" + token +
+                       "' is not a number");
+      }
+    }
+    if (values.size() < 3) {
+      Fail(path, "line " + std::to_string(line_number) +
+                     " has fewer than 3 values");
+    }
+    if (!builder) builder = values.size() >= 4 ? &with_i : &without_i;
+    builder->Add(Eigen::Vector3d(values[0], values[1], values[2]),
+                 Eigen::Vector3d::Zero(), Color3ub(0, 0, 0),
+                 values.size() >= 4 ? static_cast<float>(values[3]) : 0.f);
+  }
+  return (builder ? builder : &without_i)->Finish(path, stats);
+}
+
+// ---------------------------------------------------------------- writers
+
+void WritePcdBinary(std::ostream& out, const PointCloud& cloud) {
+  std::string fields = "x y z", sizes = "4 4 4", types = "F F F",
+              counts = "1 1 1";
+  auto add = [&](const char* name, const char* type) {
+    fields += std::string(" ") + name;
+    sizes += " 4";
+    types += std::string(" ") + type;
+    counts += " 1";
+  };
+  if (cloud.HasIntensities()) add("intensity", "F");
+  if (cloud.HasNormals()) {
+    add("normal_x", "F");
+    add("normal_y", "F");
+    add("normal_z", "F");
+  }
+  if (cloud.HasColors()) add("rgb", "F");
+  out << "# .PCD v0.7 - Point Cloud Data file format (written by colmap-lidar)\n"
+      << "VERSION 0.7\nFIELDS " << fields << "\nSIZE " << sizes << "\nTYPE "
+      << types << "\nCOUNT " << counts << "\nWIDTH " << cloud.Size()
+      << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << cloud.Size()
+      << "\nDATA binary\n";
+  std::vector<float> row;
+  for (size_t i = 0; i < cloud.Size(); ++i) {
+    row.assign(cloud.points[i].data(), cloud.points[i].data() + 3);
+    if (cloud.HasIntensities()) row.push_back(cloud.intensities[i]);
+    if (cloud.HasNormals()) {
+      for (int k = 0; k < 3; ++k) row.push_back(cloud.normals[i][k]);
+    }
+    if (cloud.HasColors()) {
+      const uint32_t rgb = (uint32_t(cloud.colors[i][0]) << 16) |
+                           (uint32_t(cloud.colors[i][1]) << 8) |
+                           cloud.colors[i][2];
+      float packed;
+      std::memcpy(&packed, &rgb, 4);
+      row.push_back(packed);
+    }
+    out.write(reinterpret_cast<const char*>(row.data()),
+              row.size() * sizeof(float));
+  }
+}
+
+void WritePlyBinary(std::ostream& out, const PointCloud& cloud) {
+  out << "ply\nformat binary_little_endian 1.0\ncomment written by "
+         "colmap-lidar\nelement vertex "
+      << cloud.Size()
+      << "\nproperty float x\nproperty float y\nproperty float z\n";
+  if (cloud.HasNormals()) {
+    out << "property float nx\nproperty float ny\nproperty float nz\n";
+  }
+  if (cloud.HasColors()) {
+    out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  }
+  if (cloud.HasIntensities()) out << "property float intensity\n";
+  out << "end_header\n";
+  std::vector<char> row;
+  auto put = [&row](const void* data, size_t n) {
+    const char* bytes = static_cast<const char*>(data);
+    row.insert(row.end(), bytes, bytes + n);
+  };
+  for (size_t i = 0; i < cloud.Size(); ++i) {
+    row.clear();
+    const Eigen::Vector3f p = cloud.points[i].cast<float>();
+    put(p.data(), 12);
+    if (cloud.HasNormals()) {
+      const Eigen::Vector3f n = cloud.normals[i].cast<float>();
+      put(n.data(), 12);
+    }
+    if (cloud.HasColors()) put(cloud.colors[i].data(), 3);
+    if (cloud.HasIntensities()) put(&cloud.intensities[i], 4);
+    out.write(row.data(), row.size());
+  }
+}
+
+}  // namespace
+
+PointCloud ReadPointCloud(const std::string& path, CloudReadStats* stats) {
+  if (!fs::is_regular_file(path)) Fail(path, "no such file");
+  if (fs::file_size(path) == 0) Fail(path, "the file is empty");
+  const std::string ext = LowerExtension(path);
+  if (ext == ".pcd") return ReadPcd(path, stats);
+  if (ext == ".ply") return ReadPly(path, stats);
+  if (ext == ".bin") return ReadKittiBin(path, stats);
+  if (ext == ".xyz" || ext == ".txt") return ReadXyzText(path, stats);
+  Fail(path, "unknown extension '" + ext + "' (expected .pcd .ply .bin .xyz .txt)");
+}
+
+void WritePointCloud(const std::string& path, const PointCloud& cloud) {
+  cloud.CheckConsistent();
+  const std::string ext = LowerExtension(path);
+  if (ext != ".pcd" && ext != ".ply") {
+    throw std::invalid_argument("Cannot write point cloud " + path +
+                                ": extension must be .pcd or .ply");
+  }
+  const std::string tmp_path =
+      path + ".tmp" + std::to_string(static_cast<long>(::getpid()));
+  {
+    std::ofstream out(tmp_path, std::ios::binary);
+    if (!out) {
+      throw std::runtime_error("Cannot write point cloud " + path +
+                               ": cannot create " + tmp_path);
+    }
+    if (ext == ".pcd") {
+      WritePcdBinary(out, cloud);
+    } else {
+      WritePlyBinary(out, cloud);
+    }
+    out.flush();
+    if (!out) {
+      out.close();
+      fs::remove(tmp_path);
+      throw std::runtime_error("Cannot write point cloud " + path +
+                               ": write failed (disk full?)");
+    }
+  }
+  fs::rename(tmp_path, path);
+}
+
+}  // namespace colmap_lidar

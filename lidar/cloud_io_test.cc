@@ -1,0 +1,145 @@
+#include "lidar/cloud_io.h"
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+
+class CloudIoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("colmap_lidar_cloud_io_" + std::to_string(std::random_device()()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string Path(const std::string& name) const {
+    return (dir_ / name).string();
+  }
+
+  static PointCloud RandomCloud(size_t n, bool attributes) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-20, 20);
+    PointCloud cloud;
+    for (size_t i = 0; i < n; ++i) {
+      cloud.points.emplace_back(u(rng), u(rng), u(rng));
+      if (attributes) {
+        cloud.normals.push_back(
+            Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
+        cloud.colors.emplace_back(i % 256, (3 * i) % 256, 255 - i % 256);
+        cloud.intensities.push_back(static_cast<float>(i % 100));
+      }
+    }
+    return cloud;
+  }
+
+  // Expects ReadPointCloud(path) to throw an error that names the file and contains `problem`.
+  void ExpectReadError(const std::string& path, const std::string& problem) {
+    try {
+      ReadPointCloud(path);
+      ADD_FAILURE() << "reading " << path << " succeeded";
+    } catch (const std::runtime_error& error) {
+      const std::string what = error.what();
+      EXPECT_NE(what.find(path), std::string::npos) << what;
+      EXPECT_NE(what.find(problem), std::string::npos) << what;
+    }
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(CloudIoTest, PcdAndPlyRoundTripWithAllAttributes) {
+  const PointCloud cloud = RandomCloud(1000, true);
+  for (const std::string name : {"a.pcd", "a.ply"}) {
+    WritePointCloud(Path(name), cloud);
+    CloudReadStats stats;
+    const PointCloud read = ReadPointCloud(Path(name), &stats);
+    ASSERT_EQ(read.Size(), cloud.Size()) << name;
+    ASSERT_TRUE(read.HasNormals() && read.HasColors() && read.HasIntensities())
+        << name;
+    EXPECT_EQ(stats.num_read, 1000u);
+    EXPECT_EQ(stats.num_dropped_non_finite, 0u);
+    double max_error = 0;
+    for (size_t i = 0; i < cloud.Size(); ++i) {
+      max_error = std::max(max_error, (read.points[i] - cloud.points[i]).norm());
+      EXPECT_EQ(read.colors[i], cloud.colors[i]);
+      EXPECT_FLOAT_EQ(read.intensities[i], cloud.intensities[i]);
+      EXPECT_NEAR((read.normals[i] - cloud.normals[i]).norm(), 0, 1e-6);
+    }
+    // float32 storage: relative precision ~6e-8 at |x| <= 35 m.
+    EXPECT_LT(max_error, 5e-6) << name;
+    EXPECT_FALSE(fs::exists(Path(name) + ".tmp")) << "temporary file left";
+  }
+}
+
+TEST_F(CloudIoTest, ReadsKittiBinAndXyzText) {
+  const std::vector<float> kitti = {1, 2, 3, 0.5f, 4, 5, 6, 0.25f};
+  std::ofstream(Path("k.bin"), std::ios::binary)
+      .write(reinterpret_cast<const char*>(kitti.data()), 32);
+  const PointCloud k = ReadPointCloud(Path("k.bin"));
+  ASSERT_EQ(k.Size(), 2u);
+  EXPECT_EQ(k.points[1], Eigen::Vector3d(4, 5, 6));
+  EXPECT_FLOAT_EQ(k.intensities[0], 0.5f);
+
+  std::ofstream(Path("p.xyz")) << "# comment\n1 2 3\n4.5 5 6\n\n7,8,9\n";
+  const PointCloud t = ReadPointCloud(Path("p.xyz"));
+  ASSERT_EQ(t.Size(), 3u);
+  EXPECT_EQ(t.points[2], Eigen::Vector3d(7, 8, 9));
+}
+
+TEST_F(CloudIoTest, ReadsAsciiPlyAndDropsNonFinitePoints) {
+  std::ofstream(Path("a.ply"))
+      << "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\n"
+         "property double y\nproperty double z\nelement face 0\n"
+         "property list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 nan 1\n2 2 2\ninf 0 0\n";
+  CloudReadStats stats;
+  const PointCloud cloud = ReadPointCloud(Path("a.ply"), &stats);
+  EXPECT_EQ(cloud.Size(), 2u);
+  EXPECT_EQ(stats.num_read, 4u);
+  EXPECT_EQ(stats.num_dropped_non_finite, 2u);
+}
+
+TEST_F(CloudIoTest, RejectsBadFilesWithTheFileNamed) {
+  ExpectReadError(Path("missing.pcd"), "no such file");
+  std::ofstream(Path("empty.ply"));
+  ExpectReadError(Path("empty.ply"), "empty");
+
+  // Truncated binary PLY and PCD: cut the last 100 bytes.
+  const PointCloud cloud = RandomCloud(500, true);
+  for (const std::string name : {"cut.ply", "cut.pcd"}) {
+    WritePointCloud(Path(name), cloud);
+    fs::resize_file(Path(name), fs::file_size(Path(name)) - 100);
+    ExpectReadError(Path(name), name == "cut.ply" ? "truncated" : "PCD");
+  }
+
+  std::ofstream(Path("cut.bin"), std::ios::binary) << "0123456789";
+  ExpectReadError(Path("cut.bin"), "multiple of 16");
+
+  PointCloud nan_cloud;
+  nan_cloud.points.assign(10, Eigen::Vector3d::Constant(std::nan("")));
+  WritePointCloud(Path("nan.pcd"), nan_cloud);
+  ExpectReadError(Path("nan.pcd"), "NaN");
+
+  std::ofstream(Path("typed.ply"))
+      << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+         "property float y\nproperty float z\nend_header\n1 two 3\n";
+  ExpectReadError(Path("typed.ply"), "not a number");
+
+  std::ofstream(Path("noxyz.ply"))
+      << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\n"
+         "end_header\n1\n";
+  ExpectReadError(Path("noxyz.ply"), "x, y, z");
+
+  std::ofstream(Path("notes.las")) << "x";
+  ExpectReadError(Path("notes.las"), "unknown extension");
+}
+
+}  // namespace
+}  // namespace colmap_lidar

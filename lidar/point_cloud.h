@@ -1,0 +1,30 @@
+// An Eigen-only point cloud: positions, optional normals, colours and intensities (each either empty or
+// of the same length as `points`). Positions are in the frame the producer names (e.g. point_in_lidar).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace colmap_lidar {
+
+using Color3ub = Eigen::Matrix<uint8_t, 3, 1>;
+
+struct PointCloud {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3d> normals;
+  std::vector<Color3ub> colors;
+  std::vector<float> intensities;
+
+  size_t Size() const { return points.size(); }
+  bool Empty() const { return points.empty(); }
+  bool HasNormals() const { return !normals.empty(); }
+  bool HasColors() const { return !colors.empty(); }
+  bool HasIntensities() const { return !intensities.empty(); }
+
+  // Throws std::invalid_argument when an attribute has neither 0 nor Size() entries.
+  void CheckConsistent() const;
+  void Reserve(size_t n, bool normals, bool colors, bool intensities);
+};
+
+}  // namespace colmap_lidar

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Fails when a layer includes (or links) what it must not:
+#   lidar/       no COLMAP, no colmap_ext/bridge/tests; its public headers (.h) include only Eigen and std
+#   colmap_ext/  no lidar/, bridge/ or tests/
+#   bridge/      no tests/ (only the CLI main, bridge/colmap_lidar_main.cc, links the simulator)
+# Prints every violation as file:line and exits 1 if there is any.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+status=0
+violation() { echo "layering: $1"; status=1; }
+
+check_includes() {  # folder, regex of forbidden includes, what
+  local hits
+  hits=$(grep -rnE "^\s*#\s*include\s*[<\"]($2)" --include='*.h' --include='*.cc' "$1" || true)
+  [ -z "$hits" ] || violation "$1 must not include $3:"$'\n'"$hits"
+}
+
+check_includes lidar 'colmap/|colmap_ext/|bridge/|tests/' "COLMAP, colmap_ext, bridge or tests"
+check_includes colmap_ext 'lidar/|bridge/|tests/' "lidar, bridge or tests"
+hits=$(grep -rnE '^\s*#\s*include\s*"tests/' --include='*.h' --include='*.cc' bridge |
+       grep -v '^bridge/colmap_lidar_main.cc:' || true)
+[ -z "$hits" ] || violation "the bridge library must not include tests/:"$'\n'"$hits"
+
+# lidar's public headers speak Eigen: no PCL, FLANN, nanoflann, OpenCV or Ceres in lidar/*.h.
+hits=$(grep -nE '^\s*#\s*include\s*<(pcl/|flann/|nanoflann|opencv2/|ceres/)' lidar/*.h || true)
+[ -z "$hits" ] || violation "lidar public headers must include only Eigen and std:"$'\n'"$hits"
+
+# Link lines: lidar links no COLMAP; colmap_ext does not link lidar; bridge library no simulator.
+grep -qE 'colmap::colmap|colmap_lidar::(colmap_ext|bridge|simulator)' lidar/CMakeLists.txt &&
+  violation "lidar/CMakeLists.txt links COLMAP or another layer"
+grep -qE 'colmap_lidar::(lidar|bridge|simulator)' colmap_ext/CMakeLists.txt &&
+  violation "colmap_ext/CMakeLists.txt links lidar, bridge or the simulator"
+sed -n '/add_library(colmap_lidar_bridge/,/^)/p;/target_link_libraries(colmap_lidar_bridge/,/)/p' \
+  bridge/CMakeLists.txt | grep -q 'simulator' &&
+  violation "the bridge library links the simulator"
+
+[ $status -eq 0 ] && echo "layering: ok (lidar | colmap_ext -> bridge -> CLI)"
+exit $status

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs what is missing (scripts/setup.sh), builds colmap-lidar and runs every test: the layering
+# check, the unit tests beside the sources and the integration tests under tests/.
+#   BUILD_DIR  build directory (default: build)
+#   JOBS       parallel build jobs (default: nproc)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
+readonly kBuildDir="${BUILD_DIR:-build}"
+echo "[test] layering check"
+bash scripts/check_layering.sh
+echo "[test] configuring and building in $kBuildDir"
+cmake -S . -B "$kBuildDir" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$kColmapPrefix${CMAKE_PREFIX_PATH:+;$CMAKE_PREFIX_PATH}" >/dev/null
+cmake --build "$kBuildDir" -j "${JOBS:-$(nproc)}"
+echo "[test] running the tests"
+cd "$kBuildDir"
+ctest --output-on-failure -j "${JOBS:-$(nproc)}"
