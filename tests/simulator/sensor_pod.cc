@@ -1,0 +1,157 @@
+#include "tests/simulator/sensor_pod.h"
+
+#include "colmap/sensor/models.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace colmap_lidar {
+namespace sim {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+// world_from_cam rotation of a camera with heading `yaw` (angle of the optical axis in the ground
+// plane, from world x towards y), pitched up by `pitch` and rolled by `roll` about its optical axis.
+Eigen::Matrix3d WorldFromCamRotation(double yaw, double pitch, double roll) {
+  const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw),
+                                std::cos(pitch) * std::sin(yaw),
+                                std::sin(pitch));
+  const Eigen::Vector3d right =
+      forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d down = forward.cross(right);
+  Eigen::Matrix3d world_from_cam;
+  world_from_cam << right, down, forward;
+  return world_from_cam *
+         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+colmap::Rigid3d CamFromWorld(const Eigen::Matrix3d& world_from_cam,
+                             const Eigen::Vector3d& center) {
+  const Eigen::Matrix3d cam_from_world = world_from_cam.transpose();
+  return colmap::Rigid3d(Eigen::Quaterniond(cam_from_world),
+                         -cam_from_world * center);
+}
+
+}  // namespace
+
+Motion MotionFromName(const std::string& name) {
+  if (name == "two_axes") return Motion::kTwoAxes;
+  if (name == "one_axis") return Motion::kOneAxis;
+  if (name == "fixed_rotation") return Motion::kFixedRotation;
+  throw std::invalid_argument("Unknown --motion '" + name +
+                              "'; expected two_axes, one_axis or fixed_rotation");
+}
+
+StationRig MakeStereoRig(double image_scale) {
+  const size_t width = static_cast<size_t>(std::lround(1028 * image_scale));
+  const size_t height = static_cast<size_t>(std::lround(752 * image_scale));
+  const double focal = 0.5 * width / std::tan(24 * kDegToRad);
+  StationRig rig;
+  rig.left = colmap::Camera::CreateFromModelName(colmap::kInvalidCameraId,
+                                                 "PINHOLE", focal, width, height);
+  rig.right = rig.left;
+  // The right camera sits 0.38 m to the right, with a small residual misalignment as on a real bar.
+  rig.right_from_left.rotation = Eigen::Quaterniond(
+      Eigen::AngleAxisd(0.15 * kDegToRad, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
+  rig.right_from_left.translation = Eigen::Vector3d(-0.38, 0.0, 0.0);
+  rig.lidar_model = "VLP-16";
+  return rig;
+}
+
+colmap::Rigid3d TrueCamFromLidar() {
+  // LiDAR axes (x forward, y left, z up) expressed in the camera (x right, y down, z forward)...
+  Eigen::Matrix3d cam_from_lidar_axes;
+  cam_from_lidar_axes << 0, -1, 0,  //
+      0, 0, -1,                     //
+      1, 0, 0;
+  // ... with a generic mounting error of a few degrees.
+  const Eigen::Matrix3d misalignment =
+      (Eigen::AngleAxisd(1.5 * kDegToRad, Eigen::Vector3d::UnitX()) *
+       Eigen::AngleAxisd(-2.0 * kDegToRad, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(2.5 * kDegToRad, Eigen::Vector3d::UnitZ()))
+          .toRotationMatrix();
+  // The LiDAR's origin in the camera frame: 0.19 m right (mid-baseline), 0.25 m up, 0.05 m back.
+  return colmap::Rigid3d(Eigen::Quaterniond(cam_from_lidar_axes * misalignment),
+                         Eigen::Vector3d(0.19, -0.25, -0.05));
+}
+
+colmap::Rigid3d PerturbPose(const colmap::Rigid3d& truth,
+                            double rotation_deg,
+                            double translation_m,
+                            uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal;
+  const Eigen::Vector3d axis =
+      Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  const Eigen::Vector3d shift =
+      Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  colmap::Rigid3d perturbed = truth;
+  perturbed.rotation =
+      (Eigen::Quaterniond(Eigen::AngleAxisd(rotation_deg * kDegToRad, axis)) *
+       truth.rotation)
+          .normalized();
+  perturbed.translation += translation_m * shift;
+  return perturbed;
+}
+
+std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
+                                          int num_stations,
+                                          Motion motion,
+                                          uint64_t seed) {
+  if (num_stations < 2) throw std::invalid_argument("Need at least 2 stations");
+  std::mt19937_64 rng(seed ^ 0x5eed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const Eigen::Vector3d& c = scene.ObjectCenter();
+  const double look_height = std::min(1.2, 0.5 * scene.ObjectHeight());
+  const double ring_pitch = -4 * kDegToRad;  // the same for all tripod stations
+  std::vector<colmap::Rigid3d> stations;
+
+  if (motion == Motion::kFixedRotation) {
+    // A line of stations in front of the structure, all with the same orientation.
+    const double yaw = M_PI / 2;  // looking along +y from the -y side
+    const Eigen::Matrix3d world_from_cam = WorldFromCamRotation(yaw, ring_pitch, 0);
+    const double distance = scene.ObjectRadius() + 2.3;
+    for (int i = 0; i < num_stations; ++i) {
+      const double s = -1.2 + 2.4 * i / (num_stations - 1);
+      const Eigen::Vector3d center(c.x() + s, c.y() - distance + 0.3 * unit(rng),
+                                   1.1 + 0.2 * unit(rng));
+      stations.push_back(CamFromWorld(world_from_cam, center));
+    }
+    return stations;
+  }
+
+  const int num_tilted =
+      motion == Motion::kTwoAxes ? std::max(2, (num_stations + 2) / 5) : 0;
+  const int num_ring = num_stations - num_tilted;
+  auto ring_azimuth = [&](double k) { return 2 * M_PI * k / num_ring - M_PI / 2; };
+  for (int i = 0; i < num_ring; ++i) {
+    const double azimuth = ring_azimuth(i);  // position of the station around the structure
+    const double distance = scene.ObjectRadius() + 2.0 + 0.8 * unit(rng);
+    const Eigen::Vector3d center = c + distance * Eigen::Vector3d(std::cos(azimuth),
+                                                                  std::sin(azimuth), 0);
+    const Eigen::Vector3d eye(center.x(), center.y(),
+                              look_height + distance * std::tan(-ring_pitch));
+    const double yaw = azimuth + M_PI + 0.06 * (unit(rng) - 0.5);
+    stations.push_back(CamFromWorld(WorldFromCamRotation(yaw, ring_pitch, 0), eye));
+  }
+  // Stations tilted up from near the ground, between the tripod ones, with alternating roll.
+  for (int i = 0; i < num_tilted; ++i) {
+    const double azimuth = ring_azimuth((i + 0.5) * num_ring / double(num_tilted));
+    const double distance = scene.ObjectRadius() + 2.2 + 0.5 * unit(rng);
+    const Eigen::Vector3d eye =
+        c + distance * Eigen::Vector3d(std::cos(azimuth), std::sin(azimuth), 0);
+    const double pitch = std::atan2(look_height - 0.45, distance) +
+                         (8 + 6 * unit(rng)) * kDegToRad;
+    const double roll = (i % 2 ? 1 : -1) * (6 + 4 * unit(rng)) * kDegToRad;
+    stations.push_back(CamFromWorld(
+        WorldFromCamRotation(azimuth + M_PI, pitch, roll),
+        Eigen::Vector3d(eye.x(), eye.y(), 0.45)));
+  }
+  return stations;
+}
+
+}  // namespace sim
+}  // namespace colmap_lidar

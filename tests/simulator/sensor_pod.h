@@ -1,0 +1,45 @@
+// The simulated sensor pod: a wide-baseline stereo pair (COLMAP camera frames: x right, y down,
+// z forward) and a VLP-16 on a motor (LiDAR frame: x forward, y left, z up), and its stations.
+// Transforms are target_from_source; quaternions are Eigen (xyzw storage) in memory.
+#pragma once
+
+#include "colmap_ext/station_dataset.h"
+#include "tests/simulator/scene.h"
+
+#include "colmap/geometry/rigid3.h"
+
+#include <string>
+#include <vector>
+
+namespace colmap_lidar {
+namespace sim {
+
+enum class Motion {
+  kTwoAxes,        // tripod rotations about the vertical, the last stations tilted about a second axis
+  kOneAxis,        // every relative rotation about the vertical axis: T_e translation along it unobservable
+  kFixedRotation,  // pure translations: T_e translation unobservable
+};
+Motion MotionFromName(const std::string& name);  // "two_axes", "one_axis", "fixed_rotation"
+
+// Left and right PINHOLE cameras of width 1028*image_scale with a 48 deg horizontal FOV, 0.38 m baseline.
+StationRig MakeStereoRig(double image_scale);
+
+// The pod's true cam_from_lidar: LiDAR 0.25 m above the left camera, near the middle of the baseline,
+// mounted with a small, generic misalignment.
+colmap::Rigid3d TrueCamFromLidar();
+
+// `truth` rotated by `rotation_deg` about a random axis and shifted by `translation_m` in a random
+// direction (seeded).
+colmap::Rigid3d PerturbPose(const colmap::Rigid3d& truth,
+                            double rotation_deg,
+                            double translation_m,
+                            uint64_t seed);
+
+// cam_from_world of the left camera of each station, 2-3 m from the structure and looking at it.
+std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
+                                          int num_stations,
+                                          Motion motion,
+                                          uint64_t seed);
+
+}  // namespace sim
+}  // namespace colmap_lidar

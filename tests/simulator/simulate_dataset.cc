@@ -1,0 +1,150 @@
+#include "tests/simulator/simulate_dataset.h"
+
+#include "colmap_ext/logging.h"
+#include "colmap_ext/station_dataset.h"
+#include "lidar/cloud_io.h"
+#include "tests/simulator/renderer.h"
+#include "tests/simulator/scene.h"
+#include "tests/simulator/sensor_pod.h"
+
+#include "colmap/mvs/depth_map.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+namespace colmap_lidar {
+namespace sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string StationName(int i) {
+  std::ostringstream name;
+  name << std::setw(3) << std::setfill('0') << i;
+  return name.str();
+}
+
+void WriteDepthMap(const std::string& path, const cv::Mat& depth) {
+  double min_depth = 0, max_depth = 0;
+  cv::minMaxLoc(depth, &min_depth, &max_depth);
+  colmap::mvs::DepthMap depth_map(depth.cols, depth.rows, 0.f,
+                                  static_cast<float>(max_depth));
+  for (int row = 0; row < depth.rows; ++row) {
+    for (int col = 0; col < depth.cols; ++col) {
+      depth_map.Set(row, col, depth.at<float>(row, col));
+    }
+  }
+  depth_map.Write(path);
+}
+
+void WriteImage(const std::string& path, const cv::Mat& image) {
+  if (!cv::imwrite(path, image)) {
+    throw std::runtime_error("Cannot write image " + path);
+  }
+}
+
+}  // namespace
+
+bool SimulationOptions::Check() const {
+  CHECK_OPTION(!output_path.empty());
+  CHECK_OPTION_GE(num_stations, 2);
+  CHECK_OPTION_GT(image_scale, 0.05);
+  CHECK_OPTION_LE(image_scale, 4.0);
+  CHECK_OPTION_GE(lidar_points, 1000);
+  CHECK_OPTION_GE(range_noise_m, 0);
+  CHECK_OPTION_GE(pixel_noise, 0);
+  CHECK_OPTION_GE(guess_rotation_deg, 0);
+  CHECK_OPTION_GE(guess_translation_m, 0);
+  CHECK_OPTION_GT(surface_spacing_m, 1e-4);
+  return true;
+}
+
+SimulationResult SimulateDataset(const SimulationOptions& options) {
+  THROW_CHECK(options.Check()) << "Invalid simulation options";
+  const auto start = std::chrono::steady_clock::now();
+  const Scene scene = Scene::Create(options.scene);
+  const Motion motion = MotionFromName(options.motion);
+  const fs::path output(options.output_path);
+  if (fs::exists(output) && !options.overwrite) {
+    throw std::runtime_error(output.string() +
+                             " exists; pass --overwrite 1 to replace it");
+  }
+  const fs::path partial = output.string() + ".partial";
+  fs::remove_all(partial);
+  for (const char* dir : {"images/left", "images/right", "lidar",
+                          "ground_truth/depth"}) {
+    fs::create_directories(partial / dir);
+  }
+
+  StationRig rig = MakeStereoRig(options.image_scale);
+  const colmap::Rigid3d cam_from_lidar = TrueCamFromLidar();
+  if (options.write_guess) {
+    rig.cam_from_lidar_guess =
+        PerturbPose(cam_from_lidar, options.guess_rotation_deg,
+                    options.guess_translation_m, options.seed + 1);
+  }
+  rig.lidar_range_noise_m = options.range_noise_m;
+  WriteRigJson((partial / "rig.json").string(), rig);
+
+  const std::vector<colmap::Rigid3d> stations =
+      MakeStations(scene, options.num_stations, motion, options.seed);
+  SimulationResult result;
+  std::map<std::string, colmap::Rigid3d> cam_from_world;
+  for (size_t i = 0; i < stations.size(); ++i) {
+    const std::string name = StationName(static_cast<int>(i));
+    cam_from_world[name] = stations[i];
+    ImageOptions image_options;
+    image_options.pixel_noise = options.pixel_noise;
+    image_options.vignetting = options.vignetting;
+    image_options.seed = options.seed * 1000 + 2 * i;
+    cv::Mat depth;
+    WriteImage((partial / "images/left" / (name + ".png")).string(),
+               RenderImage(scene, rig.left, stations[i], image_options, &depth));
+    WriteDepthMap((partial / "ground_truth/depth" / (name + ".bin")).string(), depth);
+    image_options.seed += 1;
+    WriteImage((partial / "images/right" / (name + ".png")).string(),
+               RenderImage(scene, rig.right, rig.right_from_left * stations[i],
+                           image_options, nullptr));
+
+    LidarOptions lidar_options;
+    lidar_options.num_points = options.lidar_points;
+    lidar_options.range_noise_m = options.range_noise_m;
+    lidar_options.mixed_edge_points = options.mixed_edge_points;
+    lidar_options.seed = options.seed * 1000 + i;
+    // world_from_lidar = inverse(cam_from_world) * cam_from_lidar
+    const PointCloud cloud = ScanLidar(
+        scene, colmap::Inverse(stations[i]) * cam_from_lidar, lidar_options);
+    WritePointCloud((partial / "lidar" / (name + ".pcd")).string(), cloud);
+    result.num_lidar_points += cloud.Size();
+    std::cout << "simulate_dataset: station " << name << " (" << i + 1 << "/"
+              << stations.size() << "): " << cloud.Size() << " LiDAR points"
+              << std::endl;
+  }
+  WriteNamedPoses((partial / "ground_truth/cam_from_world.txt").string(),
+                  "True pose of each station's left camera: cam_from_world",
+                  cam_from_world);
+  WritePoseFile((partial / "ground_truth/cam_from_lidar.txt").string(),
+                "True extrinsic: cam_from_lidar (x_cam = R x_lidar + t)",
+                cam_from_lidar);
+  const PointCloud surface = scene.SampleObjectSurface(options.surface_spacing_m);
+  WritePointCloud((partial / "ground_truth/surface.ply").string(), surface);
+  result.num_surface_points = surface.Size();
+
+  if (fs::exists(output)) fs::remove_all(output);
+  fs::rename(partial, output);
+  result.num_stations = static_cast<int>(stations.size());
+  result.seconds = std::chrono::duration<double>(
+                       std::chrono::steady_clock::now() - start)
+                       .count();
+  return result;
+}
+
+}  // namespace sim
+}  // namespace colmap_lidar
