@@ -1,4 +1,5 @@
 #include "colmap_ext/extension_database.h"
+#include "tests/testing/scoped_temp_dir.h"
 
 #include "colmap/scene/database.h"
 #include "colmap/sensor/models.h"
@@ -19,10 +20,7 @@ namespace fs = std::filesystem;
 class ExtensionDatabaseTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("colmap_lidar_db_test_" + std::to_string(std::random_device()()));
-    fs::create_directories(dir_);
-    path_ = (dir_ / "database.db").string();
+    path_ = dir_.File("database.db");
     colmap::Database database(path_);
     const colmap::Camera camera = colmap::Camera::CreateFromModelName(
         colmap::kInvalidCameraId, "PINHOLE", 800, 1028, 752);
@@ -34,7 +32,6 @@ class ExtensionDatabaseTest : public ::testing::Test {
       image_ids_.push_back(database.WriteImage(image));
     }
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   static std::vector<DepthPrior> MakePriors(int n, double depth0) {
     std::vector<DepthPrior> priors;
@@ -46,7 +43,7 @@ class ExtensionDatabaseTest : public ::testing::Test {
     return priors;
   }
 
-  fs::path dir_;
+  testing::ScopedTempDir dir_;
   std::string path_;
   colmap::camera_t camera_id_ = 0;
   std::vector<colmap::image_t> image_ids_;
@@ -205,7 +202,7 @@ TEST_F(ExtensionDatabaseTest, ReadOnlyDatabaseRefusesWrites) {
 }
 
 TEST_F(ExtensionDatabaseTest, RejectsMissingAndNonColmapFiles) {
-  const std::string missing = (dir_ / "missing.db").string();
+  const std::string missing = dir_.File("missing.db");
   try {
     ExtensionDatabase db(missing);
     ADD_FAILURE();
@@ -214,11 +211,11 @@ TEST_F(ExtensionDatabaseTest, RejectsMissingAndNonColmapFiles) {
   }
   EXPECT_FALSE(fs::exists(missing)) << "opening must never create a file";
 
-  const std::string text = (dir_ / "notes.db").string();
+  const std::string text = dir_.File("notes.db");
   std::ofstream(text) << "this is not an sqlite database, just some text....";
   EXPECT_THROW(ExtensionDatabase db(text), std::runtime_error);
 
-  const std::string empty_sqlite = (dir_ / "empty.db").string();
+  const std::string empty_sqlite = dir_.File("empty.db");
   sqlite3* handle = nullptr;
   sqlite3_open(empty_sqlite.c_str(), &handle);
   sqlite3_exec(handle, "CREATE TABLE other(x)", nullptr, nullptr, nullptr);

@@ -1,4 +1,5 @@
 #include "lidar/cloud_io.h"
+#include "tests/testing/scoped_temp_dir.h"
 
 #include <filesystem>
 #include <fstream>
@@ -13,15 +14,7 @@ namespace fs = std::filesystem;
 
 class CloudIoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("colmap_lidar_cloud_io_" + std::to_string(std::random_device()()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const {
-    return (dir_ / name).string();
-  }
+  std::string Path(const std::string& name) const { return dir_.File(name); }
 
   static PointCloud RandomCloud(size_t n, bool attributes) {
     std::mt19937 rng(7);
@@ -51,7 +44,7 @@ class CloudIoTest : public ::testing::Test {
     }
   }
 
-  fs::path dir_;
+  testing::ScopedTempDir dir_;
 };
 
 TEST_F(CloudIoTest, PcdAndPlyRoundTripWithAllAttributes) {

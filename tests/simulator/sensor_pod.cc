@@ -123,8 +123,11 @@ std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
     return stations;
   }
 
+  // About a fifth of the stations tilted (at least one), never more than half.
   const int num_tilted =
-      motion == Motion::kTwoAxes ? std::max(2, (num_stations + 2) / 5) : 0;
+      motion == Motion::kTwoAxes
+          ? std::min(std::max(1, (num_stations + 2) / 5), num_stations / 2)
+          : 0;
   const int num_ring = num_stations - num_tilted;
   auto ring_azimuth = [&](double k) { return 2 * M_PI * k / num_ring - M_PI / 2; };
   for (int i = 0; i < num_ring; ++i) {
@@ -149,6 +152,11 @@ std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
     stations.push_back(CamFromWorld(
         WorldFromCamRotation(azimuth + M_PI, pitch, roll),
         Eigen::Vector3d(eye.x(), eye.y(), 0.45)));
+  }
+  for (const colmap::Rigid3d& station : stations) {
+    if (!station.translation.allFinite() || !station.rotation.coeffs().allFinite()) {
+      throw std::logic_error("Simulator produced a non-finite station pose");
+    }
   }
   return stations;
 }

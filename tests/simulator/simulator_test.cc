@@ -1,0 +1,251 @@
+// Self-consistency of the simulator's ground truth: what it writes must agree with itself, because every
+// accuracy figure of the project is measured against it.
+#include "colmap_ext/station_dataset.h"
+#include "lidar/cloud_io.h"
+#include "lidar/kd_tree.h"
+#include "tests/simulator/scene.h"
+#include "tests/simulator/simulate_dataset.h"
+#include "tests/testing/scoped_temp_dir.h"
+
+#include "colmap/mvs/depth_map.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+namespace colmap_lidar {
+namespace {
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return std::nan("");
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+double Bilinear(const cv::Mat& image, double x, double y) {
+  // (x, y) in COLMAP's convention: pixel centres at +0.5.
+  const double u = x - 0.5, v = y - 0.5;
+  const int u0 = static_cast<int>(std::floor(u)), v0 = static_cast<int>(std::floor(v));
+  if (u0 < 0 || v0 < 0 || u0 + 1 >= image.cols || v0 + 1 >= image.rows) return -1;
+  const double a = u - u0, b = v - v0;
+  auto at = [&](int r, int c) { return static_cast<double>(image.at<uint8_t>(r, c)); };
+  return (1 - a) * (1 - b) * at(v0, u0) + a * (1 - b) * at(v0, u0 + 1) +
+         (1 - a) * b * at(v0 + 1, u0) + a * b * at(v0 + 1, u0 + 1);
+}
+
+sim::SimulationOptions NoiseFreeOptions(const std::string& scene,
+                                        const std::string& output_path) {
+  sim::SimulationOptions options;
+  options.scene = scene;
+  options.output_path = output_path;
+  options.num_stations = 3;
+  options.lidar_points = 30000;
+  options.range_noise_m = 0;
+  options.pixel_noise = 0;
+  options.surface_spacing_m = 0.01;
+  options.image_scale = 0.25;
+  return options;
+}
+
+// Min over the k nearest surface samples of the point-to-plane distance: exact on faces and at edges.
+double DistanceToSurface(const PointCloud& surface,
+                         const KdTree3& tree,
+                         const Eigen::Vector3d& point) {
+  std::vector<size_t> indices;
+  std::vector<double> squared;
+  tree.KNearest(point, 8, &indices, &squared);
+  double best = 1e9;
+  for (size_t k = 0; k < indices.size(); ++k) {
+    if (squared[k] > 0.03 * 0.03) continue;
+    best = std::min(best, std::abs(surface.normals[indices[k]].dot(
+                              point - surface.points[indices[k]])));
+  }
+  return best;
+}
+
+class SimulatorSceneTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SimulatorSceneTest, LidarPointsLandOnTheTrueSurface) {
+  testing::ScopedTempDir dir;
+  const std::string root = dir.File("dataset");
+  const sim::SimulationResult result =
+      sim::SimulateDataset(NoiseFreeOptions(GetParam(), root));
+  EXPECT_EQ(result.num_stations, 3);
+  const StationDataset dataset = ReadStationDataset(root);
+  ASSERT_EQ(dataset.stations.size(), 3u);
+  const auto cam_from_world =
+      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const colmap::Rigid3d cam_from_lidar =
+      ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  const PointCloud surface = ReadPointCloud(dataset.GroundTruthPath("surface.ply"));
+  ASSERT_TRUE(surface.HasNormals());
+  const KdTree3 tree(surface.points);
+  const sim::Scene scene = sim::Scene::Create(GetParam());
+
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    const PointCloud cloud = ReadPointCloud(dataset.cloud_paths[i]);
+    // world_from_lidar = inverse(cam_from_world) * cam_from_lidar
+    const colmap::Rigid3d world_from_lidar =
+        colmap::Inverse(cam_from_world.at(dataset.stations[i])) * cam_from_lidar;
+    size_t num_on_object = 0;
+    double max_distance = 0;
+    for (const Eigen::Vector3d& point_in_lidar : cloud.points) {
+      const Eigen::Vector3d point_in_world = world_from_lidar * point_in_lidar;
+      // Near the structure but not on the ground around its base (surface.ply has no ground).
+      if (!scene.InsideObject(point_in_world, 0.01) || point_in_world.z() < 0.01) {
+        continue;
+      }
+      ++num_on_object;
+      max_distance = std::max(max_distance,
+                              DistanceToSurface(surface, tree, point_in_world));
+    }
+    EXPECT_GT(num_on_object, 200u) << "station " << i;
+    // Float32 storage of the clouds (~1e-6 m) is the only error left with noise off: sub-mm.
+    EXPECT_LT(max_distance, 1e-4) << "station " << i;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllScenes,
+                         SimulatorSceneTest,
+                         ::testing::ValuesIn(sim::Scene::Names()));
+
+class SimulatorImageTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new testing::ScopedTempDir("colmap_lidar_sim_images");
+    sim::SimulationOptions options = NoiseFreeOptions("t_specimen", dir_->File("d"));
+    options.image_scale = 1.0;  // full resolution: the texture is not aliased on the object
+    options.surface_spacing_m = 0.004;
+    sim::SimulateDataset(options);
+    dataset_ = new StationDataset(ReadStationDataset(dir_->File("d")));
+  }
+  static void TearDownTestSuite() {
+    delete dataset_;
+    delete dir_;
+  }
+  static testing::ScopedTempDir* dir_;
+  static StationDataset* dataset_;
+};
+testing::ScopedTempDir* SimulatorImageTest::dir_ = nullptr;
+StationDataset* SimulatorImageTest::dataset_ = nullptr;
+
+TEST_F(SimulatorImageTest, ProjectedSurfacePointsShowTheirTextureAndDepth) {
+  const auto cam_from_world =
+      ReadNamedPoses(dataset_->GroundTruthPath("cam_from_world.txt"));
+  const PointCloud surface = ReadPointCloud(dataset_->GroundTruthPath("surface.ply"));
+  const sim::Scene scene = sim::Scene::Create("t_specimen");
+  const colmap::Camera& camera = dataset_->rig.left;
+  for (size_t i = 0; i < dataset_->stations.size(); ++i) {
+    const cv::Mat image = cv::imread(dataset_->LeftImagePath(i), cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(image.empty());
+    colmap::mvs::DepthMap depth;
+    depth.Read(dataset_->GroundTruthPath("depth/" + dataset_->stations[i] + ".bin"));
+    ASSERT_EQ(depth.GetWidth(), camera.width);
+    const colmap::Rigid3d& pose = cam_from_world.at(dataset_->stations[i]);
+    // A pose 5 mm off, as a control: the same comparison must then fail clearly.
+    colmap::Rigid3d shifted = pose;
+    shifted.translation.x() += 0.005;
+    std::vector<double> texture_errors, shifted_errors, depth_errors;
+    const Eigen::Vector3d center = colmap::Inverse(pose).translation;
+    for (size_t k = 0; k < surface.Size(); k += 3) {
+      const Eigen::Vector3d& point = surface.points[k];
+      const Eigen::Vector3d point_in_cam = pose * point;
+      if (point_in_cam.z() < 0.1) continue;
+      const Eigen::Vector2d xy = camera.ImgFromCam(point_in_cam.hnormalized());
+      if (xy.x() < 2 || xy.y() < 2 || xy.x() > camera.width - 2 ||
+          xy.y() > camera.height - 2) {
+        continue;
+      }
+      // Visible: the first hit from the camera centre towards the point is the point itself.
+      sim::RayHit hit;
+      const Eigen::Vector3d ray = (point - center).normalized();
+      if (!scene.Intersect(center, ray, 1e3, &hit) ||
+          std::abs(hit.t - (point - center).norm()) > 1e-6) {
+        continue;
+      }
+      // Away from silhouettes, where a pixel sees two surfaces.
+      if (std::abs(surface.normals[k].dot(ray)) < 0.3) continue;
+      const double expected = scene.Shade(point, hit.normal, hit.primitive);
+      texture_errors.push_back(std::abs(Bilinear(image, xy.x(), xy.y()) - expected));
+      const Eigen::Vector2d xy_shifted =
+          camera.ImgFromCam((shifted * point).hnormalized());
+      shifted_errors.push_back(
+          std::abs(Bilinear(image, xy_shifted.x(), xy_shifted.y()) - expected));
+      const float z = depth.Get(static_cast<size_t>(xy.y()), static_cast<size_t>(xy.x()));
+      depth_errors.push_back(std::abs(z - point_in_cam.z()));
+    }
+    ASSERT_GT(texture_errors.size(), 2000u) << "station " << i;
+    // Bilinear interpolation of a texture with 1 cm detail at ~2 mm pixels: a few grey levels.
+    EXPECT_LT(Median(texture_errors), 4.0) << "station " << i;
+    EXPECT_GT(Median(shifted_errors), 2.5 * Median(texture_errors)) << "station " << i;
+    // Nearest-pixel depth on a slanted face: within a pixel footprint (~2 mm at 2.5 m).
+    EXPECT_LT(Median(depth_errors), 0.002) << "station " << i;
+  }
+}
+
+TEST_F(SimulatorImageTest, LeftAndRightImagesAgreeThroughTheTrueDepthAndBaseline) {
+  const StationRig& rig = dataset_->rig;
+  EXPECT_NEAR(rig.BaselineMeters(), 0.38, 1e-9);
+  for (size_t i = 0; i < dataset_->stations.size(); ++i) {
+    const cv::Mat left = cv::imread(dataset_->LeftImagePath(i), cv::IMREAD_GRAYSCALE);
+    const cv::Mat right = cv::imread(dataset_->RightImagePath(i), cv::IMREAD_GRAYSCALE);
+    colmap::mvs::DepthMap depth;
+    depth.Read(dataset_->GroundTruthPath("depth/" + dataset_->stations[i] + ".bin"));
+    colmap::Rigid3d wrong_baseline = rig.right_from_left;
+    wrong_baseline.translation *= 0.4 / 0.38;
+    std::vector<double> errors, wrong_errors;
+    for (size_t row = 4; row < depth.GetHeight() - 4; row += 3) {
+      for (size_t col = 4; col < depth.GetWidth() - 4; col += 3) {
+        const double z = depth.Get(row, col);
+        if (z <= 0 || z > 6) continue;  // the structure and the ground near it
+        const Eigen::Vector3d point_in_left =
+            z * rig.left.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5)).homogeneous();
+        const double value = left.at<uint8_t>(row, col);
+        const Eigen::Vector2d in_right =
+            rig.right.ImgFromCam((rig.right_from_left * point_in_left).hnormalized());
+        const Eigen::Vector2d in_right_wrong =
+            rig.right.ImgFromCam((wrong_baseline * point_in_left).hnormalized());
+        const double r = Bilinear(right, in_right.x(), in_right.y());
+        const double w = Bilinear(right, in_right_wrong.x(), in_right_wrong.y());
+        if (r < 0 || w < 0) continue;
+        errors.push_back(std::abs(r - value));
+        wrong_errors.push_back(std::abs(w - value));
+      }
+    }
+    ASSERT_GT(errors.size(), 5000u);
+    EXPECT_LT(Median(errors), 4.0) << "station " << i;
+    EXPECT_GT(Median(wrong_errors), 2.5 * Median(errors)) << "station " << i;
+  }
+}
+
+TEST(SimulatorTest, RefusesToOverwriteAndLeavesNoPartialOutput) {
+  testing::ScopedTempDir dir;
+  sim::SimulationOptions options = NoiseFreeOptions("square_pillar", dir.File("d"));
+  options.num_stations = 2;
+  sim::SimulateDataset(options);
+  EXPECT_THROW(sim::SimulateDataset(options), std::runtime_error);
+  options.scene = "no_such_scene";
+  options.overwrite = true;
+  EXPECT_THROW(sim::SimulateDataset(options), std::invalid_argument);
+  EXPECT_TRUE(std::filesystem::exists(dir.File("d/rig.json")))
+      << "a failed run must not destroy the previous dataset";
+  EXPECT_FALSE(std::filesystem::exists(dir.File("d.partial")));
+}
+
+TEST(SimulatorTest, GuessIsTheTruthPerturbedByTheDocumentedAmount) {
+  testing::ScopedTempDir dir;
+  sim::SimulationOptions options = NoiseFreeOptions("t_specimen", dir.File("d"));
+  options.num_stations = 2;
+  sim::SimulateDataset(options);
+  const StationDataset dataset = ReadStationDataset(dir.File("d"));
+  ASSERT_TRUE(dataset.rig.cam_from_lidar_guess.has_value());
+  const colmap::Rigid3d truth = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  const colmap::Rigid3d& guess = *dataset.rig.cam_from_lidar_guess;
+  EXPECT_NEAR(guess.rotation.angularDistance(truth.rotation) * 180 / M_PI, 3.0, 1e-6);
+  EXPECT_NEAR((guess.translation - truth.translation).norm(), 0.05, 1e-9);
+}
+
+}  // namespace
+}  // namespace colmap_lidar
