@@ -1,0 +1,150 @@
+#include "colmap_ext/station_dataset.h"
+#include "tests/testing/scoped_temp_dir.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+json ValidRig() {
+  return json::parse(R"({
+    "left":  {"model": "PINHOLE", "width": 64, "height": 48, "params": [50, 50, 32, 24]},
+    "right": {"model": "OPENCV", "width": 64, "height": 48,
+              "params": [50, 50, 32, 24, 0.01, 0, 0, 0]},
+    "right_from_left": {"rotation": [1, 0, 0, 0], "translation": [-0.38, 0, 0]},
+    "cam_from_lidar_guess": {"rotation": [0.5, -0.5, 0.5, -0.5], "translation": [0.1, -0.2, 0]},
+    "lidar": {"model": "VLP-16", "range_noise_m": 0.01}
+  })");
+}
+
+class StationDatasetTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    for (const char* d : {"images/left", "images/right", "lidar"}) {
+      fs::create_directories(dir_.Path() / d);
+    }
+    WriteRig(ValidRig());
+    for (const char* s : {"000", "001"}) {
+      std::ofstream(dir_.File("images/left/") + s + ".png") << "x";
+      std::ofstream(dir_.File("images/right/") + s + ".png") << "x";
+      std::ofstream(dir_.File("lidar/") + s + ".pcd") << "x";
+    }
+  }
+  void WriteRig(const json& rig) { std::ofstream(dir_.File("rig.json")) << rig.dump(); }
+
+  // Expects ReadStationDataset to fail with a message naming `file` and containing `problem`.
+  void ExpectError(const std::string& file, const std::string& problem) {
+    try {
+      ReadStationDataset(dir_.Path().string());
+      ADD_FAILURE() << "no error; expected one about " << problem;
+    } catch (const std::runtime_error& error) {
+      const std::string what = error.what();
+      EXPECT_NE(what.find(file), std::string::npos) << what;
+      EXPECT_NE(what.find(problem), std::string::npos) << what;
+    }
+  }
+
+  testing::ScopedTempDir dir_;
+};
+
+TEST_F(StationDatasetTest, ReadsAValidDataset) {
+  const StationDataset dataset = ReadStationDataset(dir_.Path().string());
+  EXPECT_EQ(dataset.stations, (std::vector<std::string>{"000", "001"}));
+  EXPECT_EQ(dataset.rig.left.ModelName(), "PINHOLE");
+  EXPECT_EQ(dataset.rig.right.params.size(), 8u);
+  EXPECT_DOUBLE_EQ(dataset.rig.BaselineMeters(), 0.38);
+  ASSERT_TRUE(dataset.rig.cam_from_lidar_guess.has_value());
+  // w first in the file: [0.5, -0.5, 0.5, -0.5] is w=0.5, x=-0.5, ...
+  EXPECT_DOUBLE_EQ(dataset.rig.cam_from_lidar_guess->rotation.w(), 0.5);
+  EXPECT_DOUBLE_EQ(dataset.rig.cam_from_lidar_guess->rotation.x(), -0.5);
+  EXPECT_EQ(dataset.LeftImageName(1), "left/001.png");
+  EXPECT_FALSE(dataset.HasGroundTruth());
+}
+
+TEST_F(StationDatasetTest, RigJsonRoundTrips) {
+  const StationRig rig = ReadRigJson(dir_.File("rig.json"));
+  WriteRigJson(dir_.File("copy.json"), rig);
+  const StationRig copy = ReadRigJson(dir_.File("copy.json"));
+  EXPECT_EQ(copy.right.params, rig.right.params);
+  EXPECT_EQ(copy.lidar_model, "VLP-16");
+  EXPECT_NEAR(copy.cam_from_lidar_guess->rotation.angularDistance(
+                  rig.cam_from_lidar_guess->rotation), 0, 1e-12);
+}
+
+TEST_F(StationDatasetTest, BadRigJsonNamesTheFileAndTheKey) {
+  json rig = ValidRig();
+  rig.erase("right_from_left");
+  WriteRig(rig);
+  ExpectError("rig.json", "missing key 'right_from_left'");
+
+  rig = ValidRig();
+  rig["left"].erase("params");
+  WriteRig(rig);
+  ExpectError("rig.json", "missing key 'left.params'");
+
+  rig = ValidRig();
+  rig["left"]["model"] = "PINHOL";
+  WriteRig(rig);
+  ExpectError("rig.json", "not a COLMAP camera model");
+
+  rig = ValidRig();
+  rig["right"]["params"] = {50, 50, 32};
+  WriteRig(rig);
+  ExpectError("rig.json", "must hold 8 values for model OPENCV");
+
+  rig = ValidRig();
+  rig["right_from_left"]["rotation"] = {1, 2, 3, 4};
+  WriteRig(rig);
+  ExpectError("rig.json", "not a unit quaternion");
+
+  rig = ValidRig();
+  rig["right_from_left"]["translation"] = {0, 0, 0};
+  WriteRig(rig);
+  ExpectError("rig.json", "baseline");
+
+  std::ofstream(dir_.File("rig.json")) << "{ \"left\": ";
+  ExpectError("rig.json", "not valid JSON");
+}
+
+TEST_F(StationDatasetTest, MissingImageOrCloudNamesTheFile) {
+  fs::remove(dir_.File("images/right/001.png"));
+  ExpectError("images/right/001.png", "missing right image of station 001");
+  std::ofstream(dir_.File("images/right/001.png")) << "x";
+  fs::remove(dir_.File("lidar/000.pcd"));
+  ExpectError("lidar/000.pcd", "missing LiDAR cloud of station 000");
+  std::ofstream(dir_.File("lidar/000.bin")) << "x";  // any supported format will do
+  EXPECT_EQ(ReadStationDataset(dir_.Path().string()).cloud_paths[0], dir_.File("lidar/000.bin"));
+}
+
+TEST_F(StationDatasetTest, PoseFilesRoundTripWithWFirst) {
+  const colmap::Rigid3d pose(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized())),
+      Eigen::Vector3d(1.5, -0.25, 3));
+  WritePoseFile(dir_.File("p.txt"), "test", pose);
+  const colmap::Rigid3d read = ReadPoseFile(dir_.File("p.txt"));
+  EXPECT_NEAR(read.rotation.angularDistance(pose.rotation), 0, 1e-15);
+  EXPECT_NEAR((read.translation - pose.translation).norm(), 0, 1e-15);
+  std::ifstream file(dir_.File("p.txt"));
+  std::string line;
+  while (std::getline(file, line) && line[0] == '#') {
+  }
+  EXPECT_DOUBLE_EQ(std::stod(line), pose.rotation.w());
+
+  WriteNamedPoses(dir_.File("n.txt"), "test", {{"000", pose}, {"001", colmap::Rigid3d()}});
+  const auto poses = ReadNamedPoses(dir_.File("n.txt"));
+  ASSERT_EQ(poses.size(), 2u);
+  EXPECT_NEAR((poses.at("000").translation - pose.translation).norm(), 0, 1e-15);
+
+  std::ofstream(dir_.File("bad.txt")) << "000 1 0 0\n";
+  EXPECT_THROW(ReadNamedPoses(dir_.File("bad.txt")), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace colmap_lidar
