@@ -49,7 +49,7 @@ class CloudIoTest : public ::testing::Test {
 
 TEST_F(CloudIoTest, PcdAndPlyRoundTripWithAllAttributes) {
   const PointCloud cloud = RandomCloud(1000, true);
-  for (const std::string name : {std::string("a.pcd"), std::string("a.ply")}) {
+  for (const char* name : {"a.pcd", "a.ply"}) {
     WritePointCloud(Path(name), cloud);
     CloudReadStats stats;
     const PointCloud read = ReadPointCloud(Path(name), &stats);
@@ -106,10 +106,10 @@ TEST_F(CloudIoTest, RejectsBadFilesWithTheFileNamed) {
 
   // Truncated binary PLY and PCD: cut the last 100 bytes.
   const PointCloud cloud = RandomCloud(500, true);
-  for (const std::string name : {std::string("cut.ply"), std::string("cut.pcd")}) {
+  for (const char* name : {"cut.ply", "cut.pcd"}) {
     WritePointCloud(Path(name), cloud);
     fs::resize_file(Path(name), fs::file_size(Path(name)) - 100);
-    ExpectReadError(Path(name), name == "cut.ply" ? "truncated" : "PCD");
+    ExpectReadError(Path(name), std::string(name) == "cut.ply" ? "truncated" : "PCD");
   }
 
   std::ofstream(Path("cut.bin"), std::ios::binary) << "0123456789";
