@@ -1,0 +1,192 @@
+#include "lidar/model_evaluation.h"
+
+#include "lidar/kd_tree.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace colmap_lidar {
+namespace {
+
+// Distance to the true surface: point-to-plane to the best of the nearest samples where the point lies
+// over the sampled surface, point-to-point beyond its border.
+double SurfaceDistance(const PointCloud& truth,
+                       const KdTree3& tree,
+                       double spacing,
+                       const Eigen::Vector3d& point) {
+  std::vector<size_t> indices;
+  std::vector<double> squared;
+  tree.KNearest(point, 8, &indices, &squared);
+  if (indices.empty()) return 1e9;
+  const double nearest = std::sqrt(squared[0]);
+  double best = nearest;
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const Eigen::Vector3d offset = point - truth.points[indices[k]];
+    const double normal_distance = std::abs(truth.normals[indices[k]].dot(offset));
+    const double tangential = std::sqrt(std::max(0.0, squared[k] - normal_distance * normal_distance));
+    // Within the footprint of this sample, the plane is the surface.
+    if (tangential <= spacing) best = std::min(best, normal_distance);
+  }
+  return best;
+}
+
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0;
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[k];
+}
+
+// One Gauss-Newton step of point-to-plane ICP (linearised rotation). Returns the increment.
+Eigen::Isometry3d PointToPlaneStep(const PointCloud& truth,
+                                   const KdTree3& tree,
+                                   const std::vector<Eigen::Vector3d>& moved,
+                                   double max_distance,
+                                   size_t* num_used) {
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  *num_used = 0;
+  for (const Eigen::Vector3d& p : moved) {
+    size_t index;
+    double squared;
+    if (!tree.Nearest(p, &index, &squared) || squared > max_distance * max_distance) continue;
+    const Eigen::Vector3d& n = truth.normals[index];
+    const double r = n.dot(p - truth.points[index]);
+    Eigen::Matrix<double, 6, 1> J;
+    J << p.cross(n), n;
+    H += J * J.transpose();
+    g += J * r;
+    ++*num_used;
+  }
+  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+  if (*num_used < 6) return step;
+  const Eigen::Matrix<double, 6, 1> x = H.ldlt().solve(-g);
+  const double angle = x.head<3>().norm();
+  if (angle > 0) step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
+  step.translation() = x.tail<3>();
+  return step;
+}
+
+}  // namespace
+
+bool ModelEvaluationOptions::Check() const {
+  if (icp_max_iterations < 0 || crop_distance_m <= 0) {
+    throw std::invalid_argument("ModelEvaluationOptions: non-positive value");
+  }
+  for (double t : thresholds_m) {
+    if (t <= 0) throw std::invalid_argument("ModelEvaluationOptions: threshold <= 0");
+  }
+  return true;
+}
+
+ModelEvaluation EvaluateModel(const PointCloud& model,
+                              const PointCloud& truth,
+                              const ModelEvaluationOptions& options) {
+  options.Check();
+  if (model.Empty()) throw std::invalid_argument("The model cloud is empty");
+  if (truth.Empty() || !truth.HasNormals()) {
+    throw std::invalid_argument("The ground-truth surface needs points with normals");
+  }
+  ModelEvaluation result;
+  result.num_model_points = model.Size();
+  result.num_truth_points = truth.Size();
+  const KdTree3 truth_tree(truth.points);
+
+  // The sampling spacing of the truth: median nearest-neighbour distance over a subset.
+  std::vector<double> spacings;
+  for (size_t i = 0; i < truth.Size(); i += std::max<size_t>(1, truth.Size() / 2000)) {
+    std::vector<size_t> indices;
+    std::vector<double> squared;
+    truth_tree.KNearest(truth.points[i], 2, &indices, &squared);
+    if (squared.size() == 2) spacings.push_back(std::sqrt(squared[1]));
+  }
+  const double spacing = std::max(1e-6, Percentile(spacings, 0.5));
+
+  // Crop: the points near the structure; ICP works on them.
+  std::vector<Eigen::Vector3d> moved;
+  std::vector<size_t> kept;
+  for (size_t i = 0; i < model.Size(); ++i) {
+    size_t index;
+    double squared;
+    truth_tree.Nearest(model.points[i], &index, &squared);
+    if (squared <= options.crop_distance_m * options.crop_distance_m) {
+      moved.push_back(model.points[i]);
+      kept.push_back(i);
+    }
+  }
+  if (options.align_icp && moved.size() >= 6) {
+    double max_distance = options.crop_distance_m;
+    for (int it = 0; it < options.icp_max_iterations; ++it) {
+      size_t num_used = 0;
+      const Eigen::Isometry3d step =
+          PointToPlaneStep(truth, truth_tree, moved, max_distance, &num_used);
+      for (Eigen::Vector3d& p : moved) p = step * p;
+      result.truth_from_model = step * result.truth_from_model;
+      result.icp_iterations = it + 1;
+      const double rotation = Eigen::AngleAxisd(step.linear()).angle();
+      if (rotation < 1e-8 && step.translation().norm() < 1e-8) {
+        result.icp_converged = true;
+        break;
+      }
+      max_distance = std::max(0.5 * max_distance, 4 * spacing);
+    }
+  }
+  // After alignment, evaluate all model points within the crop distance.
+  moved.clear();
+  for (size_t i = 0; i < model.Size(); ++i) {
+    const Eigen::Vector3d p = result.truth_from_model * model.points[i];
+    const double d = SurfaceDistance(truth, truth_tree, spacing, p);
+    if (d <= options.crop_distance_m) {
+      result.distances.push_back(d);
+      result.evaluated_indices.push_back(i);
+      moved.push_back(p);
+    }
+  }
+  result.num_evaluated = result.distances.size();
+  if (result.distances.empty()) return result;
+
+  double sum = 0, sum_squared = 0;
+  for (double d : result.distances) {
+    sum += d;
+    sum_squared += d * d;
+  }
+  result.mean = sum / result.distances.size();
+  result.rmse = std::sqrt(sum_squared / result.distances.size());
+  result.median = Percentile(result.distances, 0.5);
+  result.p90 = Percentile(result.distances, 0.9);
+  result.p95 = Percentile(result.distances, 0.95);
+  result.p99 = Percentile(result.distances, 0.99);
+  result.max = *std::max_element(result.distances.begin(), result.distances.end());
+
+  const KdTree3 model_tree(moved);
+  for (double threshold : options.thresholds_m) {
+    ModelEvaluation::AtThreshold at;
+    at.threshold = threshold;
+    size_t precise = 0, complete = 0;
+    for (double d : result.distances) precise += d <= threshold;
+    for (const Eigen::Vector3d& q : truth.points) {
+      size_t index;
+      double squared;
+      if (model_tree.Nearest(q, &index, &squared) && squared <= threshold * threshold) ++complete;
+    }
+    at.precision = static_cast<double>(precise) / result.distances.size();
+    at.completeness = static_cast<double>(complete) / truth.Size();
+    at.f_score = at.precision + at.completeness > 0
+                     ? 2 * at.precision * at.completeness / (at.precision + at.completeness)
+                     : 0;
+    result.at_thresholds.push_back(at);
+  }
+
+  // Density on the structure: evaluated points per cm^2 of the true surface they cover. Each truth
+  // sample stands for spacing^2 of surface; the covered part is the completeness at the largest threshold.
+  const double covered_fraction =
+      result.at_thresholds.empty() ? 1.0 : result.at_thresholds.back().completeness;
+  const double covered_area_cm2 = covered_fraction * truth.Size() * spacing * spacing * 1e4;
+  result.density_points_per_cm2 =
+      covered_area_cm2 > 0 ? result.num_evaluated / covered_area_cm2 : 0;
+  return result;
+}
+
+}  // namespace colmap_lidar

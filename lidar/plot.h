@@ -1,0 +1,27 @@
+// Small PNG plots for reports (OpenCV inside): people look at results.
+#pragma once
+
+#include "lidar/point_cloud.h"
+
+#include <string>
+#include <vector>
+
+namespace colmap_lidar {
+
+struct HistogramPlotOptions {
+  std::string title;
+  std::string x_label;
+  double value_scale = 1.0;  // values are multiplied by this for the axis (e.g. 1000 for mm)
+  double max_value = 0;      // upper end of the axis in input units; 0 = 99th percentile
+  int num_bins = 50;
+};
+
+// Writes a histogram PNG (atomically). Throws std::runtime_error if it cannot be written.
+void WriteHistogramPng(const std::string& path,
+                       const std::vector<double>& values,
+                       const HistogramPlotOptions& options);
+
+// A blue-green-yellow-red colour for value/max_value in [0, 1] (clamped).
+Color3ub ErrorColor(double value, double max_value);
+
+}  // namespace colmap_lidar
