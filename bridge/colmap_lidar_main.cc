@@ -41,6 +41,10 @@ const std::vector<Command>& Commands() {
        "Summarise a database: COLMAP's tables and depth priors, LiDAR frames, rig"},
       {"simulate_dataset", &RunSimulateDataset,
        "Simulate a stereo + LiDAR station dataset with ground truth"},
+      {"evaluate_model", &RunEvaluateModel,
+       "Accuracy, completeness and density of a cloud against the true surface"},
+      {"evaluate_calibration", &RunEvaluateCalibration,
+       "Error of cam_from_lidar and of station poses against ground truth"},
   };
   return kCommands;
 }

@@ -12,4 +12,10 @@ int RunDatabaseCreator(int argc, char** argv);
 // Prints what a database holds: COLMAP's images/keypoints/matches and our depth priors, LiDAR frames, rig.
 int RunDatabaseInfo(int argc, char** argv);
 
+// Accuracy of a cloud against ground_truth/surface.ply: distances, completeness, density, plots.
+int RunEvaluateModel(int argc, char** argv);
+
+// Error of an estimated cam_from_lidar and of a sparse model's station poses against ground truth.
+int RunEvaluateCalibration(int argc, char** argv);
+
 }  // namespace colmap_lidar
