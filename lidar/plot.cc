@@ -35,7 +35,7 @@ Color3ub ErrorColor(double value, double max_value) {
 void WriteHistogramPng(const std::string& path,
                        const std::vector<double>& values,
                        const HistogramPlotOptions& options) {
-  constexpr int kWidth = 800, kHeight = 500, kLeft = 70, kRight = 20, kTop = 50, kBottom = 60;
+  constexpr int kWidth = 800, kHeight = 500, kLeft = 70, kRight = 45, kTop = 50, kBottom = 60;
   cv::Mat canvas(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
   double max_value = options.max_value;
   if (max_value <= 0 && !values.empty()) {
@@ -44,7 +44,7 @@ void WriteHistogramPng(const std::string& path,
     std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
     max_value = sorted[k];
   }
-  if (max_value <= 0) max_value = 1;
+  if (max_value <= 0) max_value = 1.0 / options.value_scale;  // one unit on the axis
   const int bins = std::max(1, options.num_bins);
   std::vector<int> counts(bins, 0);
   for (double v : values) {
