@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
 readonly kWorkspace="${WORKSPACE:-workspace}"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCOLMAP_LIDAR_BUILD_TESTS=OFF \
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$kColmapPrefix${CMAKE_PREFIX_PATH:+;$CMAKE_PREFIX_PATH}" >/dev/null
 cmake --build build -j "$(nproc)" --target colmap_lidar_cli
 readonly cli=build/bin/colmap-lidar

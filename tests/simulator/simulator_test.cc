@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -111,39 +113,35 @@ INSTANTIATE_TEST_SUITE_P(AllScenes,
                          SimulatorSceneTest,
                          ::testing::ValuesIn(sim::Scene::Names()));
 
-class SimulatorImageTest : public ::testing::Test {
+// Full-resolution, noise-free images of two stations of each scene (the texture is not aliased there).
+class SimulatorImageTest : public ::testing::TestWithParam<std::string> {
  protected:
-  static void SetUpTestSuite() {
-    dir_ = new testing::ScopedTempDir("colmap_lidar_sim_images");
-    sim::SimulationOptions options = NoiseFreeOptions("t_specimen", dir_->File("d"));
-    options.image_scale = 1.0;  // full resolution: the texture is not aliased on the object
+  void SetUp() override {
+    sim::SimulationOptions options = NoiseFreeOptions(GetParam(), dir_.File("d"));
+    options.num_stations = 2;
+    options.lidar_points = 2000;
+    options.image_scale = 1.0;
     options.surface_spacing_m = 0.004;
     sim::SimulateDataset(options);
-    dataset_ = new StationDataset(ReadStationDataset(dir_->File("d")));
+    dataset_ = ReadStationDataset(dir_.File("d"));
   }
-  static void TearDownTestSuite() {
-    delete dataset_;
-    delete dir_;
-  }
-  static testing::ScopedTempDir* dir_;
-  static StationDataset* dataset_;
+  testing::ScopedTempDir dir_;
+  StationDataset dataset_;
 };
-testing::ScopedTempDir* SimulatorImageTest::dir_ = nullptr;
-StationDataset* SimulatorImageTest::dataset_ = nullptr;
 
-TEST_F(SimulatorImageTest, ProjectedSurfacePointsShowTheirTextureAndDepth) {
+TEST_P(SimulatorImageTest, ProjectedSurfacePointsShowTheirTextureAndDepth) {
   const auto cam_from_world =
-      ReadNamedPoses(dataset_->GroundTruthPath("cam_from_world.txt"));
-  const PointCloud surface = ReadPointCloud(dataset_->GroundTruthPath("surface.ply"));
-  const sim::Scene scene = sim::Scene::Create("t_specimen");
-  const colmap::Camera& camera = dataset_->rig.left;
-  for (size_t i = 0; i < dataset_->stations.size(); ++i) {
-    const cv::Mat image = cv::imread(dataset_->LeftImagePath(i), cv::IMREAD_GRAYSCALE);
+      ReadNamedPoses(dataset_.GroundTruthPath("cam_from_world.txt"));
+  const PointCloud surface = ReadPointCloud(dataset_.GroundTruthPath("surface.ply"));
+  const sim::Scene scene = sim::Scene::Create(GetParam());
+  const colmap::Camera& camera = dataset_.rig.left;
+  for (size_t i = 0; i < dataset_.stations.size(); ++i) {
+    const cv::Mat image = cv::imread(dataset_.LeftImagePath(i), cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(image.empty());
     colmap::mvs::DepthMap depth;
-    depth.Read(dataset_->GroundTruthPath("depth/" + dataset_->stations[i] + ".bin"));
+    depth.Read(dataset_.GroundTruthPath("depth/" + dataset_.stations[i] + ".bin"));
     ASSERT_EQ(depth.GetWidth(), camera.width);
-    const colmap::Rigid3d& pose = cam_from_world.at(dataset_->stations[i]);
+    const colmap::Rigid3d& pose = cam_from_world.at(dataset_.stations[i]);
     // A pose 5 mm off, as a control: the same comparison must then fail clearly.
     colmap::Rigid3d shifted = pose;
     shifted.translation.x() += 0.005;
@@ -176,7 +174,7 @@ TEST_F(SimulatorImageTest, ProjectedSurfacePointsShowTheirTextureAndDepth) {
       const float z = depth.Get(static_cast<size_t>(xy.y()), static_cast<size_t>(xy.x()));
       depth_errors.push_back(std::abs(z - point_in_cam.z()));
     }
-    ASSERT_GT(texture_errors.size(), 2000u) << "station " << i;
+    ASSERT_GT(texture_errors.size(), 1000u) << "station " << i;
     // Bilinear interpolation of a texture with 1 cm detail at ~2 mm pixels: a few grey levels.
     EXPECT_LT(Median(texture_errors), 4.0) << "station " << i;
     EXPECT_GT(Median(shifted_errors), 2.5 * Median(texture_errors)) << "station " << i;
@@ -185,14 +183,14 @@ TEST_F(SimulatorImageTest, ProjectedSurfacePointsShowTheirTextureAndDepth) {
   }
 }
 
-TEST_F(SimulatorImageTest, LeftAndRightImagesAgreeThroughTheTrueDepthAndBaseline) {
-  const StationRig& rig = dataset_->rig;
+TEST_P(SimulatorImageTest, LeftAndRightImagesAgreeThroughTheTrueDepthAndBaseline) {
+  const StationRig& rig = dataset_.rig;
   EXPECT_NEAR(rig.BaselineMeters(), 0.38, 1e-9);
-  for (size_t i = 0; i < dataset_->stations.size(); ++i) {
-    const cv::Mat left = cv::imread(dataset_->LeftImagePath(i), cv::IMREAD_GRAYSCALE);
-    const cv::Mat right = cv::imread(dataset_->RightImagePath(i), cv::IMREAD_GRAYSCALE);
+  for (size_t i = 0; i < dataset_.stations.size(); ++i) {
+    const cv::Mat left = cv::imread(dataset_.LeftImagePath(i), cv::IMREAD_GRAYSCALE);
+    const cv::Mat right = cv::imread(dataset_.RightImagePath(i), cv::IMREAD_GRAYSCALE);
     colmap::mvs::DepthMap depth;
-    depth.Read(dataset_->GroundTruthPath("depth/" + dataset_->stations[i] + ".bin"));
+    depth.Read(dataset_.GroundTruthPath("depth/" + dataset_.stations[i] + ".bin"));
     colmap::Rigid3d wrong_baseline = rig.right_from_left;
     wrong_baseline.translation *= 0.4 / 0.38;
     std::vector<double> errors, wrong_errors;
@@ -218,6 +216,62 @@ TEST_F(SimulatorImageTest, LeftAndRightImagesAgreeThroughTheTrueDepthAndBaseline
     EXPECT_LT(Median(errors), 4.0) << "station " << i;
     EXPECT_GT(Median(wrong_errors), 2.5 * Median(errors)) << "station " << i;
   }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllScenes,
+                         SimulatorImageTest,
+                         ::testing::ValuesIn(sim::Scene::Names()));
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(file), {});
+}
+
+TEST(SimulatorTest, DeterministicForAGivenSeed) {
+  testing::ScopedTempDir dir;
+  sim::SimulationOptions options = NoiseFreeOptions("cylinder_pillar", dir.File("a"));
+  options.range_noise_m = 0.01;
+  options.pixel_noise = 1.0;
+  options.num_stations = 2;
+  sim::SimulateDataset(options);
+  options.output_path = dir.File("b");
+  sim::SimulateDataset(options);
+  options.output_path = dir.File("c");
+  options.seed = 1;
+  sim::SimulateDataset(options);
+  for (const char* file : {"/lidar/001.pcd", "/images/left/001.png", "/rig.json"}) {
+    EXPECT_EQ(FileBytes(dir.File("a") + file), FileBytes(dir.File("b") + file)) << file;
+    EXPECT_NE(FileBytes(dir.File("a") + file), FileBytes(dir.File("c") + file)) << file;
+  }
+}
+
+TEST(SimulatorTest, MixedEdgePointsFloatBetweenSurfaces) {
+  testing::ScopedTempDir dir;
+  sim::SimulationOptions options = NoiseFreeOptions("square_pillar", dir.File("d"));
+  options.num_stations = 2;
+  options.lidar_points = 60000;
+  options.mixed_edge_points = true;
+  sim::SimulateDataset(options);
+  const StationDataset dataset = ReadStationDataset(dir.File("d"));
+  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const colmap::Rigid3d cam_from_lidar = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  const sim::Scene scene = sim::Scene::Create("square_pillar");
+  const PointCloud cloud = ReadPointCloud(dataset.cloud_paths[0]);
+  const colmap::Rigid3d world_from_lidar =
+      colmap::Inverse(cam_from_world.at(dataset.stations[0])) * cam_from_lidar;
+  // A point on a surface is hit by the ray through it at its own range; a mixed point lies in front of
+  // or behind the first surface along its ray by more than a few centimetres.
+  size_t num_mixed = 0;
+  for (const Eigen::Vector3d& point_in_lidar : cloud.points) {
+    const Eigen::Vector3d ray = world_from_lidar.rotation * point_in_lidar.normalized();
+    sim::RayHit hit;
+    if (scene.Intersect(world_from_lidar.translation, ray, 200, &hit) &&
+        std::abs(hit.t - point_in_lidar.norm()) > 0.05) {
+      ++num_mixed;
+    }
+  }
+  EXPECT_GT(num_mixed, 20u);
+  EXPECT_LT(num_mixed, cloud.Size() / 20) << "only edge returns are mixed";
 }
 
 TEST(SimulatorTest, RefusesToOverwriteAndLeavesNoPartialOutput) {
