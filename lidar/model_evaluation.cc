@@ -1,6 +1,7 @@
 #include "lidar/model_evaluation.h"
 
 #include "lidar/kd_tree.h"
+#include "lidar/point_to_plane_icp.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -39,36 +40,6 @@ double Percentile(std::vector<double> values, double q) {
   return values[k];
 }
 
-// One Gauss-Newton step of point-to-plane ICP (linearised rotation). Returns the increment.
-Eigen::Isometry3d PointToPlaneStep(const PointCloud& truth,
-                                   const KdTree3& tree,
-                                   const std::vector<Eigen::Vector3d>& moved,
-                                   double max_distance,
-                                   size_t* num_used) {
-  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-  *num_used = 0;
-  for (const Eigen::Vector3d& p : moved) {
-    size_t index;
-    double squared;
-    if (!tree.Nearest(p, &index, &squared) || squared > max_distance * max_distance) continue;
-    const Eigen::Vector3d& n = truth.normals[index];
-    const double r = n.dot(p - truth.points[index]);
-    Eigen::Matrix<double, 6, 1> J;
-    J << p.cross(n), n;
-    H += J * J.transpose();
-    g += J * r;
-    ++*num_used;
-  }
-  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-  if (*num_used < 6) return step;
-  const Eigen::Matrix<double, 6, 1> x = H.ldlt().solve(-g);
-  const double angle = x.head<3>().norm();
-  if (angle > 0) step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
-  step.translation() = x.tail<3>();
-  return step;
-}
-
 }  // namespace
 
 bool ModelEvaluationOptions::Check() const {
@@ -105,36 +76,29 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
   const double spacing = std::max(1e-6, Percentile(spacings, 0.5));
 
   // Crop: the points near the structure; ICP works on them.
-  std::vector<Eigen::Vector3d> moved;
-  std::vector<size_t> kept;
+  PointCloud cropped;
   for (size_t i = 0; i < model.Size(); ++i) {
     size_t index;
     double squared;
     truth_tree.Nearest(model.points[i], &index, &squared);
     if (squared <= options.crop_distance_m * options.crop_distance_m) {
-      moved.push_back(model.points[i]);
-      kept.push_back(i);
+      cropped.points.push_back(model.points[i]);
     }
   }
-  if (options.align_icp && moved.size() >= 6) {
-    double max_distance = options.crop_distance_m;
-    for (int it = 0; it < options.icp_max_iterations; ++it) {
-      size_t num_used = 0;
-      const Eigen::Isometry3d step =
-          PointToPlaneStep(truth, truth_tree, moved, max_distance, &num_used);
-      for (Eigen::Vector3d& p : moved) p = step * p;
-      result.truth_from_model = step * result.truth_from_model;
-      result.icp_iterations = it + 1;
-      const double rotation = Eigen::AngleAxisd(step.linear()).angle();
-      if (rotation < 1e-8 && step.translation().norm() < 1e-8) {
-        result.icp_converged = true;
-        break;
-      }
-      max_distance = std::max(0.5 * max_distance, 4 * spacing);
-    }
+  if (options.align_icp && cropped.Size() >= 6) {
+    IcpOptions icp;
+    icp.max_iterations = std::max(1, options.icp_max_iterations);
+    icp.max_correspondence_distance = options.crop_distance_m;
+    icp.min_correspondence_distance = std::min(options.crop_distance_m, 4 * spacing);
+    icp.max_source_points = 100000;
+    const IcpResult aligned =
+        PointToPlaneIcp(cropped, truth, truth_tree, Eigen::Isometry3d::Identity(), icp);
+    result.truth_from_model = aligned.target_from_source;
+    result.icp_converged = aligned.converged;
+    result.icp_iterations = aligned.iterations;
   }
+  std::vector<Eigen::Vector3d> moved;
   // After alignment, evaluate all model points within the crop distance.
-  moved.clear();
   for (size_t i = 0; i < model.Size(); ++i) {
     const Eigen::Vector3d p = result.truth_from_model * model.points[i];
     const double d = SurfaceDistance(truth, truth_tree, spacing, p);

@@ -1,0 +1,40 @@
+// Point-to-plane associations between two station clouds (used by the joint problem's LiDAR term):
+// random source points, each paired with its nearest target point within a gate and that point's
+// normal. The target's k-d tree is built once by the caller and reused across re-associations.
+#pragma once
+
+#include "lidar/kd_tree.h"
+#include "lidar/point_cloud.h"
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <vector>
+
+namespace colmap_lidar {
+
+// One observation of the seed's LiDAR residual: E_l = n^T (target_from_source * p - q) / sigma_l.
+struct PointToPlaneObservation {
+  Eigen::Vector3d point_in_source;  // p
+  Eigen::Vector3d point_in_target;  // q
+  Eigen::Vector3d normal_in_target; // n, unit
+};
+
+struct AssociationOptions {
+  size_t num_samples = 2000;   // source points drawn (without replacement)
+  double max_distance = 0.1;   // gate on |T p - q| [m]
+  double max_curvature = 0.05; // only planar target neighbourhoods (if curvature is given)
+  uint64_t seed = 0;
+
+  bool Check() const;  // throws std::invalid_argument
+};
+
+// `target` needs normals; `target_curvature` may be null (no planarity filter).
+std::vector<PointToPlaneObservation> AssociatePointToPlane(
+    const PointCloud& source,
+    const PointCloud& target,
+    const KdTree3& target_tree,
+    const Eigen::Isometry3d& target_from_source,
+    const AssociationOptions& options,
+    const std::vector<double>* target_curvature = nullptr);
+
+}  // namespace colmap_lidar

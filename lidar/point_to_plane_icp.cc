@@ -1,0 +1,115 @@
+#include "lidar/point_to_plane_icp.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <stdexcept>
+
+namespace colmap_lidar {
+namespace {
+
+struct NormalEquations {
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  double squared_error = 0;
+  size_t count = 0;
+
+  void Add(const NormalEquations& other) {
+    H += other.H;
+    g += other.g;
+    squared_error += other.squared_error;
+    count += other.count;
+  }
+};
+
+// Linearised about the current pose: r = n^T (p' - q), d r / d[omega, t] = [p' x n, n].
+NormalEquations BuildNormalEquations(const PointCloud& source,
+                                     const PointCloud& target,
+                                     const KdTree3& tree,
+                                     const Eigen::Isometry3d& target_from_source,
+                                     size_t stride,
+                                     double gate) {
+  NormalEquations total;
+  const long num = static_cast<long>((source.Size() + stride - 1) / stride);
+#pragma omp parallel
+  {
+    NormalEquations local;
+#pragma omp for schedule(static) nowait
+    for (long k = 0; k < num; ++k) {
+      const Eigen::Vector3d p = target_from_source * source.points[k * stride];
+      size_t index;
+      double squared;
+      if (!tree.Nearest(p, &index, &squared) || squared > gate * gate) continue;
+      const Eigen::Vector3d& n = target.normals[index];
+      if (n.squaredNorm() < 0.5) continue;  // no normal estimated there
+      const double r = n.dot(p - target.points[index]);
+      Eigen::Matrix<double, 6, 1> J;
+      J << p.cross(n), n;
+      local.H.noalias() += J * J.transpose();
+      local.g.noalias() += J * r;
+      local.squared_error += r * r;
+      ++local.count;
+    }
+#pragma omp critical
+    total.Add(local);
+  }
+  return total;
+}
+
+}  // namespace
+
+bool IcpOptions::Check() const {
+  if (max_iterations < 1 || !(max_correspondence_distance > 0) ||
+      !(min_correspondence_distance > 0) || min_correspondence_distance > max_correspondence_distance ||
+      max_source_points < 6) {
+    throw std::invalid_argument("IcpOptions: invalid iteration count, gates or point budget");
+  }
+  return true;
+}
+
+IcpResult PointToPlaneIcp(const PointCloud& source,
+                          const PointCloud& target,
+                          const KdTree3& target_tree,
+                          const Eigen::Isometry3d& initial_target_from_source,
+                          const IcpOptions& options) {
+  options.Check();
+  if (source.Empty() || target.Empty()) throw std::invalid_argument("PointToPlaneIcp: empty cloud");
+  if (!target.HasNormals()) throw std::invalid_argument("PointToPlaneIcp: the target needs normals");
+  if (target_tree.Size() != target.Size()) {
+    throw std::invalid_argument("PointToPlaneIcp: the k-d tree is not built over the target");
+  }
+  const size_t stride = std::max<size_t>(1, source.Size() / options.max_source_points);
+  const size_t num_used = (source.Size() + stride - 1) / stride;
+  IcpResult result;
+  result.target_from_source = initial_target_from_source;
+  double gate = options.max_correspondence_distance;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    const NormalEquations eq =
+        BuildNormalEquations(source, target, target_tree, result.target_from_source, stride, gate);
+    result.iterations = it + 1;
+    if (eq.count < 6) break;
+    const Eigen::Matrix<double, 6, 1> x = eq.H.ldlt().solve(-eq.g);
+    if (!x.allFinite()) break;
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    const double angle = x.head<3>().norm();
+    if (angle > 0) step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
+    step.translation() = x.tail<3>();
+    result.target_from_source = step * result.target_from_source;
+    const bool small_step = angle < options.convergence_rotation_rad &&
+                            x.tail<3>().norm() < options.convergence_translation_m;
+    if (small_step && gate <= options.min_correspondence_distance) {
+      result.converged = true;
+      break;
+    }
+    // Shrink the gate towards a few times the residual, never below the minimum.
+    const double rms = std::sqrt(eq.squared_error / eq.count);
+    gate = std::max(options.min_correspondence_distance, std::min(gate, std::max(0.7 * gate, 6 * rms)));
+  }
+  const NormalEquations final_eq =
+      BuildNormalEquations(source, target, target_tree, result.target_from_source, stride, gate);
+  result.num_inliers = final_eq.count;
+  result.overlap_ratio = static_cast<double>(final_eq.count) / num_used;
+  result.rmse = final_eq.count ? std::sqrt(final_eq.squared_error / final_eq.count) : 0;
+  return result;
+}
+
+}  // namespace colmap_lidar

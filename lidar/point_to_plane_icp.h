@@ -1,0 +1,40 @@
+// Point-to-plane ICP (Chen & Medioni 1992): Gauss-Newton on sum_i (n_i^T (T p_i - q_i))^2 over the
+// source points whose nearest target point lies within a gate that shrinks from `max_correspondence_
+// distance` to `min_correspondence_distance` as the alignment converges.
+#pragma once
+
+#include "lidar/kd_tree.h"
+#include "lidar/point_cloud.h"
+
+#include <Eigen/Geometry>
+
+namespace colmap_lidar {
+
+struct IcpOptions {
+  int max_iterations = 50;
+  double max_correspondence_distance = 0.3;   // metres, first iteration
+  double min_correspondence_distance = 0.05;  // metres, the gate never shrinks below this
+  size_t max_source_points = 30000;           // evenly strided subset of the source
+  double convergence_rotation_rad = 1e-7;
+  double convergence_translation_m = 1e-6;
+
+  bool Check() const;  // throws std::invalid_argument
+};
+
+struct IcpResult {
+  Eigen::Isometry3d target_from_source = Eigen::Isometry3d::Identity();
+  bool converged = false;
+  int iterations = 0;
+  size_t num_inliers = 0;    // correspondences within the final gate
+  double overlap_ratio = 0;  // num_inliers / source points used
+  double rmse = 0;           // point-to-plane RMSE of the inliers [m]
+};
+
+// `target` must have normals and `target_tree` must be built over target.points.
+IcpResult PointToPlaneIcp(const PointCloud& source,
+                          const PointCloud& target,
+                          const KdTree3& target_tree,
+                          const Eigen::Isometry3d& initial_target_from_source,
+                          const IcpOptions& options);
+
+}  // namespace colmap_lidar
