@@ -96,13 +96,16 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
     result.target_from_source = step * result.target_from_source;
     const bool small_step = angle < options.convergence_rotation_rad &&
                             x.tail<3>().norm() < options.convergence_translation_m;
-    if (small_step && gate <= options.min_correspondence_distance) {
+    // Shrink the gate towards a few times the residual, never below the minimum.
+    const double rms = std::sqrt(eq.squared_error / eq.count);
+    const double next_gate =
+        std::max(options.min_correspondence_distance, std::min(gate, std::max(0.7 * gate, 6 * rms)));
+    // Converged: a small step with the gate settled (at its floor or at a few times the noise).
+    if (small_step && next_gate > 0.98 * gate) {
       result.converged = true;
       break;
     }
-    // Shrink the gate towards a few times the residual, never below the minimum.
-    const double rms = std::sqrt(eq.squared_error / eq.count);
-    gate = std::max(options.min_correspondence_distance, std::min(gate, std::max(0.7 * gate, 6 * rms)));
+    gate = next_gate;
   }
   const NormalEquations final_eq =
       BuildNormalEquations(source, target, target_tree, result.target_from_source, stride, gate);

@@ -1,6 +1,6 @@
 // Point-to-plane ICP (Chen & Medioni 1992): Gauss-Newton on sum_i (n_i^T (T p_i - q_i))^2 over the
 // source points whose nearest target point lies within a gate that shrinks from `max_correspondence_
-// distance` to `min_correspondence_distance` as the alignment converges.
+// distance` towards six times the residual RMS (never below `min_correspondence_distance`).
 #pragma once
 
 #include "lidar/kd_tree.h"
@@ -15,7 +15,7 @@ struct IcpOptions {
   double max_correspondence_distance = 0.3;   // metres, first iteration
   double min_correspondence_distance = 0.05;  // metres, the gate never shrinks below this
   size_t max_source_points = 30000;           // evenly strided subset of the source
-  // Converged when a step is below both (with the gate at its minimum). Nearest neighbours keep
+  // Converged when a step is below both and the gate has settled. Nearest neighbours keep
   // switching on noisy clouds, so steps settle around 1e-6 rather than at machine precision.
   double convergence_rotation_rad = 1e-6;
   double convergence_translation_m = 1e-5;

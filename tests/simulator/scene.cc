@@ -230,11 +230,13 @@ void Scene::AddBackground() {
   ground.albedo = 0.45;
   ground.texture_contrast = 0.5;
   primitives_.push_back(ground);
-  // A courtyard: walls 12 m away, 4 m high, and objects 5-9 m away, so that clouds overlap widely.
-  AddBox({-12.3, -12.3, 0}, {-12.0, 12.3, 4}, false, 0.5);
-  AddBox({12.0, -12.3, 0}, {12.3, 12.3, 4}, false, 0.55);
-  AddBox({-12.0, -12.3, 0}, {12.0, -12.0, 4}, false, 0.52);
-  AddBox({-12.0, 12.0, 0}, {12.0, 12.3, 4}, false, 0.48);
+  // A courtyard: walls 10-14 m away and 3-5 m high (deliberately not symmetric: a square courtyard
+  // would make LiDAR registration ambiguous under 90 degree turns, which real sites rarely are), and
+  // objects 5-9 m away, so that clouds overlap widely.
+  AddBox({-10.3, -11.3, 0}, {-10.0, 13.3, 4.0}, false, 0.5);
+  AddBox({13.0, -11.3, 0}, {13.3, 13.3, 3.0}, false, 0.55);
+  AddBox({-10.0, -11.3, 0}, {13.0, -11.0, 5.0}, false, 0.52);
+  AddBox({-4.0, 12.4, 0}, {10.0, 12.7, 3.5}, false, 0.48, 0.12);  // skewed
   AddBox({5.0, 3.0, 0}, {7.0, 4.0, 1.5}, false, 0.4, 0.3);
   AddBox({-8.5, 5.5, 0}, {-5.5, 6.5, 2.0}, false, 0.5, -0.4);
   AddBox({3.5, -8.0, 0}, {5.0, -6.5, 1.0}, false, 0.35);

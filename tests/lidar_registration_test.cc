@@ -1,0 +1,121 @@
+// Pairwise LiDAR registration (BSC + RANSAC + point-to-plane ICP) on simulated station clouds with
+// range noise, against the simulator's ground truth.
+#include "colmap_ext/station_dataset.h"
+#include "lidar/cloud_io.h"
+#include "lidar/pair_registration.h"
+#include "lidar/station_cloud.h"
+#include "tests/simulator/simulate_dataset.h"
+#include "tests/testing/scoped_temp_dir.h"
+
+#include <iomanip>
+#include <iostream>
+
+#include <gtest/gtest.h>
+
+namespace colmap_lidar {
+namespace {
+
+Eigen::Isometry3d ToIsometry(const colmap::Rigid3d& pose) {
+  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
+  result.linear() = pose.rotation.toRotationMatrix();
+  result.translation() = pose.translation;
+  return result;
+}
+
+class LidarRegistrationTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new testing::ScopedTempDir("colmap_lidar_registration");
+    sim::SimulationOptions options;
+    options.output_path = dir_->File("dataset");
+    options.num_stations = 6;
+    options.image_scale = 0.2;
+    options.lidar_points = 300000;  // range noise: the default 1 cm
+    sim::SimulateDataset(options);
+    const StationDataset dataset = ReadStationDataset(options.output_path);
+    const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+    const colmap::Rigid3d cam_from_lidar = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+    for (size_t i = 0; i < dataset.stations.size(); ++i) {
+      world_from_lidar_.push_back(ToIsometry(
+          colmap::Inverse(cam_from_world.at(dataset.stations[i])) * cam_from_lidar));
+      stations_.push_back(
+          PrepareStationCloud(ReadPointCloud(dataset.cloud_paths[i]), StationCloudOptions()));
+    }
+  }
+  static void TearDownTestSuite() {
+    stations_.clear();
+    world_from_lidar_.clear();
+    delete dir_;
+  }
+  static testing::ScopedTempDir* dir_;
+  static std::vector<std::unique_ptr<StationCloud>> stations_;
+  static std::vector<Eigen::Isometry3d> world_from_lidar_;
+};
+testing::ScopedTempDir* LidarRegistrationTest::dir_ = nullptr;
+std::vector<std::unique_ptr<StationCloud>> LidarRegistrationTest::stations_;
+std::vector<Eigen::Isometry3d> LidarRegistrationTest::world_from_lidar_;
+
+// Issue 4 asks for every overlapping pair; today BSC matching finds about two thirds of them (3-8 % of
+// its matches are correct, so RANSAC misses pairs with large viewpoint changes). What is guaranteed and
+// asserted here: an accepted edge is never wrong (< 0.1 deg, < 1 cm), a missed pair is refused rather
+// than mis-registered, the accepted edges connect every station, and at least half the pairs are found.
+TEST_F(LidarRegistrationTest, AcceptedEdgesAreAccurateAndConnectAllStations) {
+  double worst_deg = 0, worst_m = 0;
+  size_t num_pairs = 0, num_accepted = 0;
+  std::vector<size_t> component(stations_.size());
+  for (size_t i = 0; i < component.size(); ++i) component[i] = i;
+  auto find = [&](size_t x) {
+    while (component[x] != x) x = component[x];
+    return x;
+  };
+  std::cout << " i  j  feats_i feats_j matches inliers overlap rmse_mm  rot_deg  trans_mm\n";
+  for (size_t i = 0; i < stations_.size(); ++i) {
+    for (size_t j = i + 1; j < stations_.size(); ++j) {
+      PairRegistrationOptions options;
+      const PairRegistration r = RegisterStationClouds(*stations_[j], *stations_[i], options);
+      // lidar_i_from_lidar_j
+      const Eigen::Isometry3d truth = world_from_lidar_[i].inverse() * world_from_lidar_[j];
+      const Eigen::Isometry3d error = r.target_from_source * truth.inverse();
+      const double rot_deg = Eigen::AngleAxisd(error.linear()).angle() * 180 / M_PI;
+      const double trans_m = error.translation().norm();
+      std::cout << std::setw(2) << i << " " << std::setw(2) << j << " " << std::setw(8)
+                << stations_[i]->features.size() << std::setw(8) << stations_[j]->features.size()
+                << std::setw(8) << r.num_matches << std::setw(8) << r.num_inliers << std::fixed
+                << std::setprecision(3) << std::setw(8) << r.overlap << std::setw(8) << r.rmse * 1000
+                << std::setw(9) << rot_deg << std::setw(10) << trans_m * 1000 << " "
+                << (r.accepted ? "" : r.reason) << std::endl;
+      ++num_pairs;
+      if (r.accepted) {
+        ++num_accepted;
+        worst_deg = std::max(worst_deg, rot_deg);
+        worst_m = std::max(worst_m, trans_m);
+        component[find(i)] = find(j);
+      }
+    }
+  }
+  std::cout << "accepted " << num_accepted << " of " << num_pairs << " pairs; worst accepted error "
+            << worst_deg << " deg, " << worst_m * 1000 << " mm" << std::endl;
+  EXPECT_LT(worst_deg, 0.1);
+  EXPECT_LT(worst_m, 0.01);
+  EXPECT_GE(num_accepted * 2, num_pairs);  // measured: 9-10 of 15
+  for (size_t i = 1; i < stations_.size(); ++i) {
+    EXPECT_EQ(find(i), find(0)) << "station " << i << " is not connected";
+  }
+}
+
+TEST_F(LidarRegistrationTest, RefusesAPairWithoutOverlap) {
+  // The same station split into two halves that share nothing (x < -1 m and x > 1 m in its frame).
+  PointCloud left, right;
+  for (const Eigen::Vector3d& p : stations_[0]->cloud.points) {
+    if (p.x() < -1) left.points.push_back(p);
+    if (p.x() > 1) right.points.push_back(p);
+  }
+  const auto a = PrepareStationCloud(left, StationCloudOptions());
+  const auto b = PrepareStationCloud(right, StationCloudOptions());
+  const PairRegistration r = RegisterStationClouds(*a, *b, PairRegistrationOptions());
+  EXPECT_FALSE(r.accepted) << "overlap " << r.overlap << ", rmse " << r.rmse;
+  std::cout << "no-overlap pair refused: " << r.reason << std::endl;
+}
+
+}  // namespace
+}  // namespace colmap_lidar
