@@ -25,7 +25,7 @@
 namespace colmap_lidar {
 
 struct BscOptions {
-  double support_radius = 1.0;   // R [m]
+  double support_radius = 1.5;   // R [m]
   int grid_size = 7;             // N
   double occupancy_ratio = 0.5;  // occupied: cell density > ratio * mean cell density of the plane
   double ambiguity_ratio = 0.85; // lambda_2 / lambda_1 above this: keep the y-axis variants too
