@@ -41,6 +41,8 @@ const std::vector<Command>& Commands() {
        "Summarise a database: COLMAP's tables and depth priors, LiDAR frames, rig"},
       {"simulate_dataset", &RunSimulateDataset,
        "Simulate a stereo + LiDAR station dataset with ground truth"},
+      {"lidar_registrator", &RunLidarRegistrator,
+       "Register all station clouds and build the LiDAR pose graph"},
       {"evaluate_model", &RunEvaluateModel,
        "Accuracy, completeness and density of a cloud against the true surface"},
       {"evaluate_calibration", &RunEvaluateCalibration,

@@ -12,6 +12,10 @@ int RunDatabaseCreator(int argc, char** argv);
 // Prints what a database holds: COLMAP's images/keypoints/matches and our depth priors, LiDAR frames, rig.
 int RunDatabaseInfo(int argc, char** argv);
 
+// Registers all station clouds (BSC + RANSAC + ICP), builds the LiDAR pose graph A_l and writes
+// pairs.txt, lidar_poses.txt and summary.txt.
+int RunLidarRegistrator(int argc, char** argv);
+
 // Accuracy of a cloud against ground_truth/surface.ply: distances, completeness, density, plots.
 int RunEvaluateModel(int argc, char** argv);
 

@@ -2,11 +2,15 @@
 // range noise, against the simulator's ground truth.
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
+#include "lidar/lidar_pose_graph.h"
 #include "lidar/pair_registration.h"
 #include "lidar/station_cloud.h"
 #include "tests/simulator/simulate_dataset.h"
+#include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 
@@ -102,6 +106,29 @@ TEST_F(LidarRegistrationTest, EveryOverlappingPairWithinATenthOfADegreeAndOneCen
   }
 }
 
+TEST_F(LidarRegistrationTest, PoseGraphGivesEveryStationItsTruePose) {
+  std::vector<const StationCloud*> pointers;
+  for (const auto& s : stations_) pointers.push_back(s.get());
+  LidarGraphOptions options;
+  options.max_neighbors = 3;  // exercise the global-descriptor preselection
+  const LidarGraph graph = RegisterAllStations(pointers, options);
+  EXPECT_EQ(graph.num_components, 1);
+  EXPECT_LE(graph.edges.size() + graph.refused.size(), 12u);  // fewer than all 15 pairs
+  EXPECT_LE(graph.refinement_final_cost, graph.refinement_initial_cost);
+  double worst_deg = 0, worst_mm = 0;
+  for (size_t i = 1; i < stations_.size(); ++i) {
+    // The graph's world is station 0's LiDAR frame.
+    const Eigen::Isometry3d truth = world_from_lidar_[0].inverse() * world_from_lidar_[i];
+    const Eigen::Isometry3d error = graph.world_from_lidar[i] * truth.inverse();
+    worst_deg = std::max(worst_deg, Eigen::AngleAxisd(error.linear()).angle() * 180 / M_PI);
+    worst_mm = std::max(worst_mm, error.translation().norm() * 1000);
+  }
+  std::cout << "pose graph: " << graph.edges.size() << " edges, worst station error " << worst_deg
+            << " deg, " << worst_mm << " mm" << std::endl;
+  EXPECT_LT(worst_deg, 0.1);
+  EXPECT_LT(worst_mm, 10.0);
+}
+
 TEST_F(LidarRegistrationTest, RefusesAPairWithoutOverlap) {
   // The same station split into two halves that share nothing (x < -1 m and x > 1 m in its frame).
   PointCloud left, right;
@@ -114,6 +141,46 @@ TEST_F(LidarRegistrationTest, RefusesAPairWithoutOverlap) {
   const PairRegistration r = RegisterStationClouds(*a, *b, PairRegistrationOptions());
   EXPECT_FALSE(r.accepted) << "overlap " << r.overlap << ", rmse " << r.rmse;
   std::cout << "no-overlap pair refused: " << r.reason << std::endl;
+}
+
+TEST(LidarRegistratorCliTest, WritesTheGraphAndRejectsBadInput) {
+  testing::ScopedTempDir dir;
+  sim::SimulationOptions options;
+  options.output_path = dir.File("dataset");
+  options.num_stations = 3;
+  options.image_scale = 0.2;
+  options.lidar_points = 300000;  // ~200k points per station (at ~100k, pairs start to be refused)
+  sim::SimulateDataset(options);
+  const std::string cli = COLMAP_LIDAR_CLI_EXE;
+  auto result = testing::RunCommand(cli + " lidar_registrator --lidar_path " + dir.File("dataset/lidar") +
+                                    " --output_path " + dir.File("out"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("components 1"), std::string::npos) << result.output;
+  const auto poses = ReadNamedPoses(dir.File("out/lidar_poses.txt"));
+  ASSERT_EQ(poses.size(), 3u);
+  const StationDataset dataset = ReadStationDataset(dir.File("dataset"));
+  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const colmap::Rigid3d cam_from_lidar = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  const colmap::Rigid3d world_from_lidar0 = colmap::Inverse(cam_from_world.at("000")) * cam_from_lidar;
+  for (const std::string name : {"001", "002"}) {
+    const colmap::Rigid3d truth =
+        colmap::Inverse(world_from_lidar0) * colmap::Inverse(cam_from_world.at(name)) * cam_from_lidar;
+    EXPECT_LT((poses.at(name).translation - truth.translation).norm(), 0.01) << name;
+    EXPECT_LT(poses.at(name).rotation.angularDistance(truth.rotation) * 180 / M_PI, 0.1) << name;
+  }
+  std::ifstream pairs(dir.File("out/pairs.txt"));
+  std::string line;
+  int num_edges = 0;
+  while (std::getline(pairs, line)) num_edges += !line.empty() && line[0] != '#';
+  EXPECT_EQ(num_edges, 3);
+
+  // A truncated cloud: one clear error naming the file, non-zero exit.
+  std::filesystem::resize_file(dir.File("dataset/lidar/001.pcd"), 5000);
+  result = testing::RunCommand(cli + " lidar_registrator --lidar_path " + dir.File("dataset/lidar") +
+                               " --output_path " + dir.File("out2"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("001.pcd"), std::string::npos) << result.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("out2/pairs.txt")));
 }
 
 }  // namespace

@@ -1,0 +1,50 @@
+// All-pairs LiDAR registration and the LiDAR pose graph (the seed's A_l): register station pairs, accept
+// edges, take a maximum spanning tree for initial poses, refine all poses over all accepted edges with
+// Ceres, and report the connected components. Station poses are world_from_lidar with the first station
+// of each component as its world (identity).
+#pragma once
+
+#include "lidar/pair_registration.h"
+#include "lidar/station_cloud.h"
+
+#include <Eigen/Geometry>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace colmap_lidar {
+
+struct LidarEdge {
+  size_t target = 0;  // i
+  size_t source = 0;  // j
+  Eigen::Isometry3d target_from_source = Eigen::Isometry3d::Identity();  // lidar_i_from_lidar_j
+  PairRegistration registration;
+  double Weight() const { return registration.num_inliers * registration.overlap; }
+};
+
+struct LidarGraphOptions {
+  PairRegistrationOptions pair;
+  // 0: register every pair. Otherwise each station is registered with its `max_neighbors` most
+  // similar stations by a global descriptor (the histogram of its BSC bits), for large captures.
+  size_t max_neighbors = 0;
+  bool refine = true;  // pose-graph refinement over all accepted edges
+
+  bool Check() const;  // throws std::invalid_argument
+};
+
+struct LidarGraph {
+  std::vector<LidarEdge> edges;           // accepted
+  std::vector<LidarEdge> refused;         // attempted, not accepted (registration.reason says why)
+  std::vector<Eigen::Isometry3d> world_from_lidar;  // per station
+  std::vector<int> component;             // per station, 0-based; component 0 holds station 0
+  int num_components = 0;
+  double refinement_initial_cost = 0, refinement_final_cost = 0;
+};
+
+// Progress: called after each pair with (pairs done, pairs total).
+LidarGraph RegisterAllStations(
+    const std::vector<const StationCloud*>& stations,
+    const LidarGraphOptions& options,
+    const std::function<void(size_t, size_t)>& progress = nullptr);
+
+}  // namespace colmap_lidar
