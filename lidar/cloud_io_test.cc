@@ -6,6 +6,8 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
 
 namespace colmap_lidar {
 namespace {
@@ -68,6 +70,27 @@ TEST_F(CloudIoTest, PcdAndPlyRoundTripWithAllAttributes) {
     // float32 storage: relative precision ~6e-8 at |x| <= 35 m.
     EXPECT_LT(max_error, 5e-6) << name;
     EXPECT_FALSE(fs::exists(Path(name) + ".tmp")) << "temporary file left";
+  }
+}
+
+TEST_F(CloudIoTest, ReadsEveryPcdEncodingWrittenByPcl) {
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  for (int i = 0; i < 300; ++i) {
+    pcl::PointXYZI p;
+    p.x = 0.1f * i, p.y = -0.2f * i, p.z = 3.0f, p.intensity = static_cast<float>(i % 7);
+    cloud.push_back(p);
+  }
+  cloud[5].x = std::nanf("");  // one NaN point inside a good file: dropped and counted
+  ASSERT_EQ(pcl::io::savePCDFileASCII(Path("ascii.pcd"), cloud), 0);
+  ASSERT_EQ(pcl::io::savePCDFileBinary(Path("binary.pcd"), cloud), 0);
+  ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(Path("compressed.pcd"), cloud), 0);
+  for (const char* name : {"ascii.pcd", "binary.pcd", "compressed.pcd"}) {
+    CloudReadStats stats;
+    const PointCloud read = ReadPointCloud(Path(name), &stats);
+    ASSERT_EQ(read.Size(), 299u) << name;
+    EXPECT_EQ(stats.num_dropped_non_finite, 1u) << name;
+    EXPECT_NEAR(read.points[10].x(), 1.1, 1e-5) << name;  // index 10 is point 11 after the NaN
+    EXPECT_FLOAT_EQ(read.intensities[10], 11 % 7) << name;
   }
 }
 
