@@ -34,18 +34,28 @@ int RunVersion(int argc, char** argv);
 const std::vector<Command>& Commands() {
   static const std::vector<Command> kCommands = {
       {"help", &RunHelp, "List the commands"},
-      {"version", &RunVersion, "Print colmap-lidar's version and the COLMAP it links"},
-      {"database_creator", &RunDatabaseCreator,
+      {"version",
+       &RunVersion,
+       "Print colmap-lidar's version and the COLMAP it links"},
+      {"database_creator",
+       &RunDatabaseCreator,
        "Create a COLMAP database (or extend one) with colmap-lidar's tables"},
-      {"database_info", &RunDatabaseInfo,
-       "Summarise a database: COLMAP's tables and depth priors, LiDAR frames, rig"},
-      {"simulate_dataset", &RunSimulateDataset,
+      {"database_info",
+       &RunDatabaseInfo,
+       "Summarise a database: COLMAP's tables and depth priors, LiDAR frames, "
+       "rig"},
+      {"simulate_dataset",
+       &RunSimulateDataset,
        "Simulate a stereo + LiDAR station dataset with ground truth"},
-      {"lidar_registrator", &RunLidarRegistrator,
+      {"lidar_registrator",
+       &RunLidarRegistrator,
        "Register all station clouds and build the LiDAR pose graph"},
-      {"evaluate_model", &RunEvaluateModel,
-       "Accuracy, completeness and density of a cloud against the true surface"},
-      {"evaluate_calibration", &RunEvaluateCalibration,
+      {"evaluate_model",
+       &RunEvaluateModel,
+       "Accuracy, completeness and density of a cloud against the true "
+       "surface"},
+      {"evaluate_calibration",
+       &RunEvaluateCalibration,
        "Error of cam_from_lidar and of station poses against ground truth"},
   };
   return kCommands;
@@ -58,11 +68,12 @@ std::string VersionString() {
 }
 
 int RunHelp(int, char**) {
-  std::cout << VersionString() << "\n\n"
-            << "Usage: colmap-lidar COMMAND [--option value ...]\n"
-            << "       colmap-lidar COMMAND --help   (options of a command)\n"
-            << "Options may also come from an .ini file: --project_path FILE\n\n"
-            << "Commands:\n";
+  std::cout
+      << VersionString() << "\n\n"
+      << "Usage: colmap-lidar COMMAND [--option value ...]\n"
+      << "       colmap-lidar COMMAND --help   (options of a command)\n"
+      << "Options may also come from an .ini file: --project_path FILE\n\n"
+      << "Commands:\n";
   for (const Command& command : Commands()) {
     std::cout << "  " << std::left << std::setw(24) << command.name
               << command.help << "\n";

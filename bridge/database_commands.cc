@@ -1,9 +1,9 @@
 #include "bridge/commands.h"
 #include "colmap_ext/extension_database.h"
+#include "colmap_ext/logging.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/scene/database.h"
-#include "colmap_ext/logging.h"
 
 #include <filesystem>
 #include <iostream>
@@ -15,7 +15,8 @@ int RunDatabaseCreator(int argc, char** argv) {
   options.AddDatabaseOptions();
   options.Parse(argc, argv);
   {
-    colmap::Database database(*options.database_path);  // creates COLMAP's tables if absent
+    colmap::Database database(
+        *options.database_path);  // creates COLMAP's tables if absent
   }
   ExtensionDatabase extension(*options.database_path);
   std::cout << "Database " << *options.database_path

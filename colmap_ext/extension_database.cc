@@ -1,7 +1,8 @@
 #include "colmap_ext/extension_database.h"
 
-#include "colmap/sensor/models.h"
 #include "colmap_ext/logging.h"
+
+#include "colmap/sensor/models.h"
 
 #include <stdexcept>
 

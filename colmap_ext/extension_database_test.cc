@@ -1,15 +1,16 @@
 #include "colmap_ext/extension_database.h"
+
 #include "tests/testing/scoped_temp_dir.h"
 
 #include "colmap/scene/database.h"
 #include "colmap/sensor/models.h"
 
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
 #include <filesystem>
 #include <fstream>
 #include <random>
-
-#include <gtest/gtest.h>
-#include <sqlite3.h>
 
 namespace colmap_lidar {
 namespace {
@@ -58,9 +59,10 @@ TEST_F(ExtensionDatabaseTest, RoundTripsAllTables) {
     LidarFrame frame;
     frame.image_id = image_ids_[0];
     frame.path = "lidar/000.pcd";
-    frame.cam_from_lidar_guess = colmap::Rigid3d(
-        Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())),
-        Eigen::Vector3d(0.1, -0.2, 0.05));
+    frame.cam_from_lidar_guess =
+        colmap::Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(
+                            0.3, Eigen::Vector3d(1, 2, 3).normalized())),
+                        Eigen::Vector3d(0.1, -0.2, 0.05));
     EXPECT_GT(db.WriteLidarFrame(frame), 0);
     LidarFrame frame_without_guess;
     frame_without_guess.image_id = image_ids_[1];
@@ -168,7 +170,8 @@ TEST_F(ExtensionDatabaseTest, DeletingAnImageInColmapCascadesToOurRows) {
 }
 
 TEST_F(ExtensionDatabaseTest, LockedDatabaseGivesClearErrorAndNoChange) {
-  ExtensionDatabase db(path_, ExtensionDatabase::Mode::kReadWrite,
+  ExtensionDatabase db(path_,
+                       ExtensionDatabase::Mode::kReadWrite,
                        /*busy_timeout_ms=*/100);
   db.WriteDepthPriors(image_ids_[0], MakePriors(3, 2.0));
   sqlite3* other = nullptr;

@@ -1,9 +1,9 @@
 #include "colmap_ext/sqlite_connection.h"
 
+#include <sqlite3.h>
+
 #include <filesystem>
 #include <stdexcept>
-
-#include <sqlite3.h>
 
 namespace colmap_lidar {
 
@@ -14,8 +14,8 @@ SqliteConnection::SqliteConnection(const std::string& path,
   if (!std::filesystem::is_regular_file(path)) {
     throw std::runtime_error("Database file does not exist: " + path);
   }
-  const int flags = mode == Mode::kReadOnly ? SQLITE_OPEN_READONLY
-                                            : SQLITE_OPEN_READWRITE;
+  const int flags =
+      mode == Mode::kReadOnly ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE;
   const int rc = sqlite3_open_v2(path.c_str(), &db_, flags, nullptr);
   if (rc != SQLITE_OK) {
     const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
@@ -28,9 +28,10 @@ SqliteConnection::SqliteConnection(const std::string& path,
   // Foreign keys are per connection in SQLite; COLMAP enables them on its own.
   Execute("PRAGMA foreign_keys=ON");
   // Fails early, with a clear message, on a file that is not an SQLite database.
-  Check(sqlite3_exec(db_, "SELECT count(*) FROM sqlite_master", nullptr, nullptr,
-                     nullptr),
-        "Reading the schema");
+  Check(
+      sqlite3_exec(
+          db_, "SELECT count(*) FROM sqlite_master", nullptr, nullptr, nullptr),
+      "Reading the schema");
 }
 
 SqliteConnection::~SqliteConnection() { sqlite3_close_v2(db_); }
@@ -39,7 +40,8 @@ void SqliteConnection::Check(int rc, const std::string& what) const {
   if (rc == SQLITE_OK || rc == SQLITE_ROW || rc == SQLITE_DONE) return;
   std::string message = sqlite3_errmsg(db_);
   if ((rc & 0xff) == SQLITE_BUSY || (rc & 0xff) == SQLITE_LOCKED) {
-    message += " (another process holds a lock on the database; close it and retry)";
+    message +=
+        " (another process holds a lock on the database; close it and retry)";
   } else if ((rc & 0xff) == SQLITE_READONLY) {
     message += " (the database is read-only)";
   }
@@ -63,8 +65,8 @@ bool SqliteConnection::TableExists(const std::string& table) const {
 SqliteStatement::SqliteStatement(const SqliteConnection& connection,
                                  const std::string& sql)
     : connection_(connection) {
-  connection_.Check(sqlite3_prepare_v2(connection_.Handle(), sql.c_str(), -1,
-                                       &stmt_, nullptr),
+  connection_.Check(sqlite3_prepare_v2(
+                        connection_.Handle(), sql.c_str(), -1, &stmt_, nullptr),
                     "Preparing '" + sql.substr(0, 60) + "'");
 }
 
@@ -96,9 +98,8 @@ void SqliteStatement::BindNull(int index) {
 
 bool SqliteStatement::Step() {
   const int rc = sqlite3_step(stmt_);
-  connection_.Check(rc, "Executing '" +
-                            std::string(sqlite3_sql(stmt_)).substr(0, 60) +
-                            "'");
+  connection_.Check(
+      rc, "Executing '" + std::string(sqlite3_sql(stmt_)).substr(0, 60) + "'");
   return rc == SQLITE_ROW;
 }
 

@@ -2,15 +2,15 @@
 
 #include "colmap/sensor/models.h"
 
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
-#include <unistd.h>
-
-#include <nlohmann/json.hpp>
 
 namespace colmap_lidar {
 namespace {
@@ -37,8 +37,9 @@ std::vector<double> NumberArray(const json& value,
                                 const std::string& path,
                                 const std::string& key) {
   if (!value.is_array() || (expected_size && value.size() != expected_size)) {
-    Fail(path, "'" + key + "' must be an array of " +
-                   std::to_string(expected_size) + " numbers");
+    Fail(path,
+         "'" + key + "' must be an array of " + std::to_string(expected_size) +
+             " numbers");
   }
   std::vector<double> numbers;
   for (const json& v : value) {
@@ -57,8 +58,9 @@ colmap::Camera ParseCamera(const json& value,
   const json& model = Require(value, "model", path, where);
   if (!model.is_string() ||
       !colmap::ExistsCameraModelWithName(model.get<std::string>())) {
-    Fail(path, "'" + where + "model' is not a COLMAP camera model name: " +
-                   model.dump());
+    Fail(path,
+         "'" + where +
+             "model' is not a COLMAP camera model name: " + model.dump());
   }
   colmap::Camera camera;
   camera.model_id = colmap::CameraModelNameToId(model.get<std::string>());
@@ -73,10 +75,11 @@ colmap::Camera ParseCamera(const json& value,
   const size_t num_params = colmap::CameraModelNumParams(camera.model_id);
   const json& params = Require(value, "params", path, where);
   if (!params.is_array() || params.size() != num_params) {
-    Fail(path, "'" + where + "params' must hold " + std::to_string(num_params) +
-                   " values for model " + camera.ModelName() + " (" +
-                   camera.ParamsInfo() + "), got " +
-                   std::to_string(params.is_array() ? params.size() : 0));
+    Fail(path,
+         "'" + where + "params' must hold " + std::to_string(num_params) +
+             " values for model " + camera.ModelName() + " (" +
+             camera.ParamsInfo() + "), got " +
+             std::to_string(params.is_array() ? params.size() : 0));
   }
   camera.params = NumberArray(params, num_params, path, where + "params");
   if (camera.FocalLengthX() <= 0 || camera.FocalLengthY() <= 0) {
@@ -91,7 +94,9 @@ colmap::Rigid3d ParseRigid(const json& value,
   const std::vector<double> q = NumberArray(
       Require(value, "rotation", path, key + "."), 4, path, key + ".rotation");
   const std::vector<double> t =
-      NumberArray(Require(value, "translation", path, key + "."), 3, path,
+      NumberArray(Require(value, "translation", path, key + "."),
+                  3,
+                  path,
                   key + ".translation");
   const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);  // w first
   if (std::abs(rotation.norm() - 1) > 1e-3) {
@@ -131,14 +136,16 @@ colmap::Rigid3d ParsePose(std::istream& tokens,
   double v[7];
   for (double& x : v) {
     if (!(tokens >> x) || !std::isfinite(x)) {
-      Fail(path, "line " + std::to_string(line_number) +
-                     ": expected qw qx qy qz tx ty tz");
+      Fail(path,
+           "line " + std::to_string(line_number) +
+               ": expected qw qx qy qz tx ty tz");
     }
   }
   const Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
   if (std::abs(q.norm() - 1) > 1e-3) {
-    Fail(path, "line " + std::to_string(line_number) +
-                   ": rotation is not a unit quaternion (qw first)");
+    Fail(path,
+         "line " + std::to_string(line_number) +
+             ": rotation is not a unit quaternion (qw first)");
   }
   return colmap::Rigid3d(q.normalized(), Eigen::Vector3d(v[4], v[5], v[6]));
 }
@@ -172,19 +179,20 @@ StationRig ReadRigJson(const std::string& path) {
   StationRig rig;
   rig.left = ParseCamera(Require(root, "left", path, ""), path, "left");
   rig.right = ParseCamera(Require(root, "right", path, ""), path, "right");
-  rig.right_from_left = ParseRigid(Require(root, "right_from_left", path, ""),
-                                   path, "right_from_left");
+  rig.right_from_left = ParseRigid(
+      Require(root, "right_from_left", path, ""), path, "right_from_left");
   if (rig.BaselineMeters() < 1e-3) {
     Fail(path, "'right_from_left.translation' gives a baseline below 1 mm");
   }
   if (root.contains("cam_from_lidar_guess") &&
       !root["cam_from_lidar_guess"].is_null()) {
-    rig.cam_from_lidar_guess = ParseRigid(root["cam_from_lidar_guess"], path,
-                                          "cam_from_lidar_guess");
+    rig.cam_from_lidar_guess =
+        ParseRigid(root["cam_from_lidar_guess"], path, "cam_from_lidar_guess");
   }
   if (root.contains("lidar")) {
     const json& lidar = root["lidar"];
-    if (lidar.contains("model")) rig.lidar_model = lidar["model"].get<std::string>();
+    if (lidar.contains("model"))
+      rig.lidar_model = lidar["model"].get<std::string>();
     if (lidar.contains("range_noise_m")) {
       rig.lidar_range_noise_m = lidar["range_noise_m"].get<double>();
     }
@@ -296,7 +304,8 @@ void WriteNamedPoses(const std::string& path,
   out << "# " << header_comment << "\n"
       << "# <station> qw qx qy qz tx ty tz   (target_from_source, quaternion w "
          "first, metres)\n";
-  for (const auto& [name, pose] : poses) out << name << " " << PoseLine(pose) << "\n";
+  for (const auto& [name, pose] : poses)
+    out << name << " " << PoseLine(pose) << "\n";
   WriteFileAtomically(path, out.str());
 }
 
@@ -317,10 +326,11 @@ colmap::Rigid3d ReadPoseFile(const std::string& path) {
 void WritePoseFile(const std::string& path,
                    const std::string& header_comment,
                    const colmap::Rigid3d& target_from_source) {
-  WriteFileAtomically(path, "# " + header_comment +
-                                "\n# qw qx qy qz tx ty tz   (quaternion w "
-                                "first, metres)\n" +
-                                PoseLine(target_from_source) + "\n");
+  WriteFileAtomically(path,
+                      "# " + header_comment +
+                          "\n# qw qx qy qz tx ty tz   (quaternion w "
+                          "first, metres)\n" +
+                          PoseLine(target_from_source) + "\n");
 }
 
 }  // namespace colmap_lidar

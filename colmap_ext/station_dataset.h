@@ -25,8 +25,8 @@ struct StationRig {
   colmap::Camera right;
   colmap::Rigid3d right_from_left;
   std::optional<colmap::Rigid3d> cam_from_lidar_guess;
-  std::string lidar_model;          // e.g. "VLP-16"; empty if not given
-  double lidar_range_noise_m = 0;   // 0 if not given
+  std::string lidar_model;         // e.g. "VLP-16"; empty if not given
+  double lidar_range_noise_m = 0;  // 0 if not given
 
   double BaselineMeters() const { return right_from_left.translation.norm(); }
 };
@@ -39,7 +39,7 @@ void WriteRigJson(const std::string& path, const StationRig& rig);
 struct StationDataset {
   std::string root;
   StationRig rig;
-  std::vector<std::string> stations;  // sorted file stems, e.g. "000"
+  std::vector<std::string> stations;     // sorted file stems, e.g. "000"
   std::vector<std::string> cloud_paths;  // absolute, one per station
 
   std::string LeftImagePath(size_t i) const;

@@ -1,11 +1,12 @@
 #include "colmap_ext/station_dataset.h"
-#include "tests/testing/scoped_temp_dir.h"
 
-#include <filesystem>
-#include <fstream>
+#include "tests/testing/scoped_temp_dir.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
 
 namespace colmap_lidar {
 namespace {
@@ -37,7 +38,9 @@ class StationDatasetTest : public ::testing::Test {
       std::ofstream(dir_.File("lidar/") + s + ".pcd") << "x";
     }
   }
-  void WriteRig(const json& rig) { std::ofstream(dir_.File("rig.json")) << rig.dump(); }
+  void WriteRig(const json& rig) {
+    std::ofstream(dir_.File("rig.json")) << rig.dump();
+  }
 
   // Expects ReadStationDataset to fail with a message naming `file` and containing `problem`.
   void ExpectError(const std::string& file, const std::string& problem) {
@@ -75,7 +78,9 @@ TEST_F(StationDatasetTest, RigJsonRoundTrips) {
   EXPECT_EQ(copy.right.params, rig.right.params);
   EXPECT_EQ(copy.lidar_model, "VLP-16");
   EXPECT_NEAR(copy.cam_from_lidar_guess->rotation.angularDistance(
-                  rig.cam_from_lidar_guess->rotation), 0, 1e-12);
+                  rig.cam_from_lidar_guess->rotation),
+              0,
+              1e-12);
 }
 
 TEST_F(StationDatasetTest, BadRigJsonNamesTheFileAndTheKey) {
@@ -119,13 +124,16 @@ TEST_F(StationDatasetTest, MissingImageOrCloudNamesTheFile) {
   std::ofstream(dir_.File("images/right/001.png")) << "x";
   fs::remove(dir_.File("lidar/000.pcd"));
   ExpectError("lidar/000.pcd", "missing LiDAR cloud of station 000");
-  std::ofstream(dir_.File("lidar/000.bin")) << "x";  // any supported format will do
-  EXPECT_EQ(ReadStationDataset(dir_.Path().string()).cloud_paths[0], dir_.File("lidar/000.bin"));
+  std::ofstream(dir_.File("lidar/000.bin"))
+      << "x";  // any supported format will do
+  EXPECT_EQ(ReadStationDataset(dir_.Path().string()).cloud_paths[0],
+            dir_.File("lidar/000.bin"));
 }
 
 TEST_F(StationDatasetTest, PoseFilesRoundTripWithWFirst) {
   const colmap::Rigid3d pose(
-      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized())),
+      Eigen::Quaterniond(
+          Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized())),
       Eigen::Vector3d(1.5, -0.25, 3));
   WritePoseFile(dir_.File("p.txt"), "test", pose);
   const colmap::Rigid3d read = ReadPoseFile(dir_.File("p.txt"));
@@ -137,10 +145,12 @@ TEST_F(StationDatasetTest, PoseFilesRoundTripWithWFirst) {
   }
   EXPECT_DOUBLE_EQ(std::stod(line), pose.rotation.w());
 
-  WriteNamedPoses(dir_.File("n.txt"), "test", {{"000", pose}, {"001", colmap::Rigid3d()}});
+  WriteNamedPoses(
+      dir_.File("n.txt"), "test", {{"000", pose}, {"001", colmap::Rigid3d()}});
   const auto poses = ReadNamedPoses(dir_.File("n.txt"));
   ASSERT_EQ(poses.size(), 2u);
-  EXPECT_NEAR((poses.at("000").translation - pose.translation).norm(), 0, 1e-15);
+  EXPECT_NEAR(
+      (poses.at("000").translation - pose.translation).norm(), 0, 1e-15);
 
   std::ofstream(dir_.File("bad.txt")) << "000 1 0 0\n";
   EXPECT_THROW(ReadNamedPoses(dir_.File("bad.txt")), std::runtime_error);

@@ -2,6 +2,7 @@
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,6 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace colmap_lidar {
 namespace {
@@ -51,8 +51,8 @@ class CloudBuilder {
   PointCloud Finish(const std::string& path, CloudReadStats* stats) {
     if (num_read_ == 0) Fail(path, "the file holds no points");
     if (cloud_.Empty()) {
-      Fail(path, "all " + std::to_string(num_read_) +
-                     " points are NaN or infinite");
+      Fail(path,
+           "all " + std::to_string(num_read_) + " points are NaN or infinite");
     }
     if (stats) {
       stats->num_read = num_read_;
@@ -115,8 +115,9 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
   pcl::PCLPointCloud2 blob;
   pcl::PCDReader reader;
   if (reader.read(path, blob) < 0) {
-    Fail(path, "PCL's PCD reader rejected it (truncated or malformed; see "
-               "the message above)");
+    Fail(path,
+         "PCL's PCD reader rejected it (truncated or malformed; see "
+         "the message above)");
   }
   auto find = [&](const std::string& name) -> const pcl::PCLPointField* {
     for (const auto& f : blob.fields) {
@@ -200,7 +201,8 @@ double DecodePly(const std::string& type, const char* data, bool swap) {
     std::memcpy(&v, buffer, 8);
     return v;
   }
-  if (type == "uchar" || type == "uint8") return static_cast<uint8_t>(buffer[0]);
+  if (type == "uchar" || type == "uint8")
+    return static_cast<uint8_t>(buffer[0]);
   if (type == "char" || type == "int8") return static_cast<int8_t>(buffer[0]);
   if (type == "ushort" || type == "uint16") {
     uint16_t v;
@@ -257,7 +259,8 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
     } else if (keyword == "property" && in_vertex) {
       PlyProperty property;
       tokens >> property.type;
-      if (property.type == "list") Fail(path, "list property in vertex element");
+      if (property.type == "list")
+        Fail(path, "list property in vertex element");
       tokens >> property.name;
       property.size = PlyTypeSize(property.type);
       if (property.size == 0) {
@@ -289,7 +292,8 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
   const int ir = index_of({"red", "r"});
   const int ig = index_of({"green", "g"});
   const int ib = index_of({"blue", "b"});
-  const int ii = index_of({"intensity", "scalar_intensity", "scalar_Intensity"});
+  const int ii =
+      index_of({"intensity", "scalar_intensity", "scalar_Intensity"});
   const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
   const bool colors = ir >= 0 && ig >= 0 && ib >= 0;
   CloudBuilder builder(normals, colors, ii >= 0);
@@ -301,8 +305,9 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
   for (size_t v = 0; v < num_vertices; ++v) {
     if (format == "ascii") {
       if (!std::getline(file, line)) {
-        Fail(path, "truncated: " + std::to_string(v) + " of " +
-                       std::to_string(num_vertices) + " vertices");
+        Fail(path,
+             "truncated: " + std::to_string(v) + " of " +
+                 std::to_string(num_vertices) + " vertices");
       }
       std::istringstream tokens(line);
       for (double& value : values) {
@@ -316,15 +321,17 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
           if (token == "nan" || token == "-nan") {
             value = std::nan("");
           } else {
-            Fail(path, "vertex " + std::to_string(v) + ": '" + token +
-                           "' is not a number");
+            Fail(path,
+                 "vertex " + std::to_string(v) + ": '" + token +
+                     "' is not a number");
           }
         }
       }
     } else {
       if (!file.read(record.data(), record_size)) {
-        Fail(path, "truncated: " + std::to_string(v) + " of " +
-                       std::to_string(num_vertices) + " vertices");
+        Fail(path,
+             "truncated: " + std::to_string(v) + " of " +
+                 std::to_string(num_vertices) + " vertices");
       }
       size_t offset = 0;
       for (size_t i = 0; i < properties.size(); ++i) {
@@ -336,13 +343,12 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
     const Eigen::Vector3d normal =
         normals ? Eigen::Vector3d(values[inx], values[iny], values[inz])
                 : Eigen::Vector3d::Zero();
-    const Color3ub color =
-        colors ? Color3ub(static_cast<uint8_t>(values[ir]),
-                          static_cast<uint8_t>(values[ig]),
-                          static_cast<uint8_t>(values[ib]))
-               : Color3ub(0, 0, 0);
-    builder.Add(point, normal, color,
-                ii >= 0 ? static_cast<float>(values[ii]) : 0.f);
+    const Color3ub color = colors ? Color3ub(static_cast<uint8_t>(values[ir]),
+                                             static_cast<uint8_t>(values[ig]),
+                                             static_cast<uint8_t>(values[ib]))
+                                  : Color3ub(0, 0, 0);
+    builder.Add(
+        point, normal, color, ii >= 0 ? static_cast<float>(values[ii]) : 0.f);
   }
   return builder.Finish(path, stats);
 }
@@ -352,9 +358,10 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
 PointCloud ReadKittiBin(const std::string& path, CloudReadStats* stats) {
   const auto num_bytes = fs::file_size(path);
   if (num_bytes % (4 * sizeof(float)) != 0) {
-    Fail(path, "size " + std::to_string(num_bytes) +
-                   " bytes is not a multiple of 16 (float32 x y z i): "
-                   "truncated or not a KITTI .bin");
+    Fail(path,
+         "size " + std::to_string(num_bytes) +
+             " bytes is not a multiple of 16 (float32 x y z i): "
+             "truncated or not a KITTI .bin");
   }
   std::ifstream file(path, std::ios::binary);
   std::vector<float> data(num_bytes / sizeof(float));
@@ -364,7 +371,9 @@ PointCloud ReadKittiBin(const std::string& path, CloudReadStats* stats) {
   CloudBuilder builder(false, false, true);
   for (size_t i = 0; i + 3 < data.size(); i += 4) {
     builder.Add(Eigen::Vector3d(data[i], data[i + 1], data[i + 2]),
-                Eigen::Vector3d::Zero(), Color3ub(0, 0, 0), data[i + 3]);
+                Eigen::Vector3d::Zero(),
+                Color3ub(0, 0, 0),
+                data[i + 3]);
   }
   return builder.Finish(path, stats);
 }
@@ -387,17 +396,19 @@ PointCloud ReadXyzText(const std::string& path, CloudReadStats* stats) {
       try {
         values.push_back(std::stod(token));
       } catch (const std::exception&) {
-        Fail(path, "line " + std::to_string(line_number) + ": '" + token +
-                       "' is not a number");
+        Fail(path,
+             "line " + std::to_string(line_number) + ": '" + token +
+                 "' is not a number");
       }
     }
     if (values.size() < 3) {
-      Fail(path, "line " + std::to_string(line_number) +
-                     " has fewer than 3 values");
+      Fail(path,
+           "line " + std::to_string(line_number) + " has fewer than 3 values");
     }
     if (!builder) builder = values.size() >= 4 ? &with_i : &without_i;
     builder->Add(Eigen::Vector3d(values[0], values[1], values[2]),
-                 Eigen::Vector3d::Zero(), Color3ub(0, 0, 0),
+                 Eigen::Vector3d::Zero(),
+                 Color3ub(0, 0, 0),
                  values.size() >= 4 ? static_cast<float>(values[3]) : 0.f);
   }
   return (builder ? builder : &without_i)->Finish(path, stats);
@@ -421,7 +432,8 @@ void WritePcdBinary(std::ostream& out, const PointCloud& cloud) {
     add("normal_z", "F");
   }
   if (cloud.HasColors()) add("rgb", "F");
-  out << "# .PCD v0.7 - Point Cloud Data file format (written by colmap-lidar)\n"
+  out << "# .PCD v0.7 - Point Cloud Data file format (written by "
+         "colmap-lidar)\n"
       << "VERSION 0.7\nFIELDS " << fields << "\nSIZE " << sizes << "\nTYPE "
       << types << "\nCOUNT " << counts << "\nWIDTH " << cloud.Size()
       << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << cloud.Size()
@@ -488,7 +500,8 @@ PointCloud ReadPointCloud(const std::string& path, CloudReadStats* stats) {
   if (ext == ".ply") return ReadPly(path, stats);
   if (ext == ".bin") return ReadKittiBin(path, stats);
   if (ext == ".xyz" || ext == ".txt") return ReadXyzText(path, stats);
-  Fail(path, "unknown extension '" + ext + "' (expected .pcd .ply .bin .xyz .txt)");
+  Fail(path,
+       "unknown extension '" + ext + "' (expected .pcd .ply .bin .xyz .txt)");
 }
 
 void WritePointCloud(const std::string& path, const PointCloud& cloud) {

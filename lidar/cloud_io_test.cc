@@ -1,13 +1,14 @@
 #include "lidar/cloud_io.h"
-#include "tests/testing/scoped_temp_dir.h"
 
-#include <filesystem>
-#include <fstream>
-#include <random>
+#include "tests/testing/scoped_temp_dir.h"
 
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
 
 namespace colmap_lidar {
 namespace {
@@ -62,7 +63,8 @@ TEST_F(CloudIoTest, PcdAndPlyRoundTripWithAllAttributes) {
     EXPECT_EQ(stats.num_dropped_non_finite, 0u);
     double max_error = 0;
     for (size_t i = 0; i < cloud.Size(); ++i) {
-      max_error = std::max(max_error, (read.points[i] - cloud.points[i]).norm());
+      max_error =
+          std::max(max_error, (read.points[i] - cloud.points[i]).norm());
       EXPECT_EQ(read.colors[i], cloud.colors[i]);
       EXPECT_FLOAT_EQ(read.intensities[i], cloud.intensities[i]);
       EXPECT_NEAR((read.normals[i] - cloud.normals[i]).norm(), 0, 1e-6);
@@ -77,19 +79,23 @@ TEST_F(CloudIoTest, ReadsEveryPcdEncodingWrittenByPcl) {
   pcl::PointCloud<pcl::PointXYZI> cloud;
   for (int i = 0; i < 300; ++i) {
     pcl::PointXYZI p;
-    p.x = 0.1f * i, p.y = -0.2f * i, p.z = 3.0f, p.intensity = static_cast<float>(i % 7);
+    p.x = 0.1f * i, p.y = -0.2f * i, p.z = 3.0f,
+    p.intensity = static_cast<float>(i % 7);
     cloud.push_back(p);
   }
-  cloud[5].x = std::nanf("");  // one NaN point inside a good file: dropped and counted
+  cloud[5].x =
+      std::nanf("");  // one NaN point inside a good file: dropped and counted
   ASSERT_EQ(pcl::io::savePCDFileASCII(Path("ascii.pcd"), cloud), 0);
   ASSERT_EQ(pcl::io::savePCDFileBinary(Path("binary.pcd"), cloud), 0);
-  ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(Path("compressed.pcd"), cloud), 0);
+  ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(Path("compressed.pcd"), cloud),
+            0);
   for (const char* name : {"ascii.pcd", "binary.pcd", "compressed.pcd"}) {
     CloudReadStats stats;
     const PointCloud read = ReadPointCloud(Path(name), &stats);
     ASSERT_EQ(read.Size(), 299u) << name;
     EXPECT_EQ(stats.num_dropped_non_finite, 1u) << name;
-    EXPECT_NEAR(read.points[10].x(), 1.1, 1e-5) << name;  // index 10 is point 11 after the NaN
+    EXPECT_NEAR(read.points[10].x(), 1.1, 1e-5)
+        << name;  // index 10 is point 11 after the NaN
     EXPECT_FLOAT_EQ(read.intensities[10], 11 % 7) << name;
   }
 }
@@ -132,7 +138,8 @@ TEST_F(CloudIoTest, RejectsBadFilesWithTheFileNamed) {
   for (const char* name : {"cut.ply", "cut.pcd"}) {
     WritePointCloud(Path(name), cloud);
     fs::resize_file(Path(name), fs::file_size(Path(name)) - 100);
-    ExpectReadError(Path(name), std::string(name) == "cut.ply" ? "truncated" : "PCD");
+    ExpectReadError(Path(name),
+                    std::string(name) == "cut.ply" ? "truncated" : "PCD");
   }
 
   std::ofstream(Path("cut.bin"), std::ios::binary) << "0123456789";

@@ -66,7 +66,9 @@ void KdTree3::RadiusSearch(const Eigen::Vector3d& query,
                            double radius,
                            std::vector<size_t>* indices) const {
   std::vector<std::pair<size_t, double>> matches;
-  impl_->index.radiusSearch(query.data(), radius * radius, matches,
+  impl_->index.radiusSearch(query.data(),
+                            radius * radius,
+                            matches,
                             nanoflann::SearchParams(32, 0, false));
   indices->resize(matches.size());
   for (size_t i = 0; i < matches.size(); ++i) (*indices)[i] = matches[i].first;

@@ -8,6 +8,7 @@
 #include "lidar/station_cloud.h"
 
 #include <Eigen/Geometry>
+
 #include <functional>
 #include <string>
 #include <vector>
@@ -17,9 +18,12 @@ namespace colmap_lidar {
 struct LidarEdge {
   size_t target = 0;  // i
   size_t source = 0;  // j
-  Eigen::Isometry3d target_from_source = Eigen::Isometry3d::Identity();  // lidar_i_from_lidar_j
+  Eigen::Isometry3d target_from_source =
+      Eigen::Isometry3d::Identity();  // lidar_i_from_lidar_j
   PairRegistration registration;
-  double Weight() const { return registration.num_inliers * registration.overlap; }
+  double Weight() const {
+    return registration.num_inliers * registration.overlap;
+  }
 };
 
 struct LidarGraphOptions {
@@ -33,10 +37,12 @@ struct LidarGraphOptions {
 };
 
 struct LidarGraph {
-  std::vector<LidarEdge> edges;           // accepted
-  std::vector<LidarEdge> refused;         // attempted, not accepted (registration.reason says why)
+  std::vector<LidarEdge> edges;  // accepted
+  std::vector<LidarEdge>
+      refused;  // attempted, not accepted (registration.reason says why)
   std::vector<Eigen::Isometry3d> world_from_lidar;  // per station
-  std::vector<int> component;             // per station, 0-based; component 0 holds station 0
+  std::vector<int>
+      component;  // per station, 0-based; component 0 holds station 0
   int num_components = 0;
   double refinement_initial_cost = 0, refinement_final_cost = 0;
 };

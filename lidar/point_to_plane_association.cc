@@ -9,7 +9,9 @@ namespace colmap_lidar {
 
 bool AssociationOptions::Check() const {
   if (num_samples == 0 || !(max_distance > 0) || !(max_curvature > 0)) {
-    throw std::invalid_argument("AssociationOptions: num_samples, max_distance and max_curvature must be > 0");
+    throw std::invalid_argument(
+        "AssociationOptions: num_samples, max_distance and max_curvature must "
+        "be > 0");
   }
   return true;
 }
@@ -22,12 +24,15 @@ std::vector<PointToPlaneObservation> AssociatePointToPlane(
     const AssociationOptions& options,
     const std::vector<double>* target_curvature) {
   options.Check();
-  if (!target.HasNormals()) throw std::invalid_argument("AssociatePointToPlane: target needs normals");
+  if (!target.HasNormals())
+    throw std::invalid_argument("AssociatePointToPlane: target needs normals");
   if (target_tree.Size() != target.Size()) {
-    throw std::invalid_argument("AssociatePointToPlane: the k-d tree is not built over the target");
+    throw std::invalid_argument(
+        "AssociatePointToPlane: the k-d tree is not built over the target");
   }
   if (target_curvature && target_curvature->size() != target.Size()) {
-    throw std::invalid_argument("AssociatePointToPlane: one curvature per target point expected");
+    throw std::invalid_argument(
+        "AssociatePointToPlane: one curvature per target point expected");
   }
   // A seeded partial Fisher-Yates shuffle: the first num_samples of a random permutation.
   std::vector<size_t> order(source.Size());
@@ -45,12 +50,14 @@ std::vector<PointToPlaneObservation> AssociatePointToPlane(
     const Eigen::Vector3d& p = source.points[order[k]];
     size_t index;
     double squared;
-    if (!target_tree.Nearest(target_from_source * p, &index, &squared) || squared > max_squared) {
+    if (!target_tree.Nearest(target_from_source * p, &index, &squared) ||
+        squared > max_squared) {
       continue;
     }
     const Eigen::Vector3d& n = target.normals[index];
     if (n.squaredNorm() < 0.5) continue;
-    if (target_curvature && (*target_curvature)[index] > options.max_curvature) continue;
+    if (target_curvature && (*target_curvature)[index] > options.max_curvature)
+      continue;
     observations.push_back({p, target.points[index], n});
   }
   return observations;

@@ -7,6 +7,7 @@
 #include "lidar/point_cloud.h"
 
 #include <Eigen/Geometry>
+
 #include <cstdint>
 #include <vector>
 
@@ -14,15 +15,16 @@ namespace colmap_lidar {
 
 // One observation of the seed's LiDAR residual: E_l = n^T (target_from_source * p - q) / sigma_l.
 struct PointToPlaneObservation {
-  Eigen::Vector3d point_in_source;  // p
-  Eigen::Vector3d point_in_target;  // q
-  Eigen::Vector3d normal_in_target; // n, unit
+  Eigen::Vector3d point_in_source;   // p
+  Eigen::Vector3d point_in_target;   // q
+  Eigen::Vector3d normal_in_target;  // n, unit
 };
 
 struct AssociationOptions {
-  size_t num_samples = 2000;   // source points drawn (without replacement)
-  double max_distance = 0.1;   // gate on |T p - q| [m]
-  double max_curvature = 0.05; // only planar target neighbourhoods (if curvature is given)
+  size_t num_samples = 2000;  // source points drawn (without replacement)
+  double max_distance = 0.1;  // gate on |T p - q| [m]
+  double max_curvature =
+      0.05;  // only planar target neighbourhoods (if curvature is given)
   uint64_t seed = 0;
 
   bool Check() const;  // throws std::invalid_argument

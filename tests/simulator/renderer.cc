@@ -1,6 +1,7 @@
 #include "tests/simulator/renderer.h"
 
 #include <Eigen/Geometry>
+
 #include <cmath>
 #include <random>
 
@@ -28,14 +29,16 @@ cv::Mat RenderImage(const Scene& scene,
       const Eigen::Vector2d ray_in_cam =
           camera.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5));
       const Eigen::Vector3d ray = ray_in_cam.homogeneous();
-      const Eigen::Vector3d direction = (world_from_cam_rotation * ray).normalized();
+      const Eigen::Vector3d direction =
+          (world_from_cam_rotation * ray).normalized();
       RayHit hit;
       double value = 0;  // sky: black
       float z = 0;
       if (scene.Intersect(origin, direction, 1e3, &hit)) {
         const Eigen::Vector3d point = origin + hit.t * direction;
         value = scene.Shade(point, hit.normal, hit.primitive);
-        z = static_cast<float>(hit.t / ray.norm());  // z-depth along the optical axis
+        z = static_cast<float>(hit.t /
+                               ray.norm());  // z-depth along the optical axis
       }
       if (options.vignetting) {
         value *= std::pow(1.0 / ray.norm(), 4);
@@ -55,8 +58,8 @@ PointCloud ScanLidar(const Scene& scene,
   constexpr int kNumBeams = 16;
   // Azimuth samples per revolution (1800 = 0.2 deg at full density) and motor positions over 180 deg.
   const double per_beam = static_cast<double>(options.num_points) / kNumBeams;
-  const int num_azimuths =
-      std::clamp(static_cast<int>(std::lround(std::sqrt(per_beam * 20))), 60, 1800);
+  const int num_azimuths = std::clamp(
+      static_cast<int>(std::lround(std::sqrt(per_beam * 20))), 60, 1800);
   const int num_motor_steps =
       std::max(2, static_cast<int>(std::ceil(per_beam / num_azimuths)));
   const Eigen::Matrix3d world_from_lidar_rotation =
@@ -76,14 +79,18 @@ PointCloud ScanLidar(const Scene& scene,
       const double azimuth = 2 * M_PI * (a + 0.37 * m) / num_azimuths;
       for (int b = 0; b < kNumBeams; ++b) {
         const double elevation = (-15.0 + 2.0 * b) * M_PI / 180.0;
-        const Eigen::Vector3d ray_in_head(std::cos(elevation) * std::cos(azimuth),
-                                          std::cos(elevation) * std::sin(azimuth),
-                                          std::sin(elevation));
+        const Eigen::Vector3d ray_in_head(
+            std::cos(elevation) * std::cos(azimuth),
+            std::cos(elevation) * std::sin(azimuth),
+            std::sin(elevation));
         const Eigen::Vector3d ray_in_lidar = lidar_from_head * ray_in_head;
-        const Eigen::Vector3d ray_in_world = world_from_lidar_rotation * ray_in_lidar;
+        const Eigen::Vector3d ray_in_world =
+            world_from_lidar_rotation * ray_in_lidar;
         RayHit hit;
-        if (!scene.Intersect(world_from_lidar.translation, ray_in_world,
-                             options.max_range_m, &hit)) {
+        if (!scene.Intersect(world_from_lidar.translation,
+                             ray_in_world,
+                             options.max_range_m,
+                             &hit)) {
           continue;
         }
         double range = hit.t;
@@ -91,11 +98,14 @@ PointCloud ScanLidar(const Scene& scene,
           // A second ray 0.17 deg away stands in for the beam's footprint: across a depth edge the
           // sensor reports the average of both returns ("mixed pixels") about a third of the time.
           const Eigen::Vector3d offset_ray =
-              (ray_in_world + 0.003 * ray_in_world.cross(Eigen::Vector3d::UnitZ()))
+              (ray_in_world +
+               0.003 * ray_in_world.cross(Eigen::Vector3d::UnitZ()))
                   .normalized();
           RayHit other;
-          if (scene.Intersect(world_from_lidar.translation, offset_ray,
-                              options.max_range_m, &other) &&
+          if (scene.Intersect(world_from_lidar.translation,
+                              offset_ray,
+                              options.max_range_m,
+                              &other) &&
               std::abs(other.t - hit.t) > 0.1 && unit(rng) < 0.35) {
             range = 0.5 * (hit.t + other.t);
           }
@@ -106,7 +116,8 @@ PointCloud ScanLidar(const Scene& scene,
         if (options.range_noise_m > 0) range += noise(rng);
         cloud.points.push_back(range * ray_in_lidar);
         cloud.intensities.push_back(static_cast<float>(
-            255.0 * scene.Albedo(point_in_world, hit.primitive) * cos_incidence));
+            255.0 * scene.Albedo(point_in_world, hit.primitive) *
+            cos_incidence));
       }
     }
   }
@@ -115,8 +126,10 @@ PointCloud ScanLidar(const Scene& scene,
   for (const PointCloud& part : per_step) total += part.Size();
   cloud.Reserve(total, false, false, true);
   for (PointCloud& part : per_step) {
-    cloud.points.insert(cloud.points.end(), part.points.begin(), part.points.end());
-    cloud.intensities.insert(cloud.intensities.end(), part.intensities.begin(),
+    cloud.points.insert(
+        cloud.points.end(), part.points.begin(), part.points.end());
+    cloud.intensities.insert(cloud.intensities.end(),
+                             part.intensities.begin(),
                              part.intensities.end());
   }
   return cloud;

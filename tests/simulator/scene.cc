@@ -1,6 +1,7 @@
 #include "tests/simulator/scene.h"
 
 #include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -30,7 +31,8 @@ double ValueNoise(const Eigen::Vector3d& p, uint32_t seed) {
   const Eigen::Vector3d f = p.array().floor();
   const Eigen::Vector3d r = p - f;
   const Eigen::Vector3d s = r.array() * r.array() * (3.0 - 2.0 * r.array());
-  const int64_t x = static_cast<int64_t>(f.x()), y = static_cast<int64_t>(f.y()),
+  const int64_t x = static_cast<int64_t>(f.x()),
+                y = static_cast<int64_t>(f.y()),
                 z = static_cast<int64_t>(f.z());
   double value = 0;
   for (int dz = 0; dz < 2; ++dz) {
@@ -110,7 +112,8 @@ bool IntersectCylinder(const Primitive& cyl,
       for (const double t : {(-b - sq) / a, (-b + sq) / a}) {
         if (t > 1e-6 && t < best && std::abs(o.z() + t * dir.z()) <= h) {
           best = t;
-          best_normal = Eigen::Vector3d(o.x() + t * dir.x(), o.y() + t * dir.y(), 0) / r;
+          best_normal =
+              Eigen::Vector3d(o.x() + t * dir.x(), o.y() + t * dir.y(), 0) / r;
         }
       }
     }
@@ -294,15 +297,16 @@ double Scene::Shade(const Eigen::Vector3d& point,
                     const Eigen::Vector3d& normal,
                     int primitive) const {
   const double diffuse = std::max(0.0, normal.dot(sun_direction_));
-  return std::clamp(255.0 * Albedo(point, primitive) * (0.45 + 0.6 * diffuse),
-                    0.0, 255.0);
+  return std::clamp(
+      255.0 * Albedo(point, primitive) * (0.45 + 0.6 * diffuse), 0.0, 255.0);
 }
 
 bool Scene::InsideObject(const Eigen::Vector3d& point, double tolerance) const {
   for (const Primitive& p : primitives_) {
     if (!p.is_object) continue;
     if (p.type == Primitive::Type::kBox) {
-      const Eigen::Vector3d local = RotZ(p.yaw).transpose() * (point - p.center);
+      const Eigen::Vector3d local =
+          RotZ(p.yaw).transpose() * (point - p.center);
       if ((local.cwiseAbs() - p.half_size).maxCoeff() <= tolerance) return true;
     } else if (p.type == Primitive::Type::kCylinder) {
       const Eigen::Vector3d d = point - p.center;
@@ -317,7 +321,8 @@ bool Scene::InsideObject(const Eigen::Vector3d& point, double tolerance) const {
 
 PointCloud Scene::SampleObjectSurface(double spacing) const {
   PointCloud cloud;
-  auto keep = [&](const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+  auto keep = [&](const Eigen::Vector3d& point,
+                  const Eigen::Vector3d& normal,
                   size_t self) {
     if (point.z() < 1e-4) return;  // resting on the ground
     // Drop samples on or inside another object primitive (hidden faces of a union).
@@ -337,8 +342,10 @@ PointCloud Scene::SampleObjectSurface(double spacing) const {
       const Eigen::Matrix3d R = RotZ(p.yaw);
       for (int axis = 0; axis < 3; ++axis) {
         const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-        const int nu = std::max(1, static_cast<int>(std::ceil(2 * p.half_size[u] / spacing)));
-        const int nv = std::max(1, static_cast<int>(std::ceil(2 * p.half_size[v] / spacing)));
+        const int nu = std::max(
+            1, static_cast<int>(std::ceil(2 * p.half_size[u] / spacing)));
+        const int nv = std::max(
+            1, static_cast<int>(std::ceil(2 * p.half_size[v] / spacing)));
         for (const double side : {-1.0, 1.0}) {
           Eigen::Vector3d n = Eigen::Vector3d::Zero();
           n[axis] = side;
@@ -361,7 +368,10 @@ PointCloud Scene::SampleObjectSurface(double spacing) const {
         const double theta = 2 * M_PI * (a + 0.5) / n_theta;
         const Eigen::Vector3d n(std::cos(theta), std::sin(theta), 0);
         for (int b = 0; b < n_z; ++b) {
-          keep(p.center + r * n + Eigen::Vector3d(0, 0, -h + (b + 0.5) * 2 * h / n_z), n, i);
+          keep(p.center + r * n +
+                   Eigen::Vector3d(0, 0, -h + (b + 0.5) * 2 * h / n_z),
+               n,
+               i);
         }
       }
       const int n_cap = static_cast<int>(std::ceil(2 * r / spacing));
@@ -372,7 +382,8 @@ PointCloud Scene::SampleObjectSurface(double spacing) const {
                                      -r + (b + 0.5) * 2 * r / n_cap);
             if (xy.norm() > r) continue;
             keep(p.center + Eigen::Vector3d(xy.x(), xy.y(), side * h),
-                 Eigen::Vector3d(0, 0, side), i);
+                 Eigen::Vector3d(0, 0, side),
+                 i);
           }
         }
       }

@@ -6,6 +6,7 @@
 #include "lidar/point_cloud.h"
 
 #include <Eigen/Core>
+
 #include <string>
 #include <vector>
 
@@ -16,10 +17,12 @@ struct Primitive {
   enum class Type { kBox, kCylinder, kGround };
   Type type = Type::kBox;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // box/cylinder centre
-  Eigen::Vector3d half_size = Eigen::Vector3d::Ones();  // box half extents; cylinder: (r, r, h/2)
-  double yaw = 0;          // box rotation about world z [rad]
-  bool is_object = false;  // part of the scanned structure (sampled into surface.ply)
-  double albedo = 0.6;     // mean albedo in [0, 1]
+  Eigen::Vector3d half_size =
+      Eigen::Vector3d::Ones();  // box half extents; cylinder: (r, r, h/2)
+  double yaw = 0;               // box rotation about world z [rad]
+  bool is_object =
+      false;  // part of the scanned structure (sampled into surface.ply)
+  double albedo = 0.6;  // mean albedo in [0, 1]
   double texture_contrast = 0.45;
 };
 
@@ -81,7 +84,8 @@ class Scene {
   Eigen::Vector3d object_center_ = Eigen::Vector3d::Zero();
   double object_radius_ = 1;
   double object_height_ = 1;
-  Eigen::Vector3d sun_direction_ = Eigen::Vector3d(0.4, -0.3, 0.866).normalized();
+  Eigen::Vector3d sun_direction_ =
+      Eigen::Vector3d(0.4, -0.3, 0.866).normalized();
 };
 
 }  // namespace sim

@@ -15,11 +15,12 @@ namespace colmap_lidar {
 namespace sim {
 
 enum class Motion {
-  kTwoAxes,        // tripod rotations about the vertical, the last stations tilted about a second axis
-  kOneAxis,        // every relative rotation about the vertical axis: T_e translation along it unobservable
+  kTwoAxes,  // tripod rotations about the vertical, the last stations tilted about a second axis
+  kOneAxis,  // every relative rotation about the vertical axis: T_e translation along it unobservable
   kFixedRotation,  // pure translations: T_e translation unobservable
 };
-Motion MotionFromName(const std::string& name);  // "two_axes", "one_axis", "fixed_rotation"
+Motion MotionFromName(
+    const std::string& name);  // "two_axes", "one_axis", "fixed_rotation"
 
 // Left and right PINHOLE cameras of width 1028*image_scale with a 48 deg horizontal FOV, 0.38 m baseline.
 StationRig MakeStereoRig(double image_scale);

@@ -14,21 +14,26 @@ int RunSimulateDataset(int argc, char** argv) {
   int lidar_points = static_cast<int>(options.lidar_points);
   colmap::OptionManager manager;
   manager.AddRequiredOption("output_path", &options.output_path);
-  manager.AddDefaultOption("scene", &options.scene,
-                           "t_specimen | square_pillar | cylinder_pillar | bridge_pier");
+  manager.AddDefaultOption(
+      "scene",
+      &options.scene,
+      "t_specimen | square_pillar | cylinder_pillar | bridge_pier");
   manager.AddDefaultOption("num_stations", &options.num_stations);
-  manager.AddDefaultOption("motion", &options.motion,
-                           "two_axes | one_axis | fixed_rotation");
-  manager.AddDefaultOption("image_scale", &options.image_scale,
+  manager.AddDefaultOption(
+      "motion", &options.motion, "two_axes | one_axis | fixed_rotation");
+  manager.AddDefaultOption("image_scale",
+                           &options.image_scale,
                            "1 = 1028x752 per camera, 4 = 4112x3008");
-  manager.AddDefaultOption("lidar_points", &lidar_points, "LiDAR rays per station");
+  manager.AddDefaultOption(
+      "lidar_points", &lidar_points, "LiDAR rays per station");
   manager.AddDefaultOption("range_noise_m", &options.range_noise_m);
   manager.AddDefaultOption("pixel_noise", &options.pixel_noise, "grey levels");
   manager.AddDefaultOption("vignetting", &options.vignetting);
   manager.AddDefaultOption("mixed_edge_points", &options.mixed_edge_points);
   manager.AddDefaultOption("guess_rotation_deg", &options.guess_rotation_deg);
   manager.AddDefaultOption("guess_translation_m", &options.guess_translation_m);
-  manager.AddDefaultOption("write_guess", &options.write_guess,
+  manager.AddDefaultOption("write_guess",
+                           &options.write_guess,
                            "write cam_from_lidar_guess into rig.json");
   manager.AddDefaultOption("surface_spacing_m", &options.surface_spacing_m);
   manager.AddDefaultOption("seed", &seed);

@@ -1,10 +1,11 @@
 // Runs a shell command for integration tests and captures its exit code and combined output.
 #pragma once
 
+#include <sys/wait.h>
+
 #include <array>
 #include <cstdio>
 #include <string>
-#include <sys/wait.h>
 
 namespace colmap_lidar {
 namespace testing {
