@@ -160,10 +160,15 @@ int Main(int argc, char** argv) {
        {std::pair<std::string, Tally>{"BSC + RANSAC + ICP (ours)", bsc},
         {"PCL FPFH + SampleConsensusPrerejective + same ICP", pcl_tally}}) {
     std::cout << "| " << name << " | " << t.success << " / " << t.attempted
-              << " | " << (t.success ? t.sum_deg / t.success : 0) << " / "
-              << t.max_deg << " | " << std::setprecision(2)
-              << (t.success ? t.sum_mm / t.success : 0) << " / " << t.max_mm
-              << " | " << std::setprecision(1) << t.seconds << " |"
+              << " | ";
+    if (t.success == 0) {
+      std::cout << "n/a | n/a";  // no registered pair to measure
+    } else {
+      std::cout << t.sum_deg / t.success << " / " << t.max_deg << " | "
+                << std::setprecision(2) << t.sum_mm / t.success << " / "
+                << t.max_mm;
+    }
+    std::cout << " | " << std::setprecision(1) << t.seconds << " |"
               << std::setprecision(3) << "\n";
   }
   return 0;
