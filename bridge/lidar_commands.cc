@@ -92,7 +92,7 @@ int RunLidarRegistrator(int argc, char** argv) {
               << " after voxel " << cloud_options.voxel_size << " m, "
               << stations.back()->features.size() << " BSC features ["
               << std::fixed << std::setprecision(1) << seconds() << " s]"
-              << std::endl;
+              << std::defaultfloat << std::setprecision(6) << std::endl;
   }
   std::vector<const StationCloud*> pointers;
   for (const auto& s : stations) pointers.push_back(s.get());
@@ -101,7 +101,8 @@ int RunLidarRegistrator(int argc, char** argv) {
         if (done % 10 == 0 || done == total) {
           std::cout << "lidar_registrator: registered " << done << "/" << total
                     << " pairs [" << std::fixed << std::setprecision(1)
-                    << seconds() << " s]" << std::defaultfloat << std::endl;
+                    << seconds() << " s]" << std::defaultfloat
+                    << std::setprecision(6) << std::endl;
         }
       });
 

@@ -24,7 +24,11 @@ rm -f "$kWorkspace/database.db"
 $cli database_creator --database_path "$kWorkspace/database.db"
 $cli database_info --database_path "$kWorkspace/database.db"
 
-echo "== 3. the evaluators on the ground truth (the references every result is measured against)"
+echo "== 3. LiDAR registration and pose graph (BSC + RANSAC + ICP; each station with its 4 most similar)"
+$cli lidar_registrator --lidar_path "$kWorkspace/dataset/lidar" --output_path "$kWorkspace/lidar" \
+  --max_neighbors 4
+
+echo "== 4. the evaluator on the ground truth (the reference every model is measured against)"
 $cli evaluate_model --model_path "$kWorkspace/dataset/ground_truth/surface.ply" \
   --ground_truth_path "$kWorkspace/dataset/ground_truth/surface.ply" --output_path "$kWorkspace/eval_truth"
 
@@ -33,6 +37,7 @@ cat <<MSG
 == Summary ($((SECONDS - start)) s)
   dataset          $kWorkspace/dataset (25 stations; images, LiDAR clouds, ground truth)
   database         $kWorkspace/database.db (COLMAP's tables + depth_priors, lidar_frames, rig)
-  not yet built    import_dataset, stereo_depth, depth_prior_extractor, lidar_registrator,
-                   pose_initializer, joint_adjuster, densifier, pipeline (issues 4-8)
+  LiDAR graph      $kWorkspace/lidar/{pairs.txt, lidar_poses.txt, summary.txt}
+  not yet built    import_dataset, stereo_depth, depth_prior_extractor, pose_initializer,
+                   joint_adjuster, densifier, pipeline (issues 5-8)
 MSG
