@@ -26,6 +26,24 @@ std::string MillimetreLabel(double threshold_m) {
   return label.str() + "mm";
 }
 
+// "0.002,0.005,0.01" -> metres. Every token must be a positive number in full ("2mm" is rejected,
+// not read as 2 m); an empty result means the option was malformed.
+std::vector<double> ParseThresholds(const std::string& csv) {
+  std::vector<double> thresholds;
+  for (const std::string& token : colmap::CSVToVector<std::string>(csv)) {
+    size_t used = 0;
+    double value = 0;
+    try {
+      value = std::stod(token, &used);
+    } catch (const std::exception&) {
+      return {};
+    }
+    if (used != token.size() || !(value > 0)) return {};
+    thresholds.push_back(value);
+  }
+  return thresholds;
+}
+
 }  // namespace
 
 int RunEvaluateModel(int argc, char** argv) {
@@ -45,11 +63,12 @@ int RunEvaluateModel(int argc, char** argv) {
   manager.AddDefaultOption(
       "thresholds_m", &thresholds, "comma-separated, metres");
   manager.Parse(argc, argv);
-  options.thresholds_m.clear();
-  options.thresholds_m = colmap::CSVToVector<double>(thresholds);
-  THROW_CHECK(!options.thresholds_m.empty()) << "--thresholds_m is empty";
-  fs::create_directories(output_path);
+  options.thresholds_m = ParseThresholds(thresholds);
+  THROW_CHECK(!options.thresholds_m.empty())
+      << "--thresholds_m must be comma-separated numbers in metres, not '"
+      << thresholds << "'";
 
+  // Inputs first: a missing or bad cloud must not leave an output folder behind.
   const PointCloud model = ReadPointCloud(model_path);
   const PointCloud truth = ReadPointCloud(ground_truth_path);
   THROW_CHECK(truth.HasNormals()) << ground_truth_path << " has no normals";
@@ -57,6 +76,7 @@ int RunEvaluateModel(int argc, char** argv) {
             << truth.Size() << " surface samples" << std::endl;
   const ModelEvaluation result = EvaluateModel(model, truth, options);
 
+  fs::create_directories(output_path);
   nlohmann::json metrics;
   metrics["model_path"] = model_path;
   metrics["num_model_points"] = result.num_model_points;

@@ -292,6 +292,11 @@ std::map<std::string, colmap::Rigid3d> ReadNamedPoses(const std::string& path) {
     std::istringstream tokens(line);
     std::string name;
     tokens >> name;
+    if (poses.count(name)) {
+      Fail(path,
+           "line " + std::to_string(line_number) + ": station '" + name +
+               "' appears twice");
+    }
     poses[name] = ParsePose(tokens, path, line_number);
   }
   return poses;

@@ -154,6 +154,9 @@ TEST_F(StationDatasetTest, PoseFilesRoundTripWithWFirst) {
 
   std::ofstream(dir_.File("bad.txt")) << "000 1 0 0\n";
   EXPECT_THROW(ReadNamedPoses(dir_.File("bad.txt")), std::runtime_error);
+  std::ofstream(dir_.File("twice.txt"))
+      << "000 1 0 0 0 0 0 0\n000 1 0 0 0 1 1 1\n";
+  EXPECT_THROW(ReadNamedPoses(dir_.File("twice.txt")), std::runtime_error);
 }
 
 }  // namespace

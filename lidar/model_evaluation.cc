@@ -10,14 +10,11 @@
 #include <stdexcept>
 
 namespace colmap_lidar {
-namespace {
 
-// Distance to the true surface: point-to-plane to the best of the nearest samples where the point lies
-// over the sampled surface, point-to-point beyond its border.
-double SurfaceDistance(const PointCloud& truth,
-                       const KdTree3& tree,
-                       double spacing,
-                       const Eigen::Vector3d& point) {
+double DistanceToSampledSurface(const PointCloud& truth,
+                                const KdTree3& tree,
+                                double spacing,
+                                const Eigen::Vector3d& point) {
   std::vector<size_t> indices;
   std::vector<double> squared;
   tree.KNearest(point, 8, &indices, &squared);
@@ -35,6 +32,8 @@ double SurfaceDistance(const PointCloud& truth,
   }
   return best;
 }
+
+namespace {
 
 double Percentile(std::vector<double> values, double q) {
   if (values.empty()) return 0;
@@ -109,7 +108,7 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
   // After alignment, evaluate all model points within the crop distance.
   for (size_t i = 0; i < model.Size(); ++i) {
     const Eigen::Vector3d p = result.truth_from_model * model.points[i];
-    const double d = SurfaceDistance(truth, truth_tree, spacing, p);
+    const double d = DistanceToSampledSurface(truth, truth_tree, spacing, p);
     if (d <= options.crop_distance_m) {
       result.distances.push_back(d);
       result.evaluated_indices.push_back(i);
@@ -133,19 +132,22 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
   result.max =
       *std::max_element(result.distances.begin(), result.distances.end());
 
+  // Completeness: distance from each truth sample to the nearest model point, queried once.
   const KdTree3 model_tree(moved);
+  std::vector<double> truth_to_model(truth.Size());
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < truth.Size(); ++i) {
+    size_t index;
+    double squared;
+    model_tree.Nearest(truth.points[i], &index, &squared);
+    truth_to_model[i] = std::sqrt(squared);
+  }
   for (double threshold : options.thresholds_m) {
     ModelEvaluation::AtThreshold at;
     at.threshold = threshold;
     size_t precise = 0, complete = 0;
     for (double d : result.distances) precise += d <= threshold;
-    for (const Eigen::Vector3d& q : truth.points) {
-      size_t index;
-      double squared;
-      if (model_tree.Nearest(q, &index, &squared) &&
-          squared <= threshold * threshold)
-        ++complete;
-    }
+    for (double d : truth_to_model) complete += d <= threshold;
     at.precision = static_cast<double>(precise) / result.distances.size();
     at.completeness = static_cast<double>(complete) / truth.Size();
     at.f_score = at.precision + at.completeness > 0

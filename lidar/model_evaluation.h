@@ -3,6 +3,7 @@
 // per-point distances to the true surface.
 #pragma once
 
+#include "lidar/kd_tree.h"
 #include "lidar/point_cloud.h"
 
 #include <Eigen/Geometry>
@@ -44,6 +45,14 @@ struct ModelEvaluation {
   // threshold of the model, each standing for spacing^2).
   double density_points_per_cm2 = 0;
 };
+
+// Distance of `point` to a surface given by samples with normals on a grid of `spacing` (`tree` over
+// truth.points): point-to-plane to the best of the 8 nearest samples whose footprint (tangential
+// offset <= spacing) contains the point, point-to-point to the nearest sample beyond the border.
+double DistanceToSampledSurface(const PointCloud& truth,
+                                const KdTree3& tree,
+                                double spacing,
+                                const Eigen::Vector3d& point);
 
 // `truth` must have normals. Throws std::invalid_argument on empty input or missing normals.
 ModelEvaluation EvaluateModel(const PointCloud& model,

@@ -64,6 +64,21 @@ TEST_F(EvaluatorCliTest, EvaluateModelMeasuresTruthAndAKnownOffset) {
   EXPECT_NEAR(metrics["mean_m"].get<double>(), 0.004, 2e-4);
   EXPECT_NEAR(metrics["median_m"].get<double>(), 0.004, 1e-5);
   EXPECT_LT(metrics["precision_2mm"].get<double>(), 0.02);
+
+  // Bad input: one clear error, non-zero exit, no output folder left behind.
+  result = RunCommand(kCli + " evaluate_model --model_path " +
+                      dir_.File("missing.ply") + " --ground_truth_path " +
+                      surface + " --output_path " + dir_.File("bad"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("missing.ply"), std::string::npos)
+      << result.output;
+  result = RunCommand(
+      kCli + " evaluate_model --thresholds_m 2mm --model_path " + surface +
+      " --ground_truth_path " + surface + " --output_path " + dir_.File("bad"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--thresholds_m"), std::string::npos)
+      << result.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_.File("bad")));
 }
 
 TEST_F(EvaluatorCliTest, EvaluateCalibrationMeasuresTruthAndTheGuess) {

@@ -3,6 +3,7 @@
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
 #include "lidar/kd_tree.h"
+#include "lidar/model_evaluation.h"
 #include "tests/simulator/scene.h"
 #include "tests/simulator/simulate_dataset.h"
 #include "tests/testing/scoped_temp_dir.h"
@@ -56,30 +57,13 @@ sim::SimulationOptions NoiseFreeOptions(const std::string& scene,
   return options;
 }
 
-// Min over the k nearest surface samples of the point-to-plane distance: exact on faces and at edges.
-double DistanceToSurface(const PointCloud& surface,
-                         const KdTree3& tree,
-                         const Eigen::Vector3d& point) {
-  std::vector<size_t> indices;
-  std::vector<double> squared;
-  tree.KNearest(point, 8, &indices, &squared);
-  double best = 1e9;
-  for (size_t k = 0; k < indices.size(); ++k) {
-    if (squared[k] > 0.03 * 0.03) continue;
-    best = std::min(best,
-                    std::abs(surface.normals[indices[k]].dot(
-                        point - surface.points[indices[k]])));
-  }
-  return best;
-}
-
 class SimulatorSceneTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(SimulatorSceneTest, LidarPointsLandOnTheTrueSurface) {
   testing::ScopedTempDir dir;
   const std::string root = dir.File("dataset");
-  const sim::SimulationResult result =
-      sim::SimulateDataset(NoiseFreeOptions(GetParam(), root));
+  const sim::SimulationOptions options = NoiseFreeOptions(GetParam(), root);
+  const sim::SimulationResult result = sim::SimulateDataset(options);
   EXPECT_EQ(result.num_stations, 3);
   const StationDataset dataset = ReadStationDataset(root);
   ASSERT_EQ(dataset.stations.size(), 3u);
@@ -109,8 +93,10 @@ TEST_P(SimulatorSceneTest, LidarPointsLandOnTheTrueSurface) {
         continue;
       }
       ++num_on_object;
-      max_distance = std::max(max_distance,
-                              DistanceToSurface(surface, tree, point_in_world));
+      max_distance = std::max(
+          max_distance,
+          DistanceToSampledSurface(
+              surface, tree, options.surface_spacing_m, point_in_world));
     }
     EXPECT_GT(num_on_object, 200u) << "station " << i;
     // Float32 storage of the clouds (~1e-6 m) is the only error left with noise off: sub-mm.
