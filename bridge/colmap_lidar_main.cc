@@ -47,9 +47,24 @@ const std::vector<Command>& Commands() {
       {"simulate_dataset",
        &RunSimulateDataset,
        "Simulate a stereo + LiDAR station dataset with ground truth"},
+      {"import_dataset",
+       &RunImportDataset,
+       "Import a station dataset into a COLMAP database (camera, SIFT, "
+       "matches, rig, LiDAR frames)"},
+      {"stereo_depth",
+       &RunStereoDepth,
+       "SGM stereo depth maps per station in the left image grid"},
+      {"depth_prior_extractor",
+       &RunDepthPriorExtractor,
+       "Depth priors (d, sigma_d) of the database's keypoints from stereo "
+       "depth"},
       {"lidar_registrator",
        &RunLidarRegistrator,
        "Register all station clouds and build the LiDAR pose graph"},
+      {"joint_adjuster",
+       &RunJointAdjuster,
+       "Joint bundle adjustment: poses, landmarks and cam_from_lidar with "
+       "depth priors and LiDAR"},
       {"evaluate_model",
        &RunEvaluateModel,
        "Accuracy, completeness and density of a cloud against the true "

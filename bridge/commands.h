@@ -12,9 +12,23 @@ int RunDatabaseCreator(int argc, char** argv);
 // Prints what a database holds: COLMAP's images/keypoints/matches and our depth priors, LiDAR frames, rig.
 int RunDatabaseInfo(int argc, char** argv);
 
+// Imports a station dataset into a COLMAP database: camera from rig.json, COLMAP SIFT extraction and
+// exhaustive matching, our rig and lidar_frames rows (colmap_ext/dataset_import.h).
+int RunImportDataset(int argc, char** argv);
+
+// SGM stereo depth per station in the original left image grid (colmap_ext/stereo_depth.h).
+int RunStereoDepth(int argc, char** argv);
+
+// Depth priors of the database's keypoints from the stereo depth maps (colmap_ext/depth_prior_extractor.h).
+int RunDepthPriorExtractor(int argc, char** argv);
+
 // Registers all station clouds (BSC + RANSAC + ICP), builds the LiDAR pose graph A_l and writes
 // pairs.txt, lidar_poses.txt and summary.txt.
 int RunLidarRegistrator(int argc, char** argv);
+
+// The joint problem (reprojection + depth priors + LiDAR point-to-plane + cam_from_lidar) inside COLMAP's
+// bundle adjuster on a sparse model; writes the refined model, cam_from_lidar.txt, report.json, plots.
+int RunJointAdjuster(int argc, char** argv);
 
 // Accuracy of a cloud against ground_truth/surface.ply: distances, completeness, density, plots.
 int RunEvaluateModel(int argc, char** argv);

@@ -97,22 +97,31 @@ void ExtensionDatabase::CreateTables() {
 
 void ExtensionDatabase::WriteDepthPriors(
     colmap::image_t image_id, const std::vector<DepthPrior>& priors) {
+  WriteDepthPriors({{image_id, priors}});
+}
+
+void ExtensionDatabase::WriteDepthPriors(
+    const std::map<colmap::image_t, std::vector<DepthPrior>>&
+        priors_per_image) {
   SqliteTransaction transaction(connection_);
   SqliteStatement remove(connection_,
                          "DELETE FROM depth_priors WHERE image_id=?");
-  remove.BindInt64(1, image_id);
-  remove.Execute();
   SqliteStatement insert(
       connection_,
       "INSERT INTO depth_priors(image_id, point2D_idx, depth, sigma) "
       "VALUES(?, ?, ?, ?)");
-  for (const DepthPrior& prior : priors) {
-    insert.Reset();
-    insert.BindInt64(1, image_id);
-    insert.BindInt64(2, prior.point2D_idx);
-    insert.BindDouble(3, prior.depth);
-    insert.BindDouble(4, prior.sigma);
-    insert.Execute();
+  for (const auto& [image_id, priors] : priors_per_image) {
+    remove.Reset();
+    remove.BindInt64(1, image_id);
+    remove.Execute();
+    for (const DepthPrior& prior : priors) {
+      insert.Reset();
+      insert.BindInt64(1, image_id);
+      insert.BindInt64(2, prior.point2D_idx);
+      insert.BindDouble(3, prior.depth);
+      insert.BindDouble(4, prior.sigma);
+      insert.Execute();
+    }
   }
   transaction.Commit();
 }

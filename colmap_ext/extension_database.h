@@ -19,6 +19,7 @@
 #include "colmap/scene/camera.h"
 #include "colmap/util/types.h"
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -65,6 +66,10 @@ class ExtensionDatabase {
   // Depth priors. Write replaces all rows of the given image in one transaction.
   void WriteDepthPriors(colmap::image_t image_id,
                         const std::vector<DepthPrior>& priors);
+  // Several images in one transaction (all or nothing).
+  void WriteDepthPriors(
+      const std::map<colmap::image_t, std::vector<DepthPrior>>&
+          priors_per_image);
   std::vector<DepthPrior> ReadDepthPriors(colmap::image_t image_id) const;
   size_t NumDepthPriors() const;
   void ClearDepthPriors();

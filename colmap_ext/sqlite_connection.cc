@@ -2,8 +2,10 @@
 
 #include <sqlite3.h>
 
+#include <chrono>
 #include <filesystem>
 #include <stdexcept>
+#include <thread>
 
 namespace colmap_lidar {
 
@@ -155,6 +157,54 @@ SqliteTransaction::~SqliteTransaction() {
 void SqliteTransaction::Commit() {
   connection_.Execute("COMMIT");
   committed_ = true;
+}
+
+void CopySqliteDatabase(const std::string& from,
+                        const std::string& to,
+                        int busy_timeout_ms) {
+  const SqliteConnection source(
+      from, SqliteConnection::Mode::kReadOnly, busy_timeout_ms);
+  sqlite3* destination = nullptr;
+  if (sqlite3_open_v2(to.c_str(),
+                      &destination,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
+                      nullptr) != SQLITE_OK) {
+    const std::string message =
+        destination ? sqlite3_errmsg(destination) : "out of memory";
+    sqlite3_close(destination);
+    throw std::runtime_error("Cannot open " + to + ": " + message);
+  }
+  sqlite3_busy_timeout(destination, busy_timeout_ms);
+  sqlite3_backup* backup =
+      sqlite3_backup_init(destination, "main", source.Handle(), "main");
+  if (backup == nullptr) {
+    const std::string message = sqlite3_errmsg(destination);
+    sqlite3_close(destination);
+    throw std::runtime_error("Cannot copy " + from + " to " + to + ": " +
+                             message);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  int status = SQLITE_OK;
+  while (true) {
+    status = sqlite3_backup_step(backup, -1);
+    if (status != SQLITE_BUSY && status != SQLITE_LOCKED) break;
+    if (std::chrono::steady_clock::now() - start >
+        std::chrono::milliseconds(busy_timeout_ms)) {
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  sqlite3_backup_finish(backup);
+  const std::string message = sqlite3_errmsg(destination);
+  sqlite3_close(destination);
+  if (status == SQLITE_BUSY || status == SQLITE_LOCKED) {
+    throw std::runtime_error("Database is locked by another process: " + from +
+                             " -> " + to);
+  }
+  if (status != SQLITE_DONE) {
+    throw std::runtime_error("Cannot copy " + from + " to " + to + ": " +
+                             message);
+  }
 }
 
 }  // namespace colmap_lidar

@@ -20,7 +20,125 @@ std::string Format(double value) {
   return out.str();
 }
 
+void WritePngAtomically(const std::string& path, const cv::Mat& canvas) {
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid()) + ".png";
+  if (!cv::imwrite(tmp, canvas))
+    throw std::runtime_error("Cannot write plot " + path);
+  std::filesystem::rename(tmp, path);
+}
+
 }  // namespace
+
+void WriteLinePlotPng(const std::string& path,
+                      const std::vector<PlotSeries>& series,
+                      const LinePlotOptions& options) {
+  constexpr int kWidth = 800, kHeight = 500, kLeft = 80, kRight = 150,
+                kTop = 50, kBottom = 60;
+  const int plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
+  cv::Mat canvas(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+  const auto y_value = [&](double y) {
+    return options.log_y ? std::log10(y) : y;
+  };
+  double x_min = INFINITY, x_max = -INFINITY, y_min = INFINITY,
+         y_max = -INFINITY;
+  for (const PlotSeries& s : series) {
+    for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if (options.log_y && s.y[i] <= 0) continue;
+      x_min = std::min(x_min, s.x[i]);
+      x_max = std::max(x_max, s.x[i]);
+      y_min = std::min(y_min, y_value(s.y[i]));
+      y_max = std::max(y_max, y_value(s.y[i]));
+    }
+  }
+  if (!(x_max > x_min)) {
+    x_min = std::isfinite(x_min) ? x_min - 1 : 0;
+    x_max = x_min + 2;
+  }
+  if (!(y_max > y_min)) {
+    y_min = std::isfinite(y_min) ? y_min - 1 : 0;
+    y_max = y_min + 2;
+  }
+  const auto to_pixel = [&](double x, double y) {
+    return cv::Point(
+        kLeft + static_cast<int>((x - x_min) / (x_max - x_min) * plot_w),
+        kTop + plot_h -
+            static_cast<int>((y_value(y) - y_min) / (y_max - y_min) * plot_h));
+  };
+  const cv::Scalar black(0, 0, 0);
+  cv::rectangle(canvas, {kLeft, kTop}, {kLeft + plot_w, kTop + plot_h}, black);
+  for (int tick = 0; tick <= 5; ++tick) {
+    const int x = kLeft + tick * plot_w / 5;
+    const int y = kTop + plot_h - tick * plot_h / 5;
+    cv::putText(canvas,
+                Format(x_min + tick * (x_max - x_min) / 5),
+                {x - 15, kTop + plot_h + 22},
+                cv::FONT_HERSHEY_SIMPLEX,
+                0.45,
+                black);
+    const double y_tick = y_min + tick * (y_max - y_min) / 5;
+    cv::putText(canvas,
+                Format(options.log_y ? std::pow(10, y_tick) : y_tick),
+                {5, y + 5},
+                cv::FONT_HERSHEY_SIMPLEX,
+                0.45,
+                black);
+  }
+  for (size_t k = 0; k < series.size(); ++k) {
+    const Color3ub c = ErrorColor(static_cast<double>(k),
+                                  std::max<double>(1, series.size() - 1));
+    const cv::Scalar colour(0.8 * c[2], 0.8 * c[1], 0.8 * c[0]);
+    const PlotSeries& s = series[k];
+    bool has_previous = false;
+    cv::Point previous;
+    for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if (options.log_y && s.y[i] <= 0) continue;
+      const cv::Point p = to_pixel(s.x[i], s.y[i]);
+      if (has_previous) cv::line(canvas, previous, p, colour, 2, cv::LINE_AA);
+      cv::circle(canvas, p, 2, colour, cv::FILLED);
+      previous = p;
+      has_previous = true;
+    }
+    const int legend_y = kTop + 15 + 22 * static_cast<int>(k);
+    cv::line(canvas,
+             {kLeft + plot_w + 10, legend_y - 4},
+             {kLeft + plot_w + 35, legend_y - 4},
+             colour,
+             2);
+    cv::putText(canvas,
+                s.label,
+                {kLeft + plot_w + 40, legend_y},
+                cv::FONT_HERSHEY_SIMPLEX,
+                0.45,
+                black,
+                1,
+                cv::LINE_AA);
+  }
+  cv::putText(canvas,
+              options.title,
+              {kLeft, 30},
+              cv::FONT_HERSHEY_SIMPLEX,
+              0.6,
+              black,
+              1,
+              cv::LINE_AA);
+  cv::putText(canvas,
+              options.x_label,
+              {kLeft + plot_w / 2 - 60, kHeight - 12},
+              cv::FONT_HERSHEY_SIMPLEX,
+              0.5,
+              black,
+              1,
+              cv::LINE_AA);
+  cv::putText(canvas,
+              options.y_label + (options.log_y ? " (log)" : ""),
+              {5, kTop - 10},
+              cv::FONT_HERSHEY_SIMPLEX,
+              0.45,
+              black,
+              1,
+              cv::LINE_AA);
+  WritePngAtomically(path, canvas);
+}
 
 Color3ub ErrorColor(double value, double max_value) {
   const double t =
@@ -105,10 +223,7 @@ void WriteHistogramPng(const std::string& path,
               black,
               1,
               cv::LINE_AA);
-  const std::string tmp = path + ".tmp" + std::to_string(::getpid()) + ".png";
-  if (!cv::imwrite(tmp, canvas))
-    throw std::runtime_error("Cannot write plot " + path);
-  std::filesystem::rename(tmp, path);
+  WritePngAtomically(path, canvas);
 }
 
 }  // namespace colmap_lidar

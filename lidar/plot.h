@@ -23,6 +23,24 @@ void WriteHistogramPng(const std::string& path,
                        const std::vector<double>& values,
                        const HistogramPlotOptions& options);
 
+struct PlotSeries {
+  std::string label;
+  std::vector<double> x;
+  std::vector<double> y;
+};
+
+struct LinePlotOptions {
+  std::string title;
+  std::string x_label;
+  std::string y_label;
+  bool log_y = false;  // log10 axis for y (values <= 0 are skipped)
+};
+
+// Writes a line plot PNG of one or more series with a legend (atomically).
+void WriteLinePlotPng(const std::string& path,
+                      const std::vector<PlotSeries>& series,
+                      const LinePlotOptions& options);
+
 // A blue-green-yellow-red colour for value/max_value in [0, 1] (clamped).
 Color3ub ErrorColor(double value, double max_value);
 

@@ -23,6 +23,8 @@ std::unique_ptr<StationCloud> PrepareStationCloud(
   EstimateNormals(
       *station->tree, options.normals, &station->cloud, &station->curvature);
 
+  if (!options.compute_features) return station;
+
   // Features on a coarser copy: keypoint PCA and descriptors need metres of support, not millimetres.
   const PointCloud coarse = VoxelDownsample(raw, options.feature_voxel_size);
   const KdTree3 coarse_tree(coarse.points);

@@ -21,6 +21,8 @@ struct StationCloudOptions {
   NormalEstimationOptions normals;  // viewpoint: the LiDAR origin (0, 0, 0)
   KeypointOptions keypoints;
   BscOptions bsc;
+  bool compute_features =
+      true;  // false: only what association needs (cloud, normals, tree)
 
   bool Check() const;  // throws std::invalid_argument
 };

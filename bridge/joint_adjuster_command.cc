@@ -1,0 +1,311 @@
+// colmap-lidar joint_adjuster: the joint problem on a COLMAP sparse model (bridge/joint_adjuster.h).
+#include "bridge/commands.h"
+#include "bridge/joint_adjuster.h"
+#include "bridge/joint_problem_data.h"
+#include "colmap_ext/logging.h"
+#include "colmap_ext/station_dataset.h"
+#include "lidar/plot.h"
+
+#include "colmap/controllers/option_manager.h"
+#include "colmap/scene/reconstruction.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::array<bool, 3> ParseHeldAxes(const std::string& text) {
+  std::array<bool, 3> held = {false, false, false};
+  std::stringstream stream(text);
+  std::string axis;
+  while (std::getline(stream, axis, ',')) {
+    if (axis == "x") {
+      held[0] = true;
+    } else if (axis == "y") {
+      held[1] = true;
+    } else if (axis == "z") {
+      held[2] = true;
+    } else if (!axis.empty()) {
+      throw std::invalid_argument("--hold_translation: unknown axis '" + axis +
+                                  "' (a comma-separated subset of x,y,z)");
+    }
+  }
+  return held;
+}
+
+nlohmann::json TermJson(const TermStats& term) {
+  return {{"observations", term.num_observations},
+          {"outliers", term.num_outliers},
+          {"cost_before", term.cost_before},
+          {"cost_after", term.cost_after}};
+}
+
+nlohmann::json PoseJson(const colmap::Rigid3d& pose) {
+  const Eigen::Quaterniond& q = pose.rotation;
+  return {{"qw", q.w()},
+          {"qx", q.x()},
+          {"qy", q.y()},
+          {"qz", q.z()},
+          {"tx", pose.translation.x()},
+          {"ty", pose.translation.y()},
+          {"tz", pose.translation.z()}};
+}
+
+nlohmann::json MatrixJson(const Eigen::MatrixXd& matrix) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < matrix.rows(); ++r) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int c = 0; c < matrix.cols(); ++c) row.push_back(matrix(r, c));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+void WriteReport(const std::string& directory,
+                 const JointAdjusterOptions& options,
+                 const LoadedJointData& loaded,
+                 const colmap::Rigid3d& initial,
+                 const colmap::Rigid3d& refined,
+                 const JointAdjustmentSummary& summary) {
+  nlohmann::json report;
+  report["mode"] = JointModeName(options.mode);
+  report["conventions"] =
+      "cam_from_lidar maps LiDAR points into the left camera; quaternions w "
+      "first; covariance over (rotation vector about the camera axes [deg], "
+      "translation [mm])";
+  report["cam_from_lidar_initial"] = PoseJson(initial);
+  report["cam_from_lidar"] = PoseJson(refined);
+  report["pose_graph"] = {{"image_pairs", loaded.num_image_pairs},
+                          {"lidar_pairs", loaded.num_lidar_pairs},
+                          {"pairs", loaded.data.pairs.size()}};
+  nlohmann::json solves = nlohmann::json::array();
+  for (const SolveStats& solve : summary.solves) {
+    solves.push_back({{"round", solve.round},
+                      {"outlier_iteration", solve.outlier_iteration},
+                      {"reprojection", TermJson(solve.reprojection)},
+                      {"depth", TermJson(solve.depth)},
+                      {"lidar", TermJson(solve.lidar)},
+                      {"iterations", solve.num_iterations},
+                      {"termination", solve.termination},
+                      {"seconds", solve.seconds}});
+  }
+  report["solves"] = solves;
+  const ExtrinsicUncertainty& u = summary.uncertainty;
+  nlohmann::json uncertainty = {{"computed", u.computed},
+                                {"message", u.message}};
+  if (u.computed) {
+    uncertainty["variance_factor"] = u.variance_factor;
+    uncertainty["covariance_deg_mm"] = MatrixJson(u.covariance);
+    const Eigen::VectorXd sigma = u.covariance.diagonal().cwiseSqrt();
+    uncertainty["sigma_rotation_deg"] = {sigma[0], sigma[1], sigma[2]};
+    uncertainty["sigma_translation_mm"] = {sigma[3], sigma[4], sigma[5]};
+    uncertainty["eigen_std_devs"] = MatrixJson(u.eigenvalues.transpose());
+    uncertainty["eigenvectors_columns"] = MatrixJson(u.eigenvectors);
+  }
+  report["uncertainty"] = uncertainty;
+  report["unobservable"] = u.unobservable;
+  report["motion"] = {{"stations", summary.motion.num_stations},
+                      {"rotating_pairs", summary.motion.num_rotating_pairs},
+                      {"max_axis_angle_deg", summary.motion.max_axis_angle_deg},
+                      {"unique", summary.motion.unique},
+                      {"verdict", summary.motion.verdict}};
+  std::string verdict;
+  if (options.mode != JointMode::kJoint) {
+    verdict =
+        "cam_from_lidar held constant (" + JointModeName(options.mode) + ")";
+  } else if (u.unobservable.empty() && summary.motion.unique) {
+    verdict = "cam_from_lidar is observable";
+  } else {
+    verdict = u.unobservable.empty() ? summary.motion.verdict
+                                     : u.unobservable.front();
+  }
+  report["observability_verdict"] = verdict;
+  nlohmann::json curves = nlohmann::json::array();
+  for (const PerturbationCurve& curve : summary.perturbation) {
+    curves.push_back({{"parameter", curve.parameter},
+                      {"offsets", curve.offsets},
+                      {"costs", curve.costs}});
+  }
+  report["perturbation"] = curves;
+  WriteFileAtomically(directory + "/report.json", report.dump(2) + "\n");
+}
+
+void WritePlots(const std::string& directory,
+                const JointAdjustmentSummary& summary) {
+  PlotSeries total{"total cost", {}, {}};
+  for (size_t k = 0; k < summary.solves.size(); ++k) {
+    const SolveStats& s = summary.solves[k];
+    total.x.push_back(static_cast<double>(k + 1));
+    total.y.push_back(s.reprojection.cost_after + s.depth.cost_after +
+                      s.lidar.cost_after);
+  }
+  LinePlotOptions cost_options;
+  cost_options.title = "Joint problem: cost after each solve";
+  cost_options.x_label = "solve (rounds x outlier iterations)";
+  cost_options.y_label = "cost";
+  cost_options.log_y = true;
+  WriteLinePlotPng(directory + "/cost.png", {total}, cost_options);
+  if (summary.perturbation.empty()) return;
+
+  std::ostringstream csv;
+  csv << "# total cost with one cam_from_lidar parameter perturbed around the "
+         "optimum (x y z in mm, roll pitch yaw in deg about the camera axes)\n"
+      << "parameter,offset,cost\n";
+  std::vector<PlotSeries> translation, rotation;
+  for (const PerturbationCurve& curve : summary.perturbation) {
+    PlotSeries series{curve.parameter, curve.offsets, curve.costs};
+    (curve.parameter.size() == 1 ? translation : rotation).push_back(series);
+    for (size_t k = 0; k < curve.offsets.size(); ++k) {
+      csv << curve.parameter << "," << curve.offsets[k] << ","
+          << std::setprecision(10) << curve.costs[k] << "\n";
+    }
+  }
+  WriteFileAtomically(directory + "/perturbation.csv", csv.str());
+  LinePlotOptions plot;
+  plot.title = "Cost vs cam_from_lidar translation offset";
+  plot.x_label = "offset [mm]";
+  plot.y_label = "total cost";
+  WriteLinePlotPng(
+      directory + "/perturbation_translation.png", translation, plot);
+  plot.title = "Cost vs cam_from_lidar rotation offset";
+  plot.x_label = "offset [deg]";
+  WriteLinePlotPng(directory + "/perturbation_rotation.png", rotation, plot);
+}
+
+}  // namespace
+
+int RunJointAdjuster(int argc, char** argv) {
+  std::string input_path, dataset_path, output_path, cam_from_lidar_path;
+  std::string mode = "joint", hold_translation;
+  bool write_text = false;
+  JointAdjusterOptions adjuster;
+  JointDataOptions data_options;
+  colmap::OptionManager options;
+  options.AddDatabaseOptions();
+  options.AddRequiredOption("input_path", &input_path);
+  options.AddRequiredOption("dataset_path", &dataset_path);
+  options.AddRequiredOption("output_path", &output_path);
+  options.AddDefaultOption(
+      "mode", &mode, "joint | precalibrated | stereo_only");
+  options.AddDefaultOption("cam_from_lidar",
+                           &cam_from_lidar_path,
+                           "qw qx qy qz tx ty tz file; default: rig.json's "
+                           "cam_from_lidar_guess");
+  options.AddDefaultOption("write_text", &write_text);
+  options.AddDefaultOption("sigma_lidar_m", &adjuster.sigma_lidar_m);
+  options.AddDefaultOption("depth_weight", &adjuster.depth_weight);
+  options.AddDefaultOption("lidar_weight", &adjuster.lidar_weight);
+  options.AddDefaultOption("loss", &adjuster.loss, "none | huber | cauchy");
+  options.AddDefaultOption("loss_scale", &adjuster.loss_scale);
+  options.AddDefaultOption("max_reprojection_error_px",
+                           &adjuster.max_reprojection_error_px);
+  options.AddDefaultOption("max_depth_error_m", &adjuster.max_depth_error_m);
+  options.AddDefaultOption("max_point_to_plane_m",
+                           &adjuster.max_point_to_plane_m);
+  options.AddDefaultOption("num_association_rounds",
+                           &adjuster.num_association_rounds);
+  int num_samples = static_cast<int>(adjuster.association.num_samples);
+  options.AddDefaultOption("num_samples_per_pair", &num_samples);
+  options.AddDefaultOption("association_max_distance_m",
+                           &adjuster.association.max_distance);
+  options.AddDefaultOption("initial_association_distance_m",
+                           &adjuster.initial_association_distance_m);
+  options.AddDefaultOption("hold_rotation", &adjuster.hold_rotation);
+  options.AddDefaultOption("hold_translation",
+                           &hold_translation,
+                           "comma-separated camera axes, e.g. y or x,z");
+  options.AddDefaultOption("max_num_iterations", &adjuster.max_num_iterations);
+  options.AddDefaultOption("min_image_pair_inliers",
+                           &data_options.min_image_pair_inliers);
+  options.AddDefaultOption("unobservable_translation_mm",
+                           &adjuster.observability.unobservable_translation_mm);
+  options.AddDefaultOption("unobservable_rotation_deg",
+                           &adjuster.observability.unobservable_rotation_deg);
+  options.Parse(argc, argv);
+  adjuster.mode = JointModeFromName(mode);
+  adjuster.hold_translation = ParseHeldAxes(hold_translation);
+  THROW_CHECK_GT(num_samples, 0);
+  adjuster.association.num_samples = static_cast<size_t>(num_samples);
+  THROW_CHECK(adjuster.Check());
+  const auto start = std::chrono::steady_clock::now();
+
+  const StationDataset dataset = ReadStationDataset(dataset_path);
+  THROW_CHECK(fs::is_directory(input_path))
+      << "no sparse model folder " << input_path;
+  colmap::Reconstruction reconstruction;
+  reconstruction.Read(input_path);
+  THROW_CHECK_GE(reconstruction.NumRegImages(), 2)
+      << input_path << " has fewer than 2 registered images";
+  colmap::Rigid3d cam_from_lidar;
+  if (!cam_from_lidar_path.empty()) {
+    cam_from_lidar = ReadPoseFile(cam_from_lidar_path);
+  } else if (dataset.rig.cam_from_lidar_guess) {
+    cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
+  } else {
+    throw std::runtime_error(
+        "no initial cam_from_lidar: pass --cam_from_lidar FILE or add "
+        "cam_from_lidar_guess to " +
+        dataset.root + "/rig.json");
+  }
+  const colmap::Rigid3d initial = cam_from_lidar;
+  std::cout << "Joint adjuster (" << mode
+            << "): " << reconstruction.NumRegImages() << " images, "
+            << reconstruction.NumPoints3D() << " landmarks" << std::endl;
+  const std::unique_ptr<LoadedJointData> loaded =
+      LoadJointProblemData(*options.database_path,
+                           dataset,
+                           reconstruction,
+                           cam_from_lidar,
+                           adjuster.mode != JointMode::kStereoOnly,
+                           data_options);
+
+  JointAdjuster joint_adjuster(adjuster, loaded->data);
+  const JointAdjustmentSummary summary =
+      joint_adjuster.Run(&reconstruction, &cam_from_lidar);
+
+  // Everything into OUTPUT.partial, renamed at the end: never a half-written output folder.
+  const fs::path output(output_path);
+  const fs::path partial = output.string() + ".partial";
+  fs::remove_all(partial);
+  fs::create_directories(partial);
+  reconstruction.WriteBinary(partial.string());
+  if (write_text) reconstruction.WriteText(partial.string());
+  WritePoseFile((partial / "cam_from_lidar.txt").string(),
+                "cam_from_lidar refined by colmap-lidar joint_adjuster (" +
+                    mode + "); qw qx qy qz tx ty tz",
+                cam_from_lidar);
+  WriteReport(
+      partial.string(), adjuster, *loaded, initial, cam_from_lidar, summary);
+  WritePlots(partial.string(), summary);
+  fs::remove_all(output);
+  fs::rename(partial, output);
+
+  std::cout << "Motion: " << summary.motion.verdict << std::endl;
+  if (summary.uncertainty.computed) {
+    const Eigen::VectorXd sigma =
+        summary.uncertainty.covariance.diagonal().cwiseSqrt();
+    std::cout << std::setprecision(3) << "cam_from_lidar sigma: rotation "
+              << sigma.head<3>().transpose() << " deg, translation "
+              << sigma.tail<3>().transpose() << " mm" << std::endl;
+  }
+  for (const std::string& sentence : summary.uncertainty.unobservable) {
+    std::cout << "UNOBSERVABLE: " << sentence << std::endl;
+  }
+  std::cout << "Wrote " << output_path << " ("
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                             start)
+                   .count()
+            << " s)" << std::endl;
+  return EXIT_SUCCESS;
+}
+
+}  // namespace colmap_lidar

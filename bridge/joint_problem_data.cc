@@ -1,0 +1,155 @@
+#include "bridge/joint_problem_data.h"
+
+#include "colmap_ext/logging.h"
+#include "lidar/cloud_io.h"
+
+#include "colmap/scene/database.h"
+
+#include <filesystem>
+#include <iostream>
+#include <set>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Fraction of up to 500 source points with a target point within `distance` under target_from_source.
+double Overlap(const StationCloud& target,
+               const StationCloud& source,
+               const colmap::Rigid3d& target_from_source,
+               double distance) {
+  const size_t n = source.cloud.Size();
+  if (n == 0) return 0;
+  const size_t num_samples = std::min<size_t>(500, n);
+  size_t num_close = 0;
+  for (size_t k = 0; k < num_samples; ++k) {
+    const Eigen::Vector3d point =
+        target_from_source * source.cloud.points[k * n / num_samples];
+    size_t index = 0;
+    double squared_distance = 0;
+    if (target.tree->Nearest(point, &index, &squared_distance) &&
+        squared_distance <= distance * distance) {
+      ++num_close;
+    }
+  }
+  return static_cast<double>(num_close) / num_samples;
+}
+
+}  // namespace
+
+bool JointDataOptions::Check() const {
+  CHECK_OPTION_GE(min_image_pair_inliers, 0);
+  CHECK_OPTION_GT(lidar_overlap_distance_m, 0);
+  CHECK_OPTION_GE(min_lidar_overlap, 0);
+  CHECK_OPTION_GT(voxel_size_m, 0);
+  return true;
+}
+
+std::unique_ptr<LoadedJointData> LoadJointProblemData(
+    const std::string& database_path,
+    const StationDataset& dataset,
+    const colmap::Reconstruction& reconstruction,
+    const colmap::Rigid3d& cam_from_lidar,
+    bool load_clouds,
+    const JointDataOptions& options) {
+  THROW_CHECK(options.Check());
+  THROW_CHECK(fs::is_regular_file(database_path))
+      << "Database file does not exist: " << database_path;
+  auto loaded = std::make_unique<LoadedJointData>();
+  std::map<std::string, size_t> station_index;
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    station_index[dataset.stations[i]] = i;
+  }
+  std::vector<colmap::image_t> image_ids = reconstruction.RegImageIds();
+  std::sort(image_ids.begin(), image_ids.end());
+  std::map<colmap::image_t, size_t> station_of_image;
+  for (const colmap::image_t image_id : image_ids) {
+    const std::string& name = reconstruction.Image(image_id).Name();
+    const auto it = station_index.find(fs::path(name).stem().string());
+    if (it == station_index.end()) {
+      throw std::runtime_error("registered image '" + name +
+                               "' is not a station of " + dataset.root);
+    }
+    station_of_image[image_id] = it->second;
+  }
+
+  // Depth priors.
+  {
+    const ExtensionDatabase extension(database_path,
+                                      ExtensionDatabase::Mode::kReadOnly);
+    size_t num_priors = 0;
+    for (const colmap::image_t image_id : image_ids) {
+      auto& priors = loaded->data.depth_priors[image_id];
+      for (const DepthPrior& prior : extension.ReadDepthPriors(image_id)) {
+        priors[prior.point2D_idx] = prior;
+      }
+      num_priors += priors.size();
+    }
+    std::cout << "Depth priors: " << num_priors << " for " << image_ids.size()
+              << " registered images" << std::endl;
+  }
+
+  // A_c from COLMAP's verified pairs.
+  std::set<std::pair<colmap::image_t, colmap::image_t>> pairs;
+  {
+    const colmap::Database database(database_path);
+    std::vector<std::pair<colmap::image_t, colmap::image_t>> image_pairs;
+    std::vector<int> num_inliers;
+    database.ReadTwoViewGeometryNumInliers(&image_pairs, &num_inliers);
+    for (size_t k = 0; k < image_pairs.size(); ++k) {
+      auto [a, b] = image_pairs[k];
+      if (!station_of_image.count(a) || !station_of_image.count(b)) continue;
+      if (num_inliers[k] < options.min_image_pair_inliers) continue;
+      pairs.insert({std::min(a, b), std::max(a, b)});
+    }
+    loaded->num_image_pairs = pairs.size();
+  }
+  if (!load_clouds) {
+    loaded->data.pairs.assign(pairs.begin(), pairs.end());
+    return loaded;
+  }
+
+  // Clouds, one station at a time (the raw cloud is dropped after downsampling).
+  StationCloudOptions cloud_options;
+  cloud_options.voxel_size = options.voxel_size_m;
+  cloud_options.compute_features = false;
+  for (const colmap::image_t image_id : image_ids) {
+    const size_t station = station_of_image.at(image_id);
+    const PointCloud raw = ReadPointCloud(dataset.cloud_paths[station]);
+    loaded->clouds.push_back(PrepareStationCloud(raw, cloud_options));
+    loaded->data.clouds[image_id] = loaded->clouds.back().get();
+    std::cout << "  cloud " << dataset.stations[station] << ": " << raw.Size()
+              << " points -> " << loaded->clouds.back()->cloud.Size()
+              << " after " << options.voxel_size_m << " m voxels" << std::endl;
+  }
+
+  // A_l: overlapping clouds under the initial estimate.
+  size_t num_lidar_pairs = 0;
+  for (size_t a = 0; a < image_ids.size(); ++a) {
+    for (size_t b = a + 1; b < image_ids.size(); ++b) {
+      const colmap::Rigid3d lidar_a_from_lidar_b =
+          colmap::Inverse(cam_from_lidar) *
+          reconstruction.Image(image_ids[a]).CamFromWorld() *
+          colmap::Inverse(reconstruction.Image(image_ids[b]).CamFromWorld()) *
+          cam_from_lidar;
+      if (Overlap(*loaded->data.clouds.at(image_ids[a]),
+                  *loaded->data.clouds.at(image_ids[b]),
+                  lidar_a_from_lidar_b,
+                  options.lidar_overlap_distance_m) >=
+          options.min_lidar_overlap) {
+        ++num_lidar_pairs;
+        pairs.insert({image_ids[a], image_ids[b]});
+      }
+    }
+  }
+  loaded->num_lidar_pairs = num_lidar_pairs;
+  loaded->data.pairs.assign(pairs.begin(), pairs.end());
+  std::cout << "Pose graph: " << loaded->num_image_pairs
+            << " image pairs (A_c), " << num_lidar_pairs
+            << " overlapping LiDAR pairs (A_l), " << loaded->data.pairs.size()
+            << " pairs in A_c v A_l" << std::endl;
+  return loaded;
+}
+
+}  // namespace colmap_lidar

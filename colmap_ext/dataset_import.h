@@ -1,0 +1,46 @@
+// Imports a station dataset into a COLMAP database: the left camera from rig.json (its intrinsics are
+// kept: prior_focal_length = 1, never re-estimated from EXIF), one image per station named
+// "left/<station>.png", COLMAP's own SIFT extraction and exhaustive matching with geometric verification
+// (libcolmap's controllers, so every --SiftExtraction.* / --SiftMatching.* / --TwoViewGeometry.* option
+// is COLMAP's), plus colmap-lidar's rig and lidar_frames rows.
+//
+// Atomic and idempotent: the work happens on a copy (DATABASE.import-partial) that is copied back into
+// DATABASE in one transaction (SQLite's backup API) only when everything succeeded; a failure leaves
+// DATABASE byte-for-byte unchanged. Re-running on an imported
+// database adds nothing (COLMAP skips images with features and pairs already matched; our rows are
+// upserts); stations added to the dataset since are added.
+#pragma once
+
+#include "colmap_ext/station_dataset.h"
+
+#include "colmap/estimators/two_view_geometry.h"
+#include "colmap/feature/pairing.h"
+#include "colmap/feature/sift.h"
+
+#include <string>
+
+namespace colmap_lidar {
+
+struct DatasetImportOptions {
+  colmap::SiftExtractionOptions sift_extraction;
+  colmap::SiftMatchingOptions sift_matching;
+  colmap::TwoViewGeometryOptions two_view_geometry;
+  colmap::ExhaustiveMatchingOptions exhaustive_matching;
+};
+
+struct DatasetImportSummary {
+  colmap::camera_t camera_id = colmap::kInvalidCameraId;
+  size_t num_images = 0;      // station images in the database afterwards
+  size_t num_new_images = 0;  // added by this run
+  size_t num_verified_pairs = 0;
+};
+
+// Every station's left and right image can be read and has the size of its rig.json camera; throws
+// std::runtime_error naming the station and the file otherwise.
+void CheckStationImages(const StationDataset& dataset);
+
+DatasetImportSummary ImportDataset(const StationDataset& dataset,
+                                   const std::string& database_path,
+                                   const DatasetImportOptions& options);
+
+}  // namespace colmap_lidar

@@ -1,0 +1,105 @@
+// The depth-prior residual E_d of the seed's joint cost, in COLMAP 3.10's parameter layout:
+//
+//   E_d = (depth(X_cam) - d) / sigma_d,   X_cam = R(q_cam_from_world) X_world + t_cam_from_world
+//
+// with the cam_from_world rotation as an Eigen quaternion (xyzw storage, COLMAP's
+// Rigid3d::rotation.coeffs()), the translation and the landmark X_world (COLMAP's Point3D::xyz).
+//
+// depth(X_cam) is the z coordinate by default. The seed writes the range ||X_cam||, but a rectified
+// stereo pair measures disparity, i.e. z (Z = b f / d), and our depth maps store z in the original left
+// camera; comparing z with z keeps the residual unbiased off the optical axis, where range exceeds z by
+// up to 1/cos(24 deg) = 9 % at the image corner of a 48 deg lens. DepthType::kRange is there for priors
+// that really are ranges (e.g. time-of-flight sensors).
+#pragma once
+
+#include "colmap/estimators/cost_functions.h"
+#include "colmap/geometry/rigid3.h"
+
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/ceres.h>
+
+namespace colmap_lidar {
+
+enum class DepthType { kZ, kRange };
+
+template <typename T>
+T DepthOfPoint(const Eigen::Matrix<T, 3, 1>& point_in_cam, DepthType type) {
+  if (type == DepthType::kZ) return point_in_cam.z();
+  return point_in_cam.norm();
+}
+
+// Pose and landmark are parameter blocks: cam_from_world rotation [4], translation [3], point [3].
+class DepthPriorCostFunctor {
+ public:
+  DepthPriorCostFunctor(double depth, double sigma, DepthType type)
+      : depth_(depth), inverse_sigma_(1.0 / sigma), type_(type) {}
+
+  static ceres::CostFunction* Create(double depth,
+                                     double sigma,
+                                     DepthType type = DepthType::kZ) {
+    return new ceres::AutoDiffCostFunction<DepthPriorCostFunctor, 1, 4, 3, 3>(
+        new DepthPriorCostFunctor(depth, sigma, type));
+  }
+
+  template <typename T>
+  bool operator()(const T* const cam_from_world_rotation,
+                  const T* const cam_from_world_translation,
+                  const T* const point_in_world,
+                  T* residual) const {
+    const Eigen::Matrix<T, 3, 1> point_in_cam =
+        colmap::EigenQuaternionMap<T>(cam_from_world_rotation) *
+            colmap::EigenVector3Map<T>(point_in_world) +
+        colmap::EigenVector3Map<T>(cam_from_world_translation);
+    residual[0] =
+        (DepthOfPoint(point_in_cam, type_) - T(depth_)) * T(inverse_sigma_);
+    return true;
+  }
+
+ private:
+  const double depth_;
+  const double inverse_sigma_;
+  const DepthType type_;
+};
+
+// The same residual for an image whose pose COLMAP holds constant (its pose is not a parameter block in
+// COLMAP's problem, as for ReprojErrorConstantPoseCostFunction): only the landmark [3] is a parameter.
+class DepthPriorConstantPoseCostFunctor {
+ public:
+  DepthPriorConstantPoseCostFunctor(const colmap::Rigid3d& cam_from_world,
+                                    double depth,
+                                    double sigma,
+                                    DepthType type)
+      : cam_from_world_(cam_from_world),
+        depth_(depth),
+        inverse_sigma_(1.0 / sigma),
+        type_(type) {}
+
+  static ceres::CostFunction* Create(const colmap::Rigid3d& cam_from_world,
+                                     double depth,
+                                     double sigma,
+                                     DepthType type = DepthType::kZ) {
+    return new ceres::
+        AutoDiffCostFunction<DepthPriorConstantPoseCostFunctor, 1, 3>(
+            new DepthPriorConstantPoseCostFunctor(
+                cam_from_world, depth, sigma, type));
+  }
+
+  template <typename T>
+  bool operator()(const T* const point_in_world, T* residual) const {
+    const Eigen::Matrix<T, 3, 1> point_in_cam =
+        cam_from_world_.rotation.cast<T>() *
+            colmap::EigenVector3Map<T>(point_in_world) +
+        cam_from_world_.translation.cast<T>();
+    residual[0] =
+        (DepthOfPoint(point_in_cam, type_) - T(depth_)) * T(inverse_sigma_);
+    return true;
+  }
+
+ private:
+  const colmap::Rigid3d cam_from_world_;
+  const double depth_;
+  const double inverse_sigma_;
+  const DepthType type_;
+};
+
+}  // namespace colmap_lidar

@@ -1,0 +1,384 @@
+#include "colmap_ext/stereo_depth.h"
+
+#include "colmap_ext/logging.h"
+
+#include "colmap/mvs/depth_map.h"
+
+#include <nlohmann/json.hpp>
+#include <omp.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+
+int SgbmMode(const std::string& mode) {
+  if (mode == "sgbm") return cv::StereoSGBM::MODE_SGBM;
+  if (mode == "hh") return cv::StereoSGBM::MODE_HH;
+  if (mode == "3way") return cv::StereoSGBM::MODE_SGBM_3WAY;
+  if (mode == "hh4") return cv::StereoSGBM::MODE_HH4;
+  throw std::invalid_argument("unknown SGBM mode '" + mode +
+                              "' (sgbm, hh, 3way, hh4)");
+}
+
+// Disparity search range [min, min + num) from the depth range: num is a multiple of 16 (OpenCV).
+void DisparityRange(const StereoRectifier& rectifier,
+                    const StereoDepthOptions& options,
+                    int* min_disparity,
+                    int* num_disparities) {
+  const double fb =
+      rectifier.RectifiedFocalLength() * rectifier.BaselineMeters();
+  *min_disparity = static_cast<int>(std::floor(fb / options.max_depth_m));
+  const int max_disparity =
+      static_cast<int>(std::ceil(fb / options.min_depth_m));
+  *num_disparities =
+      std::max(16, (max_disparity - *min_disparity + 15) / 16 * 16);
+}
+
+// CV_16S fixed-point (x16) SGBM output to float pixels; invalid -> 0.
+cv::Mat ToPixels(const cv::Mat& fixed, int min_disparity) {
+  cv::Mat disparity(fixed.size(), CV_32F, cv::Scalar(0));
+  for (int row = 0; row < fixed.rows; ++row) {
+    for (int col = 0; col < fixed.cols; ++col) {
+      const short raw = fixed.at<short>(row, col);
+      if (raw >= min_disparity * 16 && raw > 0) {
+        disparity.at<float>(row, col) = raw / 16.f;
+      }
+    }
+  }
+  return disparity;
+}
+
+void WriteAtomically(const std::string& path,
+                     const std::function<void(const std::string&)>& write) {
+  const std::string temporary = path + ".tmp";
+  write(temporary);
+  fs::rename(temporary, path);
+}
+
+cv::Mat ReadImageOrThrow(const std::string& path) {
+  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) {
+    throw std::runtime_error("cannot read image " + path);
+  }
+  return image;
+}
+
+}  // namespace
+
+bool StereoDepthOptions::Check() const {
+  SgbmMode(mode);
+  CHECK_OPTION_GT(min_depth_m, 0);
+  CHECK_OPTION_GT(max_depth_m, min_depth_m);
+  CHECK_OPTION_GE(block_size, 1);
+  CHECK_OPTION_EQ(block_size % 2, 1);
+  CHECK_OPTION_GT(p2_factor, p1_factor);
+  CHECK_OPTION_GE(uniqueness_ratio, 0);
+  CHECK_OPTION_GE(speckle_window_size, 0);
+  CHECK_OPTION_GE(speckle_range_px, 0);
+  CHECK_OPTION_GT(max_left_right_diff_px, 0);
+  return true;
+}
+
+StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
+                               const cv::Mat& right_image,
+                               const StereoRectifier& rectifier,
+                               const StereoDepthOptions& options) {
+  if (left_image.size() != rectifier.ImageSize() ||
+      right_image.size() != rectifier.ImageSize()) {
+    std::ostringstream message;
+    message << "stereo pair sizes (left " << left_image.cols << "x"
+            << left_image.rows << ", right " << right_image.cols << "x"
+            << right_image.rows << ") differ from the rig's "
+            << rectifier.ImageSize().width << "x"
+            << rectifier.ImageSize().height;
+    throw std::invalid_argument(message.str());
+  }
+  cv::Mat left_grey = left_image, right_grey = right_image;
+  if (left_grey.channels() == 3)
+    cv::cvtColor(left_image, left_grey, cv::COLOR_BGR2GRAY);
+  if (right_grey.channels() == 3)
+    cv::cvtColor(right_image, right_grey, cv::COLOR_BGR2GRAY);
+  cv::Mat left_rectified, right_rectified;
+  rectifier.Rectify(left_grey, right_grey, &left_rectified, &right_rectified);
+
+  int min_disparity = 0, num_disparities = 0;
+  DisparityRange(rectifier, options, &min_disparity, &num_disparities);
+  const int area = options.block_size * options.block_size;
+  cv::Ptr<cv::StereoSGBM> matcher = cv::StereoSGBM::create(
+      min_disparity,
+      num_disparities,
+      options.block_size,
+      options.p1_factor * area,
+      options.p2_factor * area,
+      /*disp12MaxDiff=*/-1,
+      options.pre_filter_cap,
+      options.uniqueness_ratio,
+      options.speckle_window_size,
+      static_cast<int>(std::ceil(options.speckle_range_px)),
+      SgbmMode(options.mode));
+
+  // Left disparity, and the right image's disparity by matching the mirrored pair (the right image
+  // becomes the reference): d_right(x) = d such that right x matches left x + d.
+  // SGBM leaves the first min + num disparity columns invalid; padding the pair on the side of the
+  // reference image's border keeps every pixel whose match lies inside the other image.
+  const int pad = min_disparity + num_disparities;
+  const auto match = [&](const cv::Mat& reference, const cv::Mat& other) {
+    cv::Mat reference_padded, other_padded, fixed;
+    cv::copyMakeBorder(
+        reference, reference_padded, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
+    cv::copyMakeBorder(
+        other, other_padded, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
+    matcher->compute(reference_padded, other_padded, fixed);
+    return fixed(cv::Rect(pad, 0, reference.cols, reference.rows)).clone();
+  };
+  const cv::Mat left_fixed = match(left_rectified, right_rectified);
+  cv::Mat left_mirrored, right_mirrored, right_fixed;
+  cv::flip(left_rectified, left_mirrored, 1);
+  cv::flip(right_rectified, right_mirrored, 1);
+  cv::flip(match(right_mirrored, left_mirrored), right_fixed, 1);
+  cv::Mat left_disparity = ToPixels(left_fixed, min_disparity);
+  const cv::Mat right_disparity = ToPixels(right_fixed, min_disparity);
+
+  // Left-right consistency; rectified pixels from outside the original image are dropped.
+  const cv::Mat& mask = rectifier.LeftRectifiedMask();
+  cv::Mat lr_diff(left_disparity.size(), CV_32F, cv::Scalar(-1));
+  for (int row = 0; row < left_disparity.rows; ++row) {
+    for (int col = 0; col < left_disparity.cols; ++col) {
+      float& d = left_disparity.at<float>(row, col);
+      if (d <= 0.f) continue;
+      const int right_col = static_cast<int>(std::lround(col - d));
+      const float d_right =
+          right_col >= 0 ? right_disparity.at<float>(row, right_col) : 0.f;
+      const float diff = std::abs(d - d_right);
+      if (mask.at<uchar>(row, col) == 0 || d_right <= 0.f ||
+          diff > options.max_left_right_diff_px) {
+        d = 0.f;
+      } else {
+        lr_diff.at<float>(row, col) = diff;
+      }
+    }
+  }
+
+  StereoDepth result;
+  result.depth = rectifier.DepthInLeftImage(left_disparity);
+  // Confidence in the original grid: the left-right agreement of the nearest rectified pixel.
+  cv::Mat confidence_rectified(lr_diff.size(), CV_8U, cv::Scalar(0));
+  for (int row = 0; row < lr_diff.rows; ++row) {
+    for (int col = 0; col < lr_diff.cols; ++col) {
+      const float diff = lr_diff.at<float>(row, col);
+      if (diff < 0.f) continue;
+      confidence_rectified.at<uchar>(row, col) = static_cast<uchar>(std::lround(
+          1 + 254 * (1.0 - diff / (options.max_left_right_diff_px + 1e-9))));
+    }
+  }
+  result.confidence = rectifier.ToLeftImage(confidence_rectified);
+  size_t num_valid = 0;
+  for (int row = 0; row < result.depth.rows; ++row) {
+    for (int col = 0; col < result.depth.cols; ++col) {
+      if (result.depth.at<float>(row, col) > 0.f) {
+        ++num_valid;
+        result.confidence.at<uchar>(row, col) =
+            std::max<uchar>(1, result.confidence.at<uchar>(row, col));
+      } else {
+        result.confidence.at<uchar>(row, col) = 0;
+      }
+    }
+  }
+  result.valid_fraction = static_cast<double>(num_valid) /
+                          static_cast<double>(result.depth.total());
+  return result;
+}
+
+std::string StereoDepthMapPath(const std::string& depth_path,
+                               const std::string& station) {
+  return (fs::path(depth_path) / "depth_maps" /
+          (station + ".png.geometric.bin"))
+      .string();
+}
+
+void WriteStationStereoDepth(const std::string& output_path,
+                             const std::string& station,
+                             const StereoDepth& depth) {
+  const fs::path root(output_path);
+  for (const char* folder : {"depth_maps", "confidence_maps", "previews"}) {
+    fs::create_directories(root / folder);
+  }
+  float max_depth = 0.f;
+  for (int row = 0; row < depth.depth.rows; ++row) {
+    for (int col = 0; col < depth.depth.cols; ++col) {
+      max_depth = std::max(max_depth, depth.depth.at<float>(row, col));
+    }
+  }
+  colmap::mvs::DepthMap depth_map(
+      depth.depth.cols, depth.depth.rows, 0.f, max_depth);
+  for (int row = 0; row < depth.depth.rows; ++row) {
+    for (int col = 0; col < depth.depth.cols; ++col) {
+      depth_map.Set(row, col, depth.depth.at<float>(row, col));
+    }
+  }
+  WriteAtomically(StereoDepthMapPath(output_path, station),
+                  [&](const std::string& path) { depth_map.Write(path); });
+
+  const auto write_png = [](const cv::Mat& image) {
+    return [&image](const std::string& path) {
+      std::vector<uchar> bytes;
+      THROW_CHECK(cv::imencode(".png", image, bytes)) << path;
+      std::ofstream(path, std::ios::binary)
+          .write(reinterpret_cast<const char*>(bytes.data()),
+                 static_cast<std::streamsize>(bytes.size()));
+    };
+  };
+  WriteAtomically((root / "confidence_maps" / (station + ".png")).string(),
+                  write_png(depth.confidence));
+
+  // Preview: inverse depth between the 2nd and 98th percentile, turbo colour map, black = no depth.
+  std::vector<float> inverse;
+  for (int row = 0; row < depth.depth.rows; ++row) {
+    for (int col = 0; col < depth.depth.cols; ++col) {
+      const float z = depth.depth.at<float>(row, col);
+      if (z > 0.f) inverse.push_back(1.f / z);
+    }
+  }
+  cv::Mat grey(depth.depth.size(), CV_8U, cv::Scalar(0));
+  if (!inverse.empty()) {
+    std::sort(inverse.begin(), inverse.end());
+    const float lo = inverse[inverse.size() * 2 / 100];
+    const float hi = inverse[inverse.size() * 98 / 100];
+    for (int row = 0; row < depth.depth.rows; ++row) {
+      for (int col = 0; col < depth.depth.cols; ++col) {
+        const float z = depth.depth.at<float>(row, col);
+        if (z <= 0.f) continue;
+        const float t = (1.f / z - lo) / std::max(hi - lo, 1e-9f);
+        grey.at<uchar>(row, col) =
+            static_cast<uchar>(std::lround(1 + 254 * std::clamp(t, 0.f, 1.f)));
+      }
+    }
+  }
+  cv::Mat preview;
+  cv::applyColorMap(grey, preview, cv::COLORMAP_TURBO);
+  preview.setTo(cv::Scalar(0, 0, 0), grey == 0);
+  WriteAtomically((root / "previews" / (station + ".png")).string(),
+                  write_png(preview));
+}
+
+StereoDepthInfo ReadStereoDepthInfo(const std::string& depth_path) {
+  const std::string path = (fs::path(depth_path) / "stereo.json").string();
+  std::ifstream file(path);
+  if (!file) {
+    throw std::runtime_error("no stereo.json in " + depth_path +
+                             ": run `colmap-lidar stereo_depth --output_path " +
+                             depth_path + "` first");
+  }
+  try {
+    const nlohmann::json json = nlohmann::json::parse(file);
+    StereoDepthInfo info;
+    info.rectified_focal_px = json.at("rectified_focal_px").get<double>();
+    info.baseline_m = json.at("baseline_m").get<double>();
+    THROW_CHECK_GT(info.rectified_focal_px, 0) << path;
+    THROW_CHECK_GT(info.baseline_m, 0) << path;
+    return info;
+  } catch (const nlohmann::json::exception& error) {
+    throw std::runtime_error(path + ": " + error.what());
+  }
+}
+
+void ComputeDatasetStereoDepth(const StationDataset& dataset,
+                               const std::string& output_path,
+                               const StereoDepthOptions& options) {
+  THROW_CHECK(options.Check());
+  const StereoRectifier rectifier(
+      dataset.rig.left, dataset.rig.right, dataset.rig.right_from_left);
+  int min_disparity = 0, num_disparities = 0;
+  DisparityRange(rectifier, options, &min_disparity, &num_disparities);
+  std::cout << "Stereo depth: " << dataset.stations.size() << " stations, "
+            << rectifier.ImageSize().width << "x"
+            << rectifier.ImageSize().height << ", rectified f " << std::fixed
+            << std::setprecision(1) << rectifier.RectifiedFocalLength()
+            << " px, baseline " << std::setprecision(3)
+            << rectifier.BaselineMeters() << " m, disparities " << min_disparity
+            << ".." << min_disparity + num_disparities - 1 << " px, SGBM mode "
+            << options.mode << std::endl;
+  fs::create_directories(output_path);
+  fs::remove(fs::path(output_path) /
+             "stereo.json");  // not complete until rewritten
+
+  const int num_stations = static_cast<int>(dataset.stations.size());
+  std::vector<double> valid_fraction(dataset.stations.size(), 0);
+  std::vector<std::string> errors(dataset.stations.size());
+  std::atomic<int> num_done{0};
+  std::mutex print_mutex;
+  const int num_threads =
+      options.num_threads > 0 ? options.num_threads : omp_get_max_threads();
+  // One station per thread; OpenCV's own threads off meanwhile (no oversubscription).
+  const int opencv_threads = cv::getNumThreads();
+  cv::setNumThreads(num_threads > 1 ? 1 : opencv_threads);
+  const auto start = std::chrono::steady_clock::now();
+#pragma omp parallel for schedule(dynamic) num_threads(num_threads)
+  for (int i = 0; i < num_stations; ++i) {
+    const std::string& station = dataset.stations[i];
+    try {
+      const cv::Mat left = ReadImageOrThrow(dataset.LeftImagePath(i));
+      const cv::Mat right = ReadImageOrThrow(dataset.RightImagePath(i));
+      const StereoDepth depth =
+          ComputeStereoDepth(left, right, rectifier, options);
+      WriteStationStereoDepth(output_path, station, depth);
+      valid_fraction[i] = depth.valid_fraction;
+      const int done = ++num_done;
+      const double seconds = std::chrono::duration<double>(
+                                 std::chrono::steady_clock::now() - start)
+                                 .count();
+      std::lock_guard<std::mutex> lock(print_mutex);
+      std::cout << "  [" << done << "/" << num_stations << "] station "
+                << station << ": " << std::setprecision(1)
+                << 100 * depth.valid_fraction << " % of pixels with depth ("
+                << std::setprecision(0) << seconds << " s)" << std::endl;
+    } catch (const std::exception& error) {
+      errors[i] = "station " + station + ": " + error.what();
+    }
+  }
+  cv::setNumThreads(opencv_threads);
+  for (const std::string& error : errors) {
+    if (!error.empty()) throw std::runtime_error(error);
+  }
+
+  nlohmann::json json;
+  json["rectified_focal_px"] = rectifier.RectifiedFocalLength();
+  json["baseline_m"] = rectifier.BaselineMeters();
+  json["depth"] = "z in the original left camera, metres; 0 = no depth";
+  json["min_disparity_px"] = min_disparity;
+  json["num_disparities"] = num_disparities;
+  json["options"] = {
+      {"mode", options.mode},
+      {"min_depth_m", options.min_depth_m},
+      {"max_depth_m", options.max_depth_m},
+      {"block_size", options.block_size},
+      {"p1_factor", options.p1_factor},
+      {"p2_factor", options.p2_factor},
+      {"uniqueness_ratio", options.uniqueness_ratio},
+      {"speckle_window_size", options.speckle_window_size},
+      {"speckle_range_px", options.speckle_range_px},
+      {"max_left_right_diff_px", options.max_left_right_diff_px}};
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    json["valid_fraction"][dataset.stations[i]] = valid_fraction[i];
+  }
+  WriteFileAtomically((fs::path(output_path) / "stereo.json").string(),
+                      json.dump(2) + "\n");
+}
+
+}  // namespace colmap_lidar

@@ -1,0 +1,78 @@
+// Per-station stereo depth: rectify (StereoRectifier), OpenCV semi-global matching, left-right
+// consistency check, speckle filtering, then z-depth in the original left image's pixel grid.
+//
+// Output layout of WriteStationStereoDepth / ComputeDatasetStereoDepth (DIR = --output_path):
+//   DIR/depth_maps/<station>.png.geometric.bin   z-depth [m], COLMAP's DepthMap format, 0 = no depth
+//   DIR/confidence_maps/<station>.png            8-bit: 0 invalid, 1..255 = left-right agreement
+//   DIR/previews/<station>.png                   colour-mapped inverse depth for people (black = none)
+//   DIR/stereo.json                              rectified focal length, baseline, options, per-station
+//                                                valid fraction; written last (marks a complete run)
+#pragma once
+
+#include "colmap_ext/station_dataset.h"
+#include "colmap_ext/stereo_rectifier.h"
+
+#include <opencv2/core.hpp>
+
+#include <string>
+
+namespace colmap_lidar {
+
+struct StereoDepthOptions {
+  // OpenCV StereoSGBM mode: "sgbm" (5 paths), "hh" (8 paths, full cost volume: much memory), "3way"
+  // (faster), "hh4".
+  std::string mode = "sgbm";
+  // The disparity search range follows from a depth range and the rectified rig: for the 0.38 m baseline
+  // at 1028 px width this is about 14..300 px (1.5 m .. 30 m).
+  double min_depth_m = 1.5;
+  double max_depth_m = 30.0;
+  int block_size = 5;  // odd
+  // P1 = p1_factor * block_size^2, P2 = p2_factor * block_size^2 (grey images), OpenCV's recommendation.
+  int p1_factor = 8;
+  int p2_factor = 32;
+  int uniqueness_ratio = 10;  // percent
+  int pre_filter_cap = 63;
+  // Speckle filtering (StereoSGBM's own, on both disparity maps): regions smaller than this many
+  // pixels whose disparity varies by at most speckle_range px are removed.
+  int speckle_window_size = 200;
+  double speckle_range_px = 2.0;
+  // Left-right check: |d_left(x) - d_right(x - d_left(x))| must not exceed this (pixels).
+  double max_left_right_diff_px = 1.0;
+  int num_threads = -1;  // stations in parallel; -1 = all cores
+
+  bool Check() const;
+};
+
+struct StereoDepth {
+  cv::Mat depth;       // CV_32F, original left grid, metres (z), 0 = invalid
+  cv::Mat confidence;  // CV_8U, 0 invalid, 255 = perfect left-right agreement
+  double valid_fraction = 0;
+};
+
+// One stereo pair (8-bit grey or BGR). Throws std::invalid_argument for sizes that differ from the rig.
+StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
+                               const cv::Mat& right_image,
+                               const StereoRectifier& rectifier,
+                               const StereoDepthOptions& options);
+
+// Writes one station's maps into the layout above (each file atomically).
+void WriteStationStereoDepth(const std::string& output_path,
+                             const std::string& station,
+                             const StereoDepth& depth);
+
+std::string StereoDepthMapPath(const std::string& depth_path,
+                               const std::string& station);
+
+// What stereo.json records, read back by the depth-prior extractor.
+struct StereoDepthInfo {
+  double rectified_focal_px = 0;
+  double baseline_m = 0;
+};
+StereoDepthInfo ReadStereoDepthInfo(const std::string& depth_path);
+
+// All stations of a dataset, in parallel, with a progress line per station. Errors name the station.
+void ComputeDatasetStereoDepth(const StationDataset& dataset,
+                               const std::string& output_path,
+                               const StereoDepthOptions& options);
+
+}  // namespace colmap_lidar

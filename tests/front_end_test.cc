@@ -1,0 +1,292 @@
+// The front end through the CLI on simulated stations: import_dataset (COLMAP SIFT into the database),
+// stereo_depth, depth_prior_extractor; accuracy against the simulator's ground truth; COLMAP's own
+// mapper on the imported database; bad input.
+#include "colmap_ext/extension_database.h"
+#include "colmap_ext/station_dataset.h"
+#include "tests/simulator/scene.h"
+#include "tests/simulator/simulate_dataset.h"
+#include "tests/testing/run_command.h"
+#include "tests/testing/scoped_temp_dir.h"
+
+#include "colmap/mvs/depth_map.h"
+#include "colmap/scene/database.h"
+#include "colmap/scene/reconstruction.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::RunCommand;
+
+const std::string kCli = COLMAP_LIDAR_CLI_EXE;
+const std::string kColmap = COLMAP_LIDAR_COLMAP_EXE;
+const std::string kSift =
+    " --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2";
+
+double Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const size_t k = std::min(values.size() - 1,
+                            static_cast<size_t>(q * (values.size() - 1) + 0.5));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[k];
+}
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << file.rdbuf();
+  return bytes.str();
+}
+
+std::string Simulate(const testing::ScopedTempDir& dir,
+                     const std::string& name,
+                     int num_stations,
+                     const std::string& motion,
+                     double image_scale) {
+  sim::SimulationOptions options;
+  options.output_path = dir.File(name);
+  options.num_stations = num_stations;
+  options.motion = motion;
+  options.image_scale = image_scale;
+  options.lidar_points = 5000;
+  sim::SimulateDataset(options);
+  return options.output_path;
+}
+
+// The default scene and rig at full resolution (6 stations of the default two-axes motion).
+TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
+  testing::ScopedTempDir dir;
+  const std::string dataset_path = Simulate(dir, "dataset", 6, "two_axes", 1.0);
+  const StationDataset dataset = ReadStationDataset(dataset_path);
+
+  auto result =
+      RunCommand(kCli + " stereo_depth --dataset_path " + dataset_path +
+                 " --output_path " + dir.File("stereo"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::cout << result.output;
+  ASSERT_TRUE(fs::exists(dir.File("stereo/stereo.json")));
+
+  // Depth maps against the simulator's true depth maps, pixel by pixel.
+  std::vector<double> pixel_errors;
+  size_t num_true = 0, num_valid = 0;
+  for (const std::string& station : dataset.stations) {
+    colmap::mvs::DepthMap truth, depth;
+    truth.Read(dataset.GroundTruthPath("depth/" + station + ".bin"));
+    depth.Read(dir.File("stereo/depth_maps/" + station + ".png.geometric.bin"));
+    ASSERT_EQ(depth.GetWidth(), truth.GetWidth());
+    ASSERT_EQ(depth.GetHeight(), truth.GetHeight());
+    EXPECT_TRUE(fs::exists(dir.File("stereo/previews/" + station + ".png")));
+    EXPECT_TRUE(
+        fs::exists(dir.File("stereo/confidence_maps/" + station + ".png")));
+    for (size_t row = 0; row < depth.GetHeight(); ++row) {
+      for (size_t col = 0; col < depth.GetWidth(); ++col) {
+        const double z_true = truth.Get(row, col);
+        if (z_true <= 0 || z_true > 20) continue;
+        ++num_true;
+        const double z = depth.Get(row, col);
+        if (z <= 0) continue;
+        ++num_valid;
+        pixel_errors.push_back(std::abs(z - z_true) / z_true);
+      }
+    }
+  }
+  const double pixel_fraction = static_cast<double>(num_valid) / num_true;
+  std::cout << "stereo depth: " << 100 * pixel_fraction
+            << " % of pixels with depth; relative error median "
+            << 100 * Quantile(pixel_errors, 0.5) << " %, 90th percentile "
+            << 100 * Quantile(pixel_errors, 0.9) << " %" << std::endl;
+  EXPECT_GT(pixel_fraction, 0.6);
+  EXPECT_LT(Quantile(pixel_errors, 0.5), 0.005);
+
+  result = RunCommand(kCli + " import_dataset --dataset_path " + dataset_path +
+                      " --database_path " + dir.File("db.db") + kSift);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  result =
+      RunCommand(kCli + " depth_prior_extractor --database_path " +
+                 dir.File("db.db") + " --depth_path " + dir.File("stereo"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::cout << result.output;
+
+  // Each prior against the exact depth of the keypoint's ray on the true scene.
+  const sim::Scene scene = sim::Scene::Create("t_specimen");
+  const auto cam_from_world =
+      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const colmap::Database database(dir.File("db.db"));
+  const ExtensionDatabase extension(dir.File("db.db"),
+                                    ExtensionDatabase::Mode::kReadOnly);
+  std::vector<double> relative_errors, normalised_errors;
+  size_t num_keypoints = 0, num_priors = 0;
+  for (const colmap::Image& image : database.ReadAllImages()) {
+    const std::string station = fs::path(image.Name()).stem().string();
+    const colmap::Rigid3d& pose = cam_from_world.at(station);
+    const colmap::Camera camera = database.ReadCamera(image.CameraId());
+    const colmap::FeatureKeypoints keypoints =
+        database.ReadKeypoints(image.ImageId());
+    const std::vector<DepthPrior> priors =
+        extension.ReadDepthPriors(image.ImageId());
+    num_keypoints += keypoints.size();
+    num_priors += priors.size();
+    const colmap::Rigid3d world_from_cam = colmap::Inverse(pose);
+    for (const DepthPrior& prior : priors) {
+      const colmap::FeatureKeypoint& keypoint = keypoints.at(prior.point2D_idx);
+      const Eigen::Vector3d ray_in_cam =
+          camera.CamFromImg(Eigen::Vector2d(keypoint.x, keypoint.y))
+              .homogeneous();
+      sim::RayHit hit;
+      if (!scene.Intersect(world_from_cam.translation,
+                           (world_from_cam.rotation * ray_in_cam).normalized(),
+                           1000,
+                           &hit)) {
+        // A prior for a keypoint whose ray sees the sky: a gross error.
+        relative_errors.push_back(1.0);
+        normalised_errors.push_back(1e6);
+        continue;
+      }
+      const double z_true = hit.t / ray_in_cam.norm();  // ray_in_cam has z = 1
+      relative_errors.push_back(std::abs(prior.depth - z_true) / z_true);
+      normalised_errors.push_back(std::abs(prior.depth - z_true) / prior.sigma);
+    }
+  }
+  const double fraction = static_cast<double>(num_priors) / num_keypoints;
+  std::cout << std::setprecision(3) << "depth priors: " << num_priors << " of "
+            << num_keypoints << " keypoints (" << 100 * fraction
+            << " %); |error|/depth median "
+            << 100 * Quantile(relative_errors, 0.5)
+            << " %; |error|/sigma_d median " << Quantile(normalised_errors, 0.5)
+            << ", 95th percentile " << Quantile(normalised_errors, 0.95)
+            << " (ratio of observed error to sigma_d)" << std::endl;
+  EXPECT_GE(fraction, 0.6);
+  EXPECT_LE(Quantile(relative_errors, 0.5), 0.005);
+  // sigma_d with sigma_p = 1 px must not be optimistic: 95 % of errors within 2 sigma.
+  EXPECT_LE(Quantile(normalised_errors, 0.95), 2.0);
+}
+
+// COLMAP's own mapper reconstructs from the imported database; a second import adds nothing.
+TEST(FrontEndTest, ImportedDatabaseIsIdempotentAndUsableByColmapMapper) {
+  testing::ScopedTempDir dir;
+  const std::string dataset_path =
+      Simulate(dir, "dataset", 4, "fixed_rotation", 0.6);
+  const std::string db = dir.File("db.db");
+  const std::string import = kCli + " import_dataset --dataset_path " +
+                             dataset_path + " --database_path " + db + kSift;
+  auto result = RunCommand(import);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_FALSE(fs::exists(db + ".import-partial"));
+
+  auto counts = [&db]() {
+    const colmap::Database database(db);
+    const ExtensionDatabase extension(db, ExtensionDatabase::Mode::kReadOnly);
+    return std::vector<size_t>{database.NumCameras(),
+                               database.NumImages(),
+                               database.NumKeypoints(),
+                               database.NumMatches(),
+                               database.NumVerifiedImagePairs(),
+                               extension.ReadLidarFrames().size()};
+  };
+  const std::vector<size_t> first = counts();
+  EXPECT_EQ(first[0], 1u);
+  EXPECT_EQ(first[1], 4u);
+  EXPECT_EQ(first[5], 4u);
+  EXPECT_GE(first[4], 3u);
+  {
+    const colmap::Database database(db);
+    const colmap::Camera camera = database.ReadCamera(1);
+    const StationDataset dataset = ReadStationDataset(dataset_path);
+    EXPECT_EQ(camera.ModelName(), "PINHOLE");
+    EXPECT_TRUE(camera.has_prior_focal_length);
+    EXPECT_NEAR(camera.params[0], dataset.rig.left.params[0], 1e-9);
+    EXPECT_EQ(database.ReadAllImages().front().Name(), "left/000.png");
+    const ExtensionDatabase extension(db, ExtensionDatabase::Mode::kReadOnly);
+    ASSERT_TRUE(extension.ReadRig());
+    EXPECT_NEAR(extension.ReadRig()->BaselineMeters(), 0.38, 1e-9);
+  }
+  result = RunCommand(import);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(counts(), first) << "a second import changed the database";
+
+  fs::create_directories(dir.File("sparse"));
+  result = RunCommand(
+      kColmap + " mapper --database_path " + db + " --image_path " +
+      dataset_path + "/images --output_path " + dir.File("sparse") +
+      " --Mapper.num_threads 2" + " --Mapper.ba_refine_focal_length 0");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  colmap::Reconstruction reconstruction;
+  reconstruction.Read(dir.File("sparse/0"));
+  EXPECT_EQ(reconstruction.NumRegImages(), 4u);
+}
+
+// Bad stereo pairs: one clear error naming the station; the database is left exactly as it was.
+TEST(FrontEndTest, BadInputNamesTheStationAndLeavesTheDatabaseUnchanged) {
+  testing::ScopedTempDir dir;
+  const std::string dataset_path =
+      Simulate(dir, "dataset", 3, "fixed_rotation", 0.3);
+  const std::string db = dir.File("db.db");
+  ASSERT_EQ(
+      RunCommand(kCli + " database_creator --database_path " + db).exit_code,
+      0);
+  const std::string before = FileBytes(db);
+  const std::string import = kCli + " import_dataset --dataset_path " +
+                             dataset_path + " --database_path " + db + kSift;
+  const std::string stereo = kCli + " stereo_depth --dataset_path " +
+                             dataset_path + " --output_path " +
+                             dir.File("stereo");
+  const std::string right_001 = dataset_path + "/images/right/001.png";
+  const std::string saved = FileBytes(right_001);
+  auto expect_error = [&](const std::string& command,
+                          const std::vector<std::string>& needles) {
+    const auto result = RunCommand(command);
+    EXPECT_NE(result.exit_code, 0) << command;
+    for (const std::string& needle : needles) {
+      EXPECT_NE(result.output.find(needle), std::string::npos)
+          << "'" << needle << "' not in: " << result.output;
+    }
+    EXPECT_EQ(FileBytes(db), before) << "the database changed: " << command;
+    EXPECT_FALSE(fs::exists(db + ".import-partial"));
+  };
+
+  // Mismatched sizes.
+  cv::Mat right = cv::imread(right_001);
+  cv::Mat smaller;
+  cv::resize(right, smaller, cv::Size(right.cols - 8, right.rows));
+  cv::imwrite(right_001, smaller);
+  expect_error(import, {"station 001", "right image"});
+  expect_error(stereo, {"station 001"});
+  EXPECT_FALSE(fs::exists(dir.File("stereo/stereo.json")));
+
+  // Unreadable image.
+  std::ofstream(right_001, std::ios::binary) << "not a png";
+  expect_error(import, {"station 001", "cannot read"});
+  expect_error(stereo, {"station 001", "cannot read"});
+
+  // Missing right image.
+  fs::remove(right_001);
+  expect_error(import, {"001.png"});
+
+  // Unknown camera model in rig.json.
+  std::ofstream(right_001, std::ios::binary) << saved;
+  const std::string rig = FileBytes(dataset_path + "/rig.json");
+  std::string bad_rig = rig;
+  const size_t at = bad_rig.find("PINHOLE");
+  ASSERT_NE(at, std::string::npos);
+  bad_rig.replace(at, 7, "PINHOLEX");
+  std::ofstream(dataset_path + "/rig.json") << bad_rig;
+  expect_error(import, {"rig.json", "PINHOLEX"});
+  std::ofstream(dataset_path + "/rig.json") << rig;
+
+  // The repaired dataset imports.
+  const auto result = RunCommand(import);
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+}
+
+}  // namespace
+}  // namespace colmap_lidar
