@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <ceres/cost_function.h>
 #include <ceres/crs_matrix.h>
 
 #include <cmath>
@@ -50,6 +51,7 @@ bool ObservabilityOptions::Check() const {
   CHECK_OPTION_GT(unobservable_translation_mm, 0);
   CHECK_OPTION_GT(unobservable_rotation_deg, 0);
   CHECK_OPTION_GE(min_rotation_deg, 0);
+  CHECK_OPTION_GE(stereo_scale_sigma, 0);
   CHECK_OPTION_GT(max_parallel_axes_deg, 0);
   return true;
 }
@@ -115,6 +117,9 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     double* cam_from_lidar_rotation,
     double* cam_from_lidar_translation,
     const std::array<bool, 3>& held_translation,
+    const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
+    const std::unordered_map<ceres::ResidualBlockId, double>&
+        depth_scale_derivative,
     const MotionAnalysis& motion,
     const ObservabilityOptions& options) {
   ExtrinsicUncertainty result;
@@ -156,12 +161,33 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
   }
   const int num_extrinsic = static_cast<int>(extrinsic_index.size());
 
+  // Rows in cluster order.
+  std::vector<ceres::ResidualBlockId> residual_blocks;
+  std::vector<int> row_cluster;
+  std::vector<double> row_scale_derivative;
+  for (size_t c = 0; c < clusters.size(); ++c) {
+    for (const ceres::ResidualBlockId id : clusters[c]) {
+      residual_blocks.push_back(id);
+      const int num_residuals =
+          problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+      row_cluster.insert(row_cluster.end(), num_residuals, static_cast<int>(c));
+      const auto derivative = depth_scale_derivative.find(id);
+      row_scale_derivative.insert(row_scale_derivative.end(),
+                                  num_residuals,
+                                  derivative == depth_scale_derivative.end()
+                                      ? 0.0
+                                      : derivative->second);
+    }
+  }
   ceres::Problem::EvaluateOptions evaluate_options;
   evaluate_options.parameter_blocks = ordered;
+  evaluate_options.residual_blocks = residual_blocks;
   evaluate_options.num_threads = 2;
   double cost = 0;
+  std::vector<double> residuals;
   ceres::CRSMatrix crs;
-  problem->Evaluate(evaluate_options, &cost, nullptr, nullptr, &crs);
+  problem->Evaluate(evaluate_options, &cost, &residuals, nullptr, &crs);
+  THROW_CHECK_EQ(static_cast<size_t>(crs.num_rows), row_cluster.size());
   THROW_CHECK_EQ(crs.num_cols, num_other + num_extrinsic);
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(crs.values.size());
@@ -206,20 +232,86 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
   }
   const int redundancy = crs.num_rows - crs.num_cols;
   result.variance_factor = redundancy > 0 ? 2 * cost / redundancy : 1.0;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(info);
-  // Ascending information = descending standard deviation; store std devs ascending.
-  Eigen::Matrix<double, 6, 1> std_devs;
-  for (int k = 0; k < 6; ++k) {
-    const double lambda = std::max(eigen.eigenvalues()[k], 1e-30);
-    std_devs[k] = std::sqrt(result.variance_factor / lambda);
+  // Formal covariance: the pseudo-inverse of the marginal information (unobservable -> huge).
+  const auto covariance_from_information =
+      [](const Eigen::Matrix<double, 6, 6>& information, double factor) {
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(
+            information);
+        Eigen::Matrix<double, 6, 6> covariance =
+            Eigen::Matrix<double, 6, 6>::Zero();
+        for (int k = 0; k < 6; ++k) {
+          const double lambda = std::max(eigen.eigenvalues()[k], 1e-30);
+          covariance += factor / lambda * eigen.eigenvectors().col(k) *
+                        eigen.eigenvectors().col(k).transpose();
+        }
+        return covariance;
+      };
+  result.formal_covariance =
+      covariance_from_information(info, result.variance_factor);
+  result.covariance = result.formal_covariance;
+
+  // Cluster-robust (sandwich) covariance: X = H^-1 E (E selects T_e), v_c = (J_c X)^T r_c.
+  Eigen::SparseMatrix<double> regularised = information;
+  for (int i = 0; i < regularised.rows(); ++i)
+    regularised.coeffRef(i, i) += 1e-12;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> full(regularised);
+  if (full.info() == Eigen::Success && clusters.size() > 1) {
+    Eigen::MatrixXd selector =
+        Eigen::MatrixXd::Zero(crs.num_cols, num_extrinsic);
+    for (int a = 0; a < num_extrinsic; ++a) selector(num_other + a, a) = 1;
+    const Eigen::MatrixXd x = full.solve(selector);
+    const Eigen::MatrixXd y = jacobian * x;
+    std::vector<Eigen::VectorXd> scores(clusters.size(),
+                                        Eigen::VectorXd::Zero(num_extrinsic));
+    Eigen::VectorXd scale_sensitivity = Eigen::VectorXd::Zero(num_extrinsic);
+    for (int row = 0; row < crs.num_rows; ++row) {
+      scores[row_cluster[row]] += y.row(row).transpose() * residuals[row];
+      // dx = -H^-1 J^T dr/ds: T_e's response to a common stereo scale error.
+      scale_sensitivity -= y.row(row).transpose() * row_scale_derivative[row];
+    }
+    for (int a = 0; a < num_extrinsic; ++a) {
+      result.stereo_scale_sensitivity[extrinsic_index[a]] =
+          scale_sensitivity[a] * unit(extrinsic_index[a]);
+    }
+    const double num_clusters = static_cast<double>(clusters.size());
+    Eigen::MatrixXd sandwich =
+        Eigen::MatrixXd::Zero(num_extrinsic, num_extrinsic);
+    for (const Eigen::VectorXd& score : scores)
+      sandwich += score * score.transpose();
+    sandwich *= num_clusters / (num_clusters - 1);
+    if (sandwich.allFinite()) {
+      Eigen::Matrix<double, 6, 6> robust = Eigen::Matrix<double, 6, 6>::Zero();
+      for (int a = 0; a < num_extrinsic; ++a) {
+        for (int b = 0; b < num_extrinsic; ++b) {
+          robust(extrinsic_index[a], extrinsic_index[b]) =
+              sandwich(a, b) * unit(extrinsic_index[a]) *
+              unit(extrinsic_index[b]);
+        }
+      }
+      // Directions the formal information calls unobservable stay unobservable.
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> formal(
+          result.formal_covariance);
+      for (int k = 0; k < 6; ++k) {
+        if (formal.eigenvalues()[k] > 1e6) {
+          robust += formal.eigenvalues()[k] * formal.eigenvectors().col(k) *
+                    formal.eigenvectors().col(k).transpose();
+        }
+      }
+      result.covariance =
+          robust + options.stereo_scale_sigma * options.stereo_scale_sigma *
+                       result.stereo_scale_sensitivity *
+                       result.stereo_scale_sensitivity.transpose();
+      result.cluster_robust = true;
+      result.num_clusters = static_cast<int>(clusters.size());
+    }
   }
-  result.covariance.setZero();
-  for (int k = 0; k < 6; ++k) {
-    result.covariance += std_devs[k] * std_devs[k] *
-                         eigen.eigenvectors().col(k) *
-                         eigen.eigenvectors().col(k).transpose();
-    result.eigenvalues[5 - k] = std_devs[k];
-    result.eigenvectors.col(5 - k) = eigen.eigenvectors().col(k);
+
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(
+      result.covariance);
+  for (int k = 0; k < 6;
+       ++k) {  // eigen values ascending: store std devs ascending
+    result.eigenvalues[k] = std::sqrt(std::max(eigen.eigenvalues()[k], 0.0));
+    result.eigenvectors.col(k) = eigen.eigenvectors().col(k);
   }
   result.computed = true;
 

@@ -1,8 +1,11 @@
 // Observability of the camera-LiDAR extrinsic T_e = cam_from_lidar after the joint solve:
-// - its 6x6 covariance, marginalised from the joint problem's Gauss-Newton information (J^T J with
-//   every other variable block eliminated by a Schur complement), scaled by the a-posteriori variance
-//   factor, with its eigen-decomposition; directions whose standard deviation exceeds a threshold are
-//   named in words;
+// - its 6x6 covariance from the joint problem's Gauss-Newton information H = J^T J (every other variable
+//   block marginalised). Two estimates: the formal one, H^-1 scaled by the a-posteriori variance factor,
+//   assumes independent residuals; the reported one is cluster-robust (a sandwich H^-1 (sum_c g_c g_c^T)
+//   H^-1 with g_c = J_c^T r_c summed per cluster: a LiDAR station pair, an image's depth priors, a
+//   landmark's reprojections), because residuals of one cluster share errors (a stereo depth bias, a
+//   LiDAR surface) and the formal covariance is then several times too optimistic. Directions whose
+//   standard deviation exceeds a threshold are named in words;
 // - the seed's uniqueness test on the relative motions: T_e is unique only with >= 3 stations whose
 //   relative rotation axes are not all parallel (hand-eye calibration, AX = XB).
 // Units: rotation as a rotation vector about the camera axes in degrees (Ceres' EigenQuaternionManifold
@@ -16,6 +19,7 @@
 
 #include <array>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace colmap_lidar {
@@ -24,6 +28,10 @@ struct ObservabilityOptions {
   // A direction of T_e whose standard deviation exceeds these is called unobservable.
   double unobservable_translation_mm = 5.0;
   double unobservable_rotation_deg = 0.2;
+  // Systematic relative scale error of the stereo depth (baseline/focal calibration, sub-pixel bias),
+  // a "consider" parameter: its effect on T_e, sigma^2 * s s^T with s = dT_e/dscale, is added to the
+  // covariance (random residual scatter cannot reveal an error common to every depth prior).
+  double stereo_scale_sigma = 0.001;
   double min_rotation_deg =
       2.0;  // relative rotations below this do not count as rotating
   double max_parallel_axes_deg = 5.0;  // axes closer than this are parallel
@@ -34,9 +42,17 @@ struct ObservabilityOptions {
 struct ExtrinsicUncertainty {
   bool computed = false;
   std::string message;  // why not, if not computed
-  // 6x6 covariance of (rotation vector [deg] about the camera axes, translation [mm]) of cam_from_lidar,
-  // scaled by the a-posteriori variance factor (see variance_factor).
+  // 6x6 covariance of (rotation vector [deg] about the camera axes, translation [mm]) of cam_from_lidar:
+  // cluster-robust if it could be computed (see cluster_robust), else the formal one.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> formal_covariance =
+      Eigen::Matrix<double, 6, 6>::Zero();
+  bool cluster_robust = false;
+  // Rotation [deg] and translation [mm] of T_e per unit of relative stereo scale error (the consider
+  // parameter); its contribution stereo_scale_sigma^2 s s^T is included in `covariance`.
+  Eigen::Matrix<double, 6, 1> stereo_scale_sensitivity =
+      Eigen::Matrix<double, 6, 1>::Zero();
+  int num_clusters = 0;
   double variance_factor = 1;  // 2 cost / (residuals - parameters)
   Eigen::Matrix<double, 6, 1> eigenvalues =
       Eigen::Matrix<double, 6, 1>::Zero();  // std devs, ascending
@@ -64,12 +80,17 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
 // Marginal covariance of T_e's blocks in `problem` (both must be variable parameter blocks; the rotation
 // with a quaternion manifold of tangent size 3, the translation possibly with a subset manifold).
 // `motion` turns unobservable directions into advice.
+// `depth_scale_derivative`: d(residual)/d(stereo scale) of each depth-prior block (-d / sigma_d).
+// `clusters`: every residual block of the problem, grouped (see above).
 // `held_translation`: translation components held constant by a subset manifold (known exactly).
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     ceres::Problem* problem,
     double* cam_from_lidar_rotation,
     double* cam_from_lidar_translation,
     const std::array<bool, 3>& held_translation,
+    const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
+    const std::unordered_map<ceres::ResidualBlockId, double>&
+        depth_scale_derivative,
     const MotionAnalysis& motion,
     const ObservabilityOptions& options);
 

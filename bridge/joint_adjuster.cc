@@ -63,6 +63,11 @@ struct JointProblem {
   std::vector<ceres::ResidualBlockId> reprojection_ids;
   std::vector<ceres::ResidualBlockId> depth_ids;
   std::vector<ceres::ResidualBlockId> lidar_ids;
+  std::vector<colmap::image_t> depth_images;  // parallel to depth_ids
+  std::vector<double>
+      depth_scale_derivatives;  // -d / sigma, parallel to depth_ids
+  std::vector<std::pair<colmap::image_t, colmap::image_t>>
+      lidar_pairs;  // parallel to lidar_ids
   colmap::BundleAdjustmentOptions ba_options;
 };
 
@@ -235,6 +240,9 @@ JointAdjustmentSummary JointAdjuster::Run(
           }
           const double sigma = prior->second.sigma * depth_scale;
           if (config.HasConstantCamPose(element.image_id)) {
+            joint->depth_images.push_back(element.image_id);
+            joint->depth_scale_derivatives.push_back(-prior->second.depth /
+                                                     sigma);
             joint->depth_ids.push_back(problem->AddResidualBlock(
                 DepthPriorConstantPoseCostFunctor::Create(
                     reconstruction->Image(element.image_id).CamFromWorld(),
@@ -244,6 +252,9 @@ JointAdjustmentSummary JointAdjuster::Run(
                 xyz));
           } else {
             const auto [rotation, translation] = pose_blocks(element.image_id);
+            joint->depth_images.push_back(element.image_id);
+            joint->depth_scale_derivatives.push_back(-prior->second.depth /
+                                                     sigma);
             joint->depth_ids.push_back(problem->AddResidualBlock(
                 DepthPriorCostFunctor::Create(prior->second.depth, sigma),
                 loss.get(),
@@ -280,6 +291,7 @@ JointAdjustmentSummary JointAdjuster::Run(
             pose_blocks(observation.target);
         const auto [source_rotation, source_translation] =
             pose_blocks(observation.source);
+        joint->lidar_pairs.emplace_back(observation.target, observation.source);
         joint->lidar_ids.push_back(
             problem->AddResidualBlock(LidarPointToPlaneCostFunctor::Create(
                                           observation.data.point_in_source,
@@ -421,10 +433,56 @@ JointAdjustmentSummary JointAdjuster::Run(
   summary.motion = AnalyseMotion(*reconstruction, options_.observability);
   if (use_lidar) {
     ceres::Problem* problem = last->problem.get();
+    // Clusters of residuals that share errors: a landmark's reprojections, an image's depth priors, a
+    // directed LiDAR station pair.
+    std::vector<std::vector<ceres::ResidualBlockId>> clusters;
+    {
+      std::unordered_map<const double*, size_t> landmark_cluster;
+      for (const auto& [point3D_id, point3D] : reconstruction->Points3D()) {
+        landmark_cluster.emplace(point3D.xyz.data(), landmark_cluster.size());
+      }
+      clusters.resize(landmark_cluster.size());
+      std::vector<double*> blocks;
+      for (const ceres::ResidualBlockId id : last->reprojection_ids) {
+        problem->GetParameterBlocksForResidualBlock(id, &blocks);
+        for (const double* block : blocks) {
+          const auto it = landmark_cluster.find(block);
+          if (it != landmark_cluster.end()) {
+            clusters[it->second].push_back(id);
+            break;
+          }
+        }
+      }
+      std::map<colmap::image_t, std::vector<ceres::ResidualBlockId>> per_image;
+      for (size_t k = 0; k < last->depth_ids.size(); ++k) {
+        per_image[last->depth_images[k]].push_back(last->depth_ids[k]);
+      }
+      std::map<std::pair<colmap::image_t, colmap::image_t>,
+               std::vector<ceres::ResidualBlockId>>
+          per_pair;
+      for (size_t k = 0; k < last->lidar_ids.size(); ++k) {
+        per_pair[last->lidar_pairs[k]].push_back(last->lidar_ids[k]);
+      }
+      for (auto& [image_id, ids] : per_image)
+        clusters.push_back(std::move(ids));
+      for (auto& [pair, ids] : per_pair) clusters.push_back(std::move(ids));
+      clusters.erase(
+          std::remove_if(clusters.begin(),
+                         clusters.end(),
+                         [](const auto& ids) { return ids.empty(); }),
+          clusters.end());
+    }
+    std::unordered_map<ceres::ResidualBlockId, double> depth_scale_derivative;
+    for (size_t k = 0; k < last->depth_ids.size(); ++k) {
+      depth_scale_derivative[last->depth_ids[k]] =
+          last->depth_scale_derivatives[k];
+    }
     summary.uncertainty = ComputeExtrinsicUncertainty(problem,
                                                       extrinsic_rotation,
                                                       extrinsic_translation,
                                                       options_.hold_translation,
+                                                      clusters,
+                                                      depth_scale_derivative,
                                                       summary.motion,
                                                       options_.observability);
 

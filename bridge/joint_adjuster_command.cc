@@ -105,6 +105,19 @@ void WriteReport(const std::string& directory,
   if (u.computed) {
     uncertainty["variance_factor"] = u.variance_factor;
     uncertainty["covariance_deg_mm"] = MatrixJson(u.covariance);
+    uncertainty["cluster_robust"] = u.cluster_robust;
+    uncertainty["stereo_scale_sigma"] =
+        options.observability.stereo_scale_sigma;
+    uncertainty["stereo_scale_sensitivity_deg_mm"] =
+        MatrixJson(u.stereo_scale_sensitivity.transpose());
+    uncertainty["num_clusters"] = u.num_clusters;
+    uncertainty["formal_covariance_deg_mm"] = MatrixJson(u.formal_covariance);
+    const Eigen::VectorXd formal_sigma =
+        u.formal_covariance.diagonal().cwiseSqrt();
+    uncertainty["formal_sigma_rotation_deg"] = {
+        formal_sigma[0], formal_sigma[1], formal_sigma[2]};
+    uncertainty["formal_sigma_translation_mm"] = {
+        formal_sigma[3], formal_sigma[4], formal_sigma[5]};
     const Eigen::VectorXd sigma = u.covariance.diagonal().cwiseSqrt();
     uncertainty["sigma_rotation_deg"] = {sigma[0], sigma[1], sigma[2]};
     uncertainty["sigma_translation_mm"] = {sigma[3], sigma[4], sigma[5]};
@@ -226,6 +239,10 @@ int RunJointAdjuster(int argc, char** argv) {
   options.AddDefaultOption("max_num_iterations", &adjuster.max_num_iterations);
   options.AddDefaultOption("min_image_pair_inliers",
                            &data_options.min_image_pair_inliers);
+  options.AddDefaultOption("max_lidar_neighbors",
+                           &data_options.max_lidar_neighbors);
+  options.AddDefaultOption("stereo_scale_sigma",
+                           &adjuster.observability.stereo_scale_sigma);
   options.AddDefaultOption("unobservable_translation_mm",
                            &adjuster.observability.unobservable_translation_mm);
   options.AddDefaultOption("unobservable_rotation_deg",

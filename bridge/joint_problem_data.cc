@@ -43,6 +43,7 @@ bool JointDataOptions::Check() const {
   CHECK_OPTION_GT(lidar_overlap_distance_m, 0);
   CHECK_OPTION_GE(min_lidar_overlap, 0);
   CHECK_OPTION_GT(voxel_size_m, 0);
+  CHECK_OPTION_GT(max_lidar_neighbors, 0);
   return true;
 }
 
@@ -124,8 +125,11 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(
               << " after " << options.voxel_size_m << " m voxels" << std::endl;
   }
 
-  // A_l: overlapping clouds under the initial estimate.
-  size_t num_lidar_pairs = 0;
+  // A_l: overlapping clouds under the initial estimate; each station keeps its `max_lidar_neighbors`
+  // most overlapping partners (all stations of a courtyard overlap; the term needs a connected graph,
+  // not every pair).
+  std::vector<std::vector<std::pair<double, size_t>>> partners(
+      image_ids.size());
   for (size_t a = 0; a < image_ids.size(); ++a) {
     for (size_t b = a + 1; b < image_ids.size(); ++b) {
       const colmap::Rigid3d lidar_a_from_lidar_b =
@@ -133,16 +137,29 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(
           reconstruction.Image(image_ids[a]).CamFromWorld() *
           colmap::Inverse(reconstruction.Image(image_ids[b]).CamFromWorld()) *
           cam_from_lidar;
-      if (Overlap(*loaded->data.clouds.at(image_ids[a]),
-                  *loaded->data.clouds.at(image_ids[b]),
-                  lidar_a_from_lidar_b,
-                  options.lidar_overlap_distance_m) >=
-          options.min_lidar_overlap) {
-        ++num_lidar_pairs;
-        pairs.insert({image_ids[a], image_ids[b]});
+      const double overlap = Overlap(*loaded->data.clouds.at(image_ids[a]),
+                                     *loaded->data.clouds.at(image_ids[b]),
+                                     lidar_a_from_lidar_b,
+                                     options.lidar_overlap_distance_m);
+      if (overlap >= options.min_lidar_overlap) {
+        partners[a].emplace_back(overlap, b);
+        partners[b].emplace_back(overlap, a);
       }
     }
   }
+  std::set<std::pair<colmap::image_t, colmap::image_t>> lidar_pairs;
+  for (size_t a = 0; a < image_ids.size(); ++a) {
+    std::sort(partners[a].rbegin(), partners[a].rend());
+    for (size_t k = 0; k < partners[a].size() &&
+                       k < static_cast<size_t>(options.max_lidar_neighbors);
+         ++k) {
+      const colmap::image_t other = image_ids[partners[a][k].second];
+      lidar_pairs.insert(
+          {std::min(image_ids[a], other), std::max(image_ids[a], other)});
+    }
+  }
+  const size_t num_lidar_pairs = lidar_pairs.size();
+  pairs.insert(lidar_pairs.begin(), lidar_pairs.end());
   loaded->num_lidar_pairs = num_lidar_pairs;
   loaded->data.pairs.assign(pairs.begin(), pairs.end());
   std::cout << "Pose graph: " << loaded->num_image_pairs

@@ -3,8 +3,8 @@
 // A_c v A_l:
 // - A_c: image pairs that COLMAP verified with at least `min_image_pair_inliers` inlier matches;
 // - A_l: station pairs whose clouds overlap under the initial poses and T_e (a fraction of sampled source
-//   points has a target neighbour within `lidar_overlap_distance_m`), so that LiDAR bridges images that
-//   do not overlap.
+//   points has a target neighbour within `lidar_overlap_distance_m`), the `max_lidar_neighbors` most
+//   overlapping per station, so that LiDAR bridges images that do not overlap.
 #pragma once
 
 #include "bridge/joint_adjuster.h"
@@ -19,7 +19,8 @@ struct JointDataOptions {
   int min_image_pair_inliers = 15;
   double lidar_overlap_distance_m = 0.2;
   double min_lidar_overlap = 0.3;
-  double voxel_size_m = 0.05;  // clouds for the LiDAR term
+  int max_lidar_neighbors = 4;  // most overlapping partners kept per station
+  double voxel_size_m = 0.05;   // clouds for the LiDAR term
 
   bool Check() const;
 };

@@ -77,7 +77,7 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
   ASSERT_TRUE(fs::exists(dir.File("stereo/stereo.json")));
 
   // Depth maps against the simulator's true depth maps, pixel by pixel.
-  std::vector<double> pixel_errors;
+  std::vector<double> pixel_errors, signed_pixel_errors;
   size_t num_true = 0, num_valid = 0;
   for (const std::string& station : dataset.stations) {
     colmap::mvs::DepthMap truth, depth;
@@ -97,6 +97,7 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
         if (z <= 0) continue;
         ++num_valid;
         pixel_errors.push_back(std::abs(z - z_true) / z_true);
+        signed_pixel_errors.push_back((z - z_true) / z_true);
       }
     }
   }
@@ -104,7 +105,8 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
   std::cout << "stereo depth: " << 100 * pixel_fraction
             << " % of pixels with depth; relative error median "
             << 100 * Quantile(pixel_errors, 0.5) << " %, 90th percentile "
-            << 100 * Quantile(pixel_errors, 0.9) << " %" << std::endl;
+            << 100 * Quantile(pixel_errors, 0.9) << " %; signed median "
+            << 100 * Quantile(signed_pixel_errors, 0.5) << " %" << std::endl;
   EXPECT_GT(pixel_fraction, 0.6);
   EXPECT_LT(Quantile(pixel_errors, 0.5), 0.005);
 
@@ -124,7 +126,7 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
   const colmap::Database database(dir.File("db.db"));
   const ExtensionDatabase extension(dir.File("db.db"),
                                     ExtensionDatabase::Mode::kReadOnly);
-  std::vector<double> relative_errors, normalised_errors;
+  std::vector<double> relative_errors, normalised_errors, signed_errors;
   size_t num_keypoints = 0, num_priors = 0;
   for (const colmap::Image& image : database.ReadAllImages()) {
     const std::string station = fs::path(image.Name()).stem().string();
@@ -154,6 +156,7 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
       }
       const double z_true = hit.t / ray_in_cam.norm();  // ray_in_cam has z = 1
       relative_errors.push_back(std::abs(prior.depth - z_true) / z_true);
+      signed_errors.push_back((prior.depth - z_true) / z_true);
       normalised_errors.push_back(std::abs(prior.depth - z_true) / prior.sigma);
     }
   }
@@ -164,7 +167,8 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
             << 100 * Quantile(relative_errors, 0.5)
             << " %; |error|/sigma_d median " << Quantile(normalised_errors, 0.5)
             << ", 95th percentile " << Quantile(normalised_errors, 0.95)
-            << " (ratio of observed error to sigma_d)" << std::endl;
+            << " (ratio of observed error to sigma_d); signed median "
+            << 100 * Quantile(signed_errors, 0.5) << " %" << std::endl;
   EXPECT_GE(fraction, 0.6);
   EXPECT_LE(Quantile(relative_errors, 0.5), 0.005);
   // sigma_d with sigma_p = 1 px must not be optimistic: 95 % of errors within 2 sigma.
