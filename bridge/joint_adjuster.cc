@@ -1,5 +1,6 @@
 #include "bridge/joint_adjuster.h"
 
+#include "bridge/extrinsic_prior_cost.h"
 #include "bridge/lidar_point_to_plane_cost.h"
 #include "colmap_ext/depth_prior_cost.h"
 #include "colmap_ext/logging.h"
@@ -66,6 +67,7 @@ struct JointProblem {
   std::vector<colmap::image_t> depth_images;  // parallel to depth_ids
   std::vector<double>
       depth_scale_derivatives;  // -d / sigma, parallel to depth_ids
+  std::vector<ceres::ResidualBlockId> prior_ids;
   std::vector<std::pair<colmap::image_t, colmap::image_t>>
       lidar_pairs;  // parallel to lidar_ids
   colmap::BundleAdjustmentOptions ba_options;
@@ -106,6 +108,7 @@ bool JointAdjusterOptions::Check() const {
   CHECK_OPTION_GE(num_association_rounds, 1);
   CHECK_OPTION_GE(initial_association_distance_m, association.max_distance);
   CHECK_OPTION_GT(max_num_iterations, 0);
+  CHECK_OPTION_GE(extrinsic_prior_sigma_m, 0);
   association.Check();
   observability.Check();
   return true;
@@ -175,6 +178,7 @@ JointAdjustmentSummary JointAdjuster::Run(
   const bool refine_extrinsic = options_.mode == JointMode::kJoint;
   double* extrinsic_rotation = cam_from_lidar->rotation.coeffs().data();
   double* extrinsic_translation = cam_from_lidar->translation.data();
+  const Eigen::Vector3d initial_translation = cam_from_lidar->translation;
 
   // Losses are owned here (COLMAP's problem does not take ownership).
   const std::unique_ptr<ceres::LossFunction> loss =
@@ -282,6 +286,13 @@ JointAdjustmentSummary JointAdjuster::Run(
         problem->SetParameterBlockConstant(extrinsic_translation);
       } else if (!held.empty()) {
         colmap::SetSubsetManifold(3, held, problem, extrinsic_translation);
+      }
+      if (refine_extrinsic && held.size() < 3 &&
+          options_.extrinsic_prior_sigma_m > 0) {
+        joint->prior_ids.push_back(problem->AddResidualBlock(
+            ExtrinsicTranslationPriorCostFunctor::Create(
+                initial_translation, options_.extrinsic_prior_sigma_m),
+            nullptr, extrinsic_translation));
       }
       const double sigma =
           options_.sigma_lidar_m / std::sqrt(options_.lidar_weight);
@@ -466,6 +477,7 @@ JointAdjustmentSummary JointAdjuster::Run(
       for (auto& [image_id, ids] : per_image)
         clusters.push_back(std::move(ids));
       for (auto& [pair, ids] : per_pair) clusters.push_back(std::move(ids));
+      clusters.push_back(last->prior_ids);
       clusters.erase(
           std::remove_if(clusters.begin(),
                          clusters.end(),

@@ -73,6 +73,9 @@ struct JointAdjusterOptions {
   // translation per camera axis.
   bool hold_rotation = false;
   std::array<bool, 3> hold_translation = {false, false, false};
+  // Weak prior on T_e's translation at its initial value (bridge/extrinsic_prior_cost.h): keeps an
+  // unobservable direction where it started instead of letting it drift; 0 = off.
+  double extrinsic_prior_sigma_m = 1.0;
   int max_num_iterations = 100;
   ObservabilityOptions observability;
 

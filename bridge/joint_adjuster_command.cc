@@ -237,6 +237,8 @@ int RunJointAdjuster(int argc, char** argv) {
                            &hold_translation,
                            "comma-separated camera axes, e.g. y or x,z");
   options.AddDefaultOption("max_num_iterations", &adjuster.max_num_iterations);
+  options.AddDefaultOption("extrinsic_prior_sigma_m",
+                           &adjuster.extrinsic_prior_sigma_m);
   options.AddDefaultOption("min_image_pair_inliers",
                            &data_options.min_image_pair_inliers);
   options.AddDefaultOption("max_lidar_neighbors",
