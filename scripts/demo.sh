@@ -19,16 +19,21 @@ mkdir -p "$kWorkspace"
 $cli simulate_dataset --scene t_specimen --output_path "$kWorkspace/dataset" \
   --lidar_points "${LIDAR_POINTS:-400000}" --overwrite 1
 
-echo "== 2. a COLMAP database with colmap-lidar's tables"
+echo "== 2. stereo depth per station (OpenCV SGBM, left-right check; depth in the left image grid)"
+$cli stereo_depth --dataset_path "$kWorkspace/dataset" --output_path "$kWorkspace/stereo"
+
+echo "== 3. import into a COLMAP database (camera from rig.json, COLMAP SIFT + matching, rig, LiDAR frames)"
 rm -f "$kWorkspace/database.db"
-$cli database_creator --database_path "$kWorkspace/database.db"
+$cli import_dataset --dataset_path "$kWorkspace/dataset" --database_path "$kWorkspace/database.db" \
+  2>&1 | grep -v '^I20'
+$cli depth_prior_extractor --database_path "$kWorkspace/database.db" --depth_path "$kWorkspace/stereo"
 $cli database_info --database_path "$kWorkspace/database.db"
 
-echo "== 3. LiDAR registration and pose graph (BSC + RANSAC + ICP; each station with its 4 most similar)"
+echo "== 4. LiDAR registration and pose graph (BSC + RANSAC + ICP; each station with its 4 most similar)"
 $cli lidar_registrator --lidar_path "$kWorkspace/dataset/lidar" --output_path "$kWorkspace/lidar" \
   --max_neighbors 4
 
-echo "== 4. the evaluator on the ground truth (the reference every model is measured against)"
+echo "== 5. the evaluator on the ground truth (the reference every model is measured against)"
 $cli evaluate_model --model_path "$kWorkspace/dataset/ground_truth/surface.ply" \
   --ground_truth_path "$kWorkspace/dataset/ground_truth/surface.ply" --output_path "$kWorkspace/eval_truth"
 
@@ -36,8 +41,9 @@ cat <<MSG
 
 == Summary ($((SECONDS - start)) s)
   dataset          $kWorkspace/dataset (25 stations; images, LiDAR clouds, ground truth)
-  database         $kWorkspace/database.db (COLMAP's tables + depth_priors, lidar_frames, rig)
+  stereo depth     $kWorkspace/stereo/{depth_maps,confidence_maps,previews}/, stereo.json
+  database         $kWorkspace/database.db (COLMAP's images, SIFT, matches + depth_priors, lidar_frames, rig)
   LiDAR graph      $kWorkspace/lidar/{pairs.txt, lidar_poses.txt, summary.txt}
-  not yet built    import_dataset, stereo_depth, depth_prior_extractor, pose_initializer,
-                   joint_adjuster, densifier, pipeline (issues 5-8)
+  not yet built    pose_initializer and pipeline (issue 7: joint_adjuster needs an initial model),
+                   densifier (issue 8)
 MSG
