@@ -73,6 +73,20 @@ struct JointProblem {
   colmap::BundleAdjustmentOptions ba_options;
 };
 
+// The depth prior of a landmark observation, unless it has none or was found an outlier.
+const DepthPrior* FindDepthPrior(const JointProblemData& data,
+                                 const std::set<ImagePoint>& outliers,
+                                 const colmap::TrackElement& element) {
+  const auto image_priors = data.depth_priors.find(element.image_id);
+  if (image_priors == data.depth_priors.end()) return nullptr;
+  const auto prior = image_priors->second.find(element.point2D_idx);
+  if (prior == image_priors->second.end() ||
+      outliers.count({element.image_id, element.point2D_idx})) {
+    return nullptr;
+  }
+  return &prior->second;
+}
+
 }  // namespace
 
 JointMode JointModeFromName(const std::string& name) {
@@ -235,32 +249,26 @@ JointAdjustmentSummary JointAdjuster::Run(
       for (const auto& [point3D_id, point3D] : reconstruction->Points3D()) {
         double* xyz = reconstruction->Point3D(point3D_id).xyz.data();
         for (const colmap::TrackElement& element : point3D.track.Elements()) {
-          const auto image_priors = data_.depth_priors.find(element.image_id);
-          if (image_priors == data_.depth_priors.end()) continue;
-          const auto prior = image_priors->second.find(element.point2D_idx);
-          if (prior == image_priors->second.end() ||
-              depth_outliers.count({element.image_id, element.point2D_idx})) {
-            continue;
-          }
-          const double sigma = prior->second.sigma * depth_scale;
+          const DepthPrior* prior =
+              FindDepthPrior(data_, depth_outliers, element);
+          if (prior == nullptr) continue;
+          const double sigma = prior->sigma * depth_scale;
           if (config.HasConstantCamPose(element.image_id)) {
             joint->depth_images.push_back(element.image_id);
-            joint->depth_scale_derivatives.push_back(-prior->second.depth /
-                                                     sigma);
+            joint->depth_scale_derivatives.push_back(-prior->depth / sigma);
             joint->depth_ids.push_back(problem->AddResidualBlock(
                 DepthPriorConstantPoseCostFunctor::Create(
                     reconstruction->Image(element.image_id).CamFromWorld(),
-                    prior->second.depth,
+                    prior->depth,
                     sigma),
                 loss.get(),
                 xyz));
           } else {
             const auto [rotation, translation] = pose_blocks(element.image_id);
             joint->depth_images.push_back(element.image_id);
-            joint->depth_scale_derivatives.push_back(-prior->second.depth /
-                                                     sigma);
+            joint->depth_scale_derivatives.push_back(-prior->depth / sigma);
             joint->depth_ids.push_back(problem->AddResidualBlock(
-                DepthPriorCostFunctor::Create(prior->second.depth, sigma),
+                DepthPriorCostFunctor::Create(prior->depth, sigma),
                 loss.get(),
                 rotation,
                 translation,
@@ -292,7 +300,8 @@ JointAdjustmentSummary JointAdjuster::Run(
         joint->prior_ids.push_back(problem->AddResidualBlock(
             ExtrinsicTranslationPriorCostFunctor::Create(
                 initial_translation, options_.extrinsic_prior_sigma_m),
-            nullptr, extrinsic_translation));
+            nullptr,
+            extrinsic_translation));
       }
       const double sigma =
           options_.sigma_lidar_m / std::sqrt(options_.lidar_weight);
@@ -383,16 +392,11 @@ JointAdjustmentSummary JointAdjuster::Run(
                                           element.point2D_idx);
             continue;
           }
-          const auto image_priors = data_.depth_priors.find(element.image_id);
-          if (image_priors == data_.depth_priors.end()) continue;
-          const auto prior = image_priors->second.find(element.point2D_idx);
-          if (prior == image_priors->second.end() ||
-              depth_outliers.count({element.image_id, element.point2D_idx})) {
-            continue;
-          }
+          const DepthPrior* prior =
+              FindDepthPrior(data_, depth_outliers, element);
+          if (prior == nullptr) continue;
           const double depth = (image.CamFromWorld() * point3D.xyz).z();
-          if (std::abs(depth - prior->second.depth) >
-              options_.max_depth_error_m) {
+          if (std::abs(depth - prior->depth) > options_.max_depth_error_m) {
             depth_outliers.insert({element.image_id, element.point2D_idx});
             ++new_outliers;
           }

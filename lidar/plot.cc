@@ -20,6 +20,20 @@ std::string Format(double value) {
   return out.str();
 }
 
+void PutText(cv::Mat* canvas,
+             const std::string& text,
+             const cv::Point& origin,
+             double scale) {
+  cv::putText(*canvas,
+              text,
+              origin,
+              cv::FONT_HERSHEY_SIMPLEX,
+              scale,
+              cv::Scalar(0, 0, 0),
+              1,
+              cv::LINE_AA);
+}
+
 void WritePngAtomically(const std::string& path, const cv::Mat& canvas) {
   const std::string tmp = path + ".tmp" + std::to_string(::getpid()) + ".png";
   if (!cv::imwrite(tmp, canvas))
@@ -104,39 +118,15 @@ void WriteLinePlotPng(const std::string& path,
              {kLeft + plot_w + 35, legend_y - 4},
              colour,
              2);
-    cv::putText(canvas,
-                s.label,
-                {kLeft + plot_w + 40, legend_y},
-                cv::FONT_HERSHEY_SIMPLEX,
-                0.45,
-                black,
-                1,
-                cv::LINE_AA);
+    PutText(&canvas, s.label, {kLeft + plot_w + 40, legend_y}, 0.45);
   }
-  cv::putText(canvas,
-              options.title,
-              {kLeft, 30},
-              cv::FONT_HERSHEY_SIMPLEX,
-              0.6,
-              black,
-              1,
-              cv::LINE_AA);
-  cv::putText(canvas,
-              options.x_label,
-              {kLeft + plot_w / 2 - 60, kHeight - 12},
-              cv::FONT_HERSHEY_SIMPLEX,
-              0.5,
-              black,
-              1,
-              cv::LINE_AA);
-  cv::putText(canvas,
-              options.y_label + (options.log_y ? " (log)" : ""),
-              {5, kTop - 10},
-              cv::FONT_HERSHEY_SIMPLEX,
-              0.45,
-              black,
-              1,
-              cv::LINE_AA);
+  PutText(&canvas, options.title, {kLeft, 30}, 0.6);
+  PutText(
+      &canvas, options.x_label, {kLeft + plot_w / 2 - 60, kHeight - 12}, 0.5);
+  PutText(&canvas,
+          options.y_label + (options.log_y ? " (log)" : ""),
+          {5, kTop - 10},
+          0.45);
   WritePngAtomically(path, canvas);
 }
 
@@ -207,22 +197,12 @@ void WriteHistogramPng(const std::string& path,
               cv::FONT_HERSHEY_SIMPLEX,
               0.45,
               black);
-  cv::putText(canvas,
-              options.title + "  (n = " + std::to_string(values.size()) + ")",
-              {kLeft, 30},
-              cv::FONT_HERSHEY_SIMPLEX,
-              0.6,
-              black,
-              1,
-              cv::LINE_AA);
-  cv::putText(canvas,
-              options.x_label,
-              {kLeft + plot_w / 2 - 60, kHeight - 12},
-              cv::FONT_HERSHEY_SIMPLEX,
-              0.5,
-              black,
-              1,
-              cv::LINE_AA);
+  PutText(&canvas,
+          options.title + "  (n = " + std::to_string(values.size()) + ")",
+          {kLeft, 30},
+          0.6);
+  PutText(
+      &canvas, options.x_label, {kLeft + plot_w / 2 - 60, kHeight - 12}, 0.5);
   WritePngAtomically(path, canvas);
 }
 
