@@ -65,6 +65,13 @@ const std::vector<Command>& Commands() {
        &RunJointAdjuster,
        "Joint bundle adjustment: poses, landmarks and cam_from_lidar with "
        "depth priors and LiDAR"},
+      {"pose_initializer",
+       &RunPoseInitializer,
+       "Initial station poses, cam_from_lidar and landmarks (a metric COLMAP "
+       "model)"},
+      {"pipeline",
+       &RunPipeline,
+       "Run every step on a dataset into a workspace (restartable)"},
       {"evaluate_model",
        &RunEvaluateModel,
        "Accuracy, completeness and density of a cloud against the true "

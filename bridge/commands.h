@@ -30,6 +30,13 @@ int RunLidarRegistrator(int argc, char** argv);
 // bundle adjuster on a sparse model; writes the refined model, cam_from_lidar.txt, report.json, plots.
 int RunJointAdjuster(int argc, char** argv);
 
+// Initial poses (image and LiDAR edges, hand-eye cam_from_lidar, spanning tree + pose graph) and
+// landmarks by COLMAP's triangulator: a metric COLMAP model for the joint adjuster.
+int RunPoseInitializer(int argc, char** argv);
+
+// Every step from a station dataset to the refined model, restartable (bridge/pipeline_commands.cc).
+int RunPipeline(int argc, char** argv);
+
 // Accuracy of a cloud against ground_truth/surface.ply: distances, completeness, density, plots.
 int RunEvaluateModel(int argc, char** argv);
 

@@ -6,9 +6,8 @@
 // information (1/sigma^2 = 1e-6 per mm^2) is negligible next to what the LiDAR gives an observable one.
 #pragma once
 
-#include <ceres/autodiff_cost_function.h>
-
 #include <Eigen/Core>
+#include <ceres/autodiff_cost_function.h>
 
 namespace colmap_lidar {
 

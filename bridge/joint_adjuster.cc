@@ -430,10 +430,10 @@ JointAdjustmentSummary JointAdjuster::Run(
       stats.seconds = std::chrono::duration<double>(
                           std::chrono::steady_clock::now() - start)
                           .count();
-      std::cout << std::setprecision(4) << "  solve " << stats.round << "."
-                << stats.outlier_iteration << ": cost reprojection "
-                << stats.reprojection.cost_before << " -> "
-                << stats.reprojection.cost_after << ", depth "
+      std::cout << std::defaultfloat << std::setprecision(4) << "  solve "
+                << stats.round << "." << stats.outlier_iteration
+                << ": cost reprojection " << stats.reprojection.cost_before
+                << " -> " << stats.reprojection.cost_after << ", depth "
                 << stats.depth.cost_before << " -> " << stats.depth.cost_after
                 << ", lidar " << stats.lidar.cost_before << " -> "
                 << stats.lidar.cost_after << "; " << stats.num_iterations

@@ -211,7 +211,8 @@ int RunJointAdjuster(int argc, char** argv) {
       "mode", &mode, "joint | precalibrated | stereo_only");
   options.AddDefaultOption("cam_from_lidar",
                            &cam_from_lidar_path,
-                           "qw qx qy qz tx ty tz file; default: rig.json's "
+                           "qw qx qy qz tx ty tz file; default: "
+                           "INPUT/cam_from_lidar.txt, else rig.json's "
                            "cam_from_lidar_guess");
   options.AddDefaultOption("write_text", &write_text);
   options.AddDefaultOption("sigma_lidar_m", &adjuster.sigma_lidar_m);
@@ -265,8 +266,12 @@ int RunJointAdjuster(int argc, char** argv) {
   THROW_CHECK_GE(reconstruction.NumRegImages(), 2)
       << input_path << " has fewer than 2 registered images";
   colmap::Rigid3d cam_from_lidar;
+  const std::string model_extrinsic =
+      (fs::path(input_path) / "cam_from_lidar.txt").string();
   if (!cam_from_lidar_path.empty()) {
     cam_from_lidar = ReadPoseFile(cam_from_lidar_path);
+  } else if (fs::exists(model_extrinsic)) {
+    cam_from_lidar = ReadPoseFile(model_extrinsic);  // pose_initializer's
   } else if (dataset.rig.cam_from_lidar_guess) {
     cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
   } else {

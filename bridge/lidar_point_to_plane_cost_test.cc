@@ -52,31 +52,38 @@ TEST(LidarPointToPlaneCost, ZeroOnThePlaneAndTheSignedDistanceOffIt) {
       normal_in_lidar_i.cross(Eigen::Vector3d(1, 0, 0)).normalized();
   const Eigen::Vector3d point_in_lidar_i = on_plane + 0.2 * tangent;
   double residual = 1;
-  std::unique_ptr<ceres::CostFunction> exact(LidarPointToPlaneCostFunctor::Create(
-      point_in_lidar_j, point_in_lidar_i, normal_in_lidar_i, 0.02));
+  std::unique_ptr<ceres::CostFunction> exact(
+      LidarPointToPlaneCostFunctor::Create(
+          point_in_lidar_j, point_in_lidar_i, normal_in_lidar_i, 0.02));
   std::vector<double*> blocks = setup.Blocks();
   ASSERT_TRUE(exact->Evaluate(blocks.data(), &residual, nullptr));
   EXPECT_NEAR(residual, 0, 1e-12);
   // 1 cm behind the plane (along -n) with sigma 2 cm: E_l = -0.5.
   std::unique_ptr<ceres::CostFunction> off(LidarPointToPlaneCostFunctor::Create(
-      point_in_lidar_j, point_in_lidar_i + 0.01 * normal_in_lidar_i,
-      normal_in_lidar_i, 0.02));
+      point_in_lidar_j,
+      point_in_lidar_i + 0.01 * normal_in_lidar_i,
+      normal_in_lidar_i,
+      0.02));
   ASSERT_TRUE(off->Evaluate(blocks.data(), &residual, nullptr));
   EXPECT_NEAR(residual, -0.5, 1e-9);
 }
 
 TEST(LidarPointToPlaneCost, AnalyticGradientsMatchNumericAtGenericPoses) {
   ThreeFrames setup;
-  std::unique_ptr<ceres::CostFunction> cost(LidarPointToPlaneCostFunctor::Create(
-      Eigen::Vector3d(1.3, -0.4, 0.7), Eigen::Vector3d(-0.2, 0.9, 1.4),
-      Eigen::Vector3d(0.3, 0.5, -0.8).normalized(), 0.02));
+  std::unique_ptr<ceres::CostFunction> cost(
+      LidarPointToPlaneCostFunctor::Create(
+          Eigen::Vector3d(1.3, -0.4, 0.7),
+          Eigen::Vector3d(-0.2, 0.9, 1.4),
+          Eigen::Vector3d(0.3, 0.5, -0.8).normalized(),
+          0.02));
   // Ambient quaternion coordinates: checks the autodiff derivative of the whole function.
   const std::vector<const ceres::Manifold*> manifolds(6, nullptr);
   ceres::NumericDiffOptions numeric_options;
   ceres::GradientChecker checker(cost.get(), &manifolds, numeric_options);
   ceres::GradientChecker::ProbeResults results;
   std::vector<double*> blocks = setup.Blocks();
-  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-7, &results)) << results.error_log;
+  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-7, &results))
+      << results.error_log;
 }
 
 }  // namespace

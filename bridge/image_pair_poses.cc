@@ -1,0 +1,128 @@
+#include "bridge/image_pair_poses.h"
+
+#include "colmap_ext/logging.h"
+
+#include <Eigen/Geometry>
+
+#include <random>
+
+namespace colmap_lidar {
+namespace {
+
+colmap::Rigid3d Umeyama(const Eigen::Matrix3Xd& target,
+                        const Eigen::Matrix3Xd& source) {
+  const Eigen::Matrix4d t =
+      Eigen::umeyama(source, target, /*with_scaling=*/false);
+  return colmap::Rigid3d(Eigen::Quaterniond(t.topLeftCorner<3, 3>()),
+                         t.topRightCorner<3, 1>());
+}
+
+}  // namespace
+
+bool ImagePairPoseOptions::Check() const {
+  CHECK_OPTION_GE(min_inliers, 3);
+  CHECK_OPTION_GT(max_relative_error, 0);
+  CHECK_OPTION_GT(num_ransac_iterations, 0);
+  return true;
+}
+
+std::vector<ImagePairPose> EstimateImagePairPoses(
+    const colmap::Database& database,
+    const DepthPriorsByImage& depth_priors,
+    const ImagePairPoseOptions& options) {
+  THROW_CHECK(options.Check());
+  std::unordered_map<colmap::image_t, colmap::Image> images;
+  std::unordered_map<colmap::camera_t, colmap::Camera> cameras;
+  for (const colmap::Image& image : database.ReadAllImages())
+    images[image.ImageId()] = image;
+  for (const colmap::Camera& camera : database.ReadAllCameras()) {
+    cameras[camera.camera_id] = camera;
+  }
+  std::vector<colmap::image_pair_t> pair_ids;
+  std::vector<colmap::TwoViewGeometry> geometries;
+  database.ReadTwoViewGeometries(&pair_ids, &geometries);
+  std::mt19937_64 rng(options.seed);
+  std::vector<ImagePairPose> poses;
+  for (size_t p = 0; p < pair_ids.size(); ++p) {
+    const auto [image_i, image_j] =
+        colmap::Database::PairIdToImagePair(pair_ids[p]);
+    const auto priors_i = depth_priors.find(image_i);
+    const auto priors_j = depth_priors.find(image_j);
+    if (priors_i == depth_priors.end() || priors_j == depth_priors.end())
+      continue;
+    const colmap::FeatureKeypoints keypoints_i =
+        database.ReadKeypoints(image_i);
+    const colmap::FeatureKeypoints keypoints_j =
+        database.ReadKeypoints(image_j);
+    const colmap::Camera& camera_i = cameras.at(images.at(image_i).CameraId());
+    const colmap::Camera& camera_j = cameras.at(images.at(image_j).CameraId());
+    std::vector<Eigen::Vector3d> points_i, points_j;
+    for (const colmap::FeatureMatch& match : geometries[p].inlier_matches) {
+      const auto prior_i = priors_i->second.find(match.point2D_idx1);
+      const auto prior_j = priors_j->second.find(match.point2D_idx2);
+      if (prior_i == priors_i->second.end() ||
+          prior_j == priors_j->second.end()) {
+        continue;
+      }
+      const colmap::FeatureKeypoint& ki = keypoints_i.at(match.point2D_idx1);
+      const colmap::FeatureKeypoint& kj = keypoints_j.at(match.point2D_idx2);
+      points_i.push_back(
+          prior_i->second.depth *
+          camera_i.CamFromImg(Eigen::Vector2d(ki.x, ki.y)).homogeneous());
+      points_j.push_back(
+          prior_j->second.depth *
+          camera_j.CamFromImg(Eigen::Vector2d(kj.x, kj.y)).homogeneous());
+    }
+    const int n = static_cast<int>(points_i.size());
+    if (n < options.min_inliers) continue;
+    const auto inliers_of = [&](const colmap::Rigid3d& i_from_j) {
+      std::vector<int> inliers;
+      for (int k = 0; k < n; ++k) {
+        if ((points_i[k] - i_from_j * points_j[k]).norm() <=
+            options.max_relative_error * points_i[k].z()) {
+          inliers.push_back(k);
+        }
+      }
+      return inliers;
+    };
+    const auto fit = [&](const std::vector<int>& indices) {
+      Eigen::Matrix3Xd target(3, indices.size()), source(3, indices.size());
+      for (size_t k = 0; k < indices.size(); ++k) {
+        target.col(k) = points_i[indices[k]];
+        source.col(k) = points_j[indices[k]];
+      }
+      return Umeyama(target, source);
+    };
+    std::uniform_int_distribution<int> pick(0, n - 1);
+    std::vector<int> best;
+    for (int iteration = 0; iteration < options.num_ransac_iterations;
+         ++iteration) {
+      const int a = pick(rng), b = pick(rng), c = pick(rng);
+      if (a == b || b == c || a == c) continue;
+      std::vector<int> inliers = inliers_of(fit({a, b, c}));
+      if (inliers.size() > best.size()) best = std::move(inliers);
+    }
+    if (static_cast<int>(best.size()) < options.min_inliers) continue;
+    ImagePairPose pose;
+    pose.image_i = image_i;
+    pose.image_j = image_j;
+    pose.num_correspondences = n;
+    for (int refinement = 0; refinement < 3; ++refinement) {
+      pose.cam_i_from_cam_j = fit(best);
+      best = inliers_of(pose.cam_i_from_cam_j);
+      if (static_cast<int>(best.size()) < options.min_inliers) break;
+    }
+    if (static_cast<int>(best.size()) < options.min_inliers) continue;
+    pose.num_inliers = static_cast<int>(best.size());
+    double squared = 0;
+    for (const int k : best) {
+      squared +=
+          (points_i[k] - pose.cam_i_from_cam_j * points_j[k]).squaredNorm();
+    }
+    pose.rms_m = std::sqrt(squared / best.size());
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
+}  // namespace colmap_lidar

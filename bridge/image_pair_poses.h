@@ -1,0 +1,46 @@
+// Image edges A_c of the pose graph: for each image pair COLMAP verified, the metric relative pose
+// cam_i_from_cam_j from the inlier matches that carry depth priors on both sides: each such match gives
+// a 3D-3D correspondence (the keypoint's ray scaled to its prior z-depth in either camera); 3-point
+// RANSAC with Umeyama (no scale: the depths are metric), refined on the inliers.
+#pragma once
+
+#include "colmap_ext/extension_database.h"
+
+#include "colmap/geometry/rigid3.h"
+#include "colmap/scene/database.h"
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+namespace colmap_lidar {
+
+struct ImagePairPoseOptions {
+  int min_inliers = 20;
+  // A correspondence is an inlier if the two 3D points agree within this fraction of their depth.
+  double max_relative_error = 0.02;
+  int num_ransac_iterations = 500;
+  uint64_t seed = 0;
+
+  bool Check() const;
+};
+
+struct ImagePairPose {
+  colmap::image_t image_i = colmap::kInvalidImageId;
+  colmap::image_t image_j = colmap::kInvalidImageId;
+  colmap::Rigid3d cam_i_from_cam_j;
+  int num_correspondences = 0;  // matches with depth priors on both sides
+  int num_inliers = 0;
+  double rms_m = 0;  // of the inliers
+};
+
+using DepthPriorsByImage =
+    std::unordered_map<colmap::image_t,
+                       std::unordered_map<colmap::point2D_t, DepthPrior>>;
+
+std::vector<ImagePairPose> EstimateImagePairPoses(
+    const colmap::Database& database,
+    const DepthPriorsByImage& depth_priors,
+    const ImagePairPoseOptions& options);
+
+}  // namespace colmap_lidar

@@ -1,0 +1,290 @@
+#include "bridge/pose_initializer.h"
+
+#include "bridge/relative_pose_cost.h"
+#include "colmap_ext/logging.h"
+
+#include "colmap/controllers/incremental_mapper.h"
+#include "colmap/estimators/cost_functions.h"
+#include "colmap/feature/utils.h"
+#include "colmap/scene/database.h"
+#include "colmap/scene/reconstruction_manager.h"
+
+#include <ceres/ceres.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <queue>
+#include <set>
+#include <sstream>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct LidarPair {
+  std::string target, source;
+  colmap::Rigid3d target_from_source;
+  double inliers = 0;
+};
+
+std::vector<LidarPair> ReadLidarPairs(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw std::runtime_error("cannot read LiDAR pose graph " + path);
+  std::vector<LidarPair> pairs;
+  std::string line;
+  while (std::getline(file, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    LidarPair pair;
+    double qw, qx, qy, qz, tx, ty, tz;
+    if (!(fields >> pair.target >> pair.source >> qw >> qx >> qy >> qz >> tx >>
+          ty >> tz >> pair.inliers)) {
+      throw std::runtime_error(path + ": malformed line '" + line + "'");
+    }
+    pair.target_from_source =
+        colmap::Rigid3d(Eigen::Quaterniond(qw, qx, qy, qz).normalized(),
+                        Eigen::Vector3d(tx, ty, tz));
+    pairs.push_back(pair);
+  }
+  return pairs;
+}
+
+}  // namespace
+
+bool PoseInitializerOptions::Check() const {
+  image_pairs.Check();
+  hand_eye.Check();
+  CHECK_OPTION_GT(sigma_rotation_deg, 0);
+  CHECK_OPTION_GT(sigma_translation_m, 0);
+  return true;
+}
+
+PoseInitialization InitializePoses(const std::string& database_path,
+                                   const StationDataset& dataset,
+                                   const std::string& registration_path,
+                                   const PoseInitializerOptions& options) {
+  THROW_CHECK(options.Check());
+  THROW_CHECK(fs::is_regular_file(database_path))
+      << "Database file does not exist: " << database_path;
+  PoseInitialization init;
+  const ExtensionDatabase extension(database_path,
+                                    ExtensionDatabase::Mode::kReadOnly);
+  const colmap::Database database(database_path);
+  std::map<std::string, colmap::image_t> image_of_station;
+  std::map<colmap::image_t, std::string> names;
+  std::set<std::string> stations(dataset.stations.begin(),
+                                 dataset.stations.end());
+  DepthPriorsByImage priors;
+  for (const colmap::Image& image : database.ReadAllImages()) {
+    const std::string station = fs::path(image.Name()).stem().string();
+    if (!stations.count(station)) continue;
+    image_of_station[station] = image.ImageId();
+    names[image.ImageId()] = image.Name();
+    for (const DepthPrior& prior : extension.ReadDepthPriors(image.ImageId())) {
+      priors[image.ImageId()][prior.point2D_idx] = prior;
+    }
+  }
+  THROW_CHECK(!image_of_station.empty())
+      << database_path << " holds no image of the stations of " << dataset.root;
+
+  // A_c.
+  const std::vector<ImagePairPose> image_pairs =
+      EstimateImagePairPoses(database, priors, options.image_pairs);
+  std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d>
+      image_edge;
+  for (const ImagePairPose& pair : image_pairs) {
+    init.edges.push_back({pair.image_i,
+                          pair.image_j,
+                          pair.cam_i_from_cam_j,
+                          static_cast<double>(pair.num_inliers),
+                          false});
+    image_edge[{pair.image_i, pair.image_j}] = pair.cam_i_from_cam_j;
+  }
+  init.num_image_edges = static_cast<int>(image_pairs.size());
+
+  // A_l.
+  std::vector<
+      std::tuple<colmap::image_t, colmap::image_t, colmap::Rigid3d, double>>
+      lidar_edges;
+  if (!registration_path.empty()) {
+    for (const LidarPair& pair :
+         ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
+      if (!image_of_station.count(pair.target) ||
+          !image_of_station.count(pair.source)) {
+        continue;
+      }
+      lidar_edges.emplace_back(image_of_station.at(pair.target),
+                               image_of_station.at(pair.source),
+                               pair.target_from_source,
+                               pair.inliers);
+    }
+  }
+  init.num_lidar_edges = static_cast<int>(lidar_edges.size());
+
+  // cam_from_lidar.
+  std::vector<HandEyeMotion> motions;
+  for (const auto& [i, j, lidar_i_from_lidar_j, weight] : lidar_edges) {
+    if (image_edge.count({i, j})) {
+      motions.push_back({image_edge.at({i, j}), lidar_i_from_lidar_j});
+    } else if (image_edge.count({j, i})) {
+      motions.push_back(
+          {colmap::Inverse(image_edge.at({j, i})), lidar_i_from_lidar_j});
+    }
+  }
+  init.hand_eye = SolveHandEye(motions, options.hand_eye);
+  if (options.use_guess && dataset.rig.cam_from_lidar_guess) {
+    init.cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
+    init.extrinsic_source = "rig.json guess";
+  } else if (init.hand_eye.unique) {
+    init.cam_from_lidar = init.hand_eye.cam_from_lidar;
+    init.extrinsic_source = "hand-eye";
+  } else if (dataset.rig.cam_from_lidar_guess) {
+    init.cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
+    init.extrinsic_source =
+        "rig.json guess (hand-eye: " + init.hand_eye.message + ")";
+  } else {
+    throw std::runtime_error(
+        "cannot initialise cam_from_lidar: " + init.hand_eye.message +
+        "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
+  }
+  for (const auto& [i, j, lidar_i_from_lidar_j, weight] : lidar_edges) {
+    init.edges.push_back({i,
+                          j,
+                          init.cam_from_lidar * lidar_i_from_lidar_j *
+                              colmap::Inverse(init.cam_from_lidar),
+                          weight,
+                          true});
+  }
+
+  // Maximum-weight spanning tree from the first station (Prim).
+  const colmap::image_t root = image_of_station.begin()->second;
+  std::map<colmap::image_t, std::vector<size_t>> incident;
+  for (size_t e = 0; e < init.edges.size(); ++e) {
+    incident[init.edges[e].image_i].push_back(e);
+    incident[init.edges[e].image_j].push_back(e);
+  }
+  init.cam_from_world[root] = colmap::Rigid3d();
+  std::priority_queue<std::pair<double, size_t>> queue;
+  for (const size_t e : incident[root]) queue.push({init.edges[e].weight, e});
+  while (!queue.empty()) {
+    const size_t e = queue.top().second;
+    queue.pop();
+    const PoseGraphEdge& edge = init.edges[e];
+    const bool has_i = init.cam_from_world.count(edge.image_i) > 0;
+    const bool has_j = init.cam_from_world.count(edge.image_j) > 0;
+    if (has_i == has_j) continue;
+    colmap::image_t added;
+    if (has_i) {  // cam_j_from_world = inverse(cam_i_from_cam_j) * cam_i_from_world
+      added = edge.image_j;
+      init.cam_from_world[added] = colmap::Inverse(edge.cam_i_from_cam_j) *
+                                   init.cam_from_world.at(edge.image_i);
+    } else {
+      added = edge.image_i;
+      init.cam_from_world[added] =
+          edge.cam_i_from_cam_j * init.cam_from_world.at(edge.image_j);
+    }
+    for (const size_t next : incident[added])
+      queue.push({init.edges[next].weight, next});
+  }
+  for (const auto& [station, image_id] : image_of_station) {
+    if (!init.cam_from_world.count(image_id))
+      init.unreachable.push_back(names.at(image_id));
+  }
+
+  // Pose graph over every edge between reachable stations.
+  ceres::Problem problem;
+  const double sigma_rotation = options.sigma_rotation_deg * M_PI / 180;
+  for (const PoseGraphEdge& edge : init.edges) {
+    if (!init.cam_from_world.count(edge.image_i) ||
+        !init.cam_from_world.count(edge.image_j)) {
+      continue;
+    }
+    colmap::Rigid3d& pose_i = init.cam_from_world.at(edge.image_i);
+    colmap::Rigid3d& pose_j = init.cam_from_world.at(edge.image_j);
+    problem.AddResidualBlock(
+        RelativePoseCostFunctor::Create(
+            edge.cam_i_from_cam_j, sigma_rotation, options.sigma_translation_m),
+        new ceres::CauchyLoss(3.0),
+        pose_i.rotation.coeffs().data(),
+        pose_i.translation.data(),
+        pose_j.rotation.coeffs().data(),
+        pose_j.translation.data());
+  }
+  for (auto& [image_id, pose] : init.cam_from_world) {
+    if (!problem.HasParameterBlock(pose.rotation.coeffs().data())) continue;
+    colmap::SetQuaternionManifold(&problem, pose.rotation.coeffs().data());
+    if (image_id == root) {
+      problem.SetParameterBlockConstant(pose.rotation.coeffs().data());
+      problem.SetParameterBlockConstant(pose.translation.data());
+    }
+  }
+  if (problem.NumResidualBlocks() > 0) {
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    solver_options.max_num_iterations = 100;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+  }
+  return init;
+}
+
+void TriangulateInitialModel(const std::string& database_path,
+                             const std::string& image_path,
+                             const PoseInitialization& initialization,
+                             const std::string& output_path) {
+  auto reconstruction = std::make_shared<colmap::Reconstruction>();
+  std::vector<colmap::Image> without_correspondences;
+  {
+    const colmap::Database database(database_path);
+    for (const colmap::Camera& camera : database.ReadAllCameras()) {
+      reconstruction->AddCamera(camera);
+    }
+    // Images without any match would break COLMAP's observation manager: they join after triangulation.
+    std::set<colmap::image_t> matched;
+    std::vector<std::pair<colmap::image_t, colmap::image_t>> pairs;
+    std::vector<int> num_inliers;
+    database.ReadTwoViewGeometryNumInliers(&pairs, &num_inliers);
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      if (num_inliers[k] > 0) {
+        matched.insert(pairs[k].first);
+        matched.insert(pairs[k].second);
+      }
+    }
+    for (const auto& [image_id, pose] : initialization.cam_from_world) {
+      colmap::Image image = database.ReadImage(image_id);
+      image.CamFromWorld() = pose;
+      image.SetPoints2D(colmap::FeatureKeypointsToPointsVector(
+          database.ReadKeypoints(image_id)));
+      if (matched.count(image_id)) {
+        reconstruction->AddImage(image);
+        reconstruction->RegisterImage(image_id);
+      } else {
+        without_correspondences.push_back(image);
+      }
+    }
+  }
+  auto options = std::make_shared<colmap::IncrementalMapperOptions>();
+  options->fix_existing_images = true;
+  options->ba_refine_focal_length = false;
+  options->ba_refine_principal_point = false;
+  options->ba_refine_extra_params = false;
+  options->num_threads = -1;
+  if (reconstruction->NumRegImages() >= 2) {
+    colmap::IncrementalMapperController mapper(
+        options,
+        image_path,
+        database_path,
+        std::make_shared<colmap::ReconstructionManager>());
+    mapper.TriangulateReconstruction(reconstruction);
+  }
+  for (const colmap::Image& image : without_correspondences) {
+    reconstruction->AddImage(image);
+    reconstruction->RegisterImage(image.ImageId());
+  }
+  fs::create_directories(output_path);
+  reconstruction->WriteBinary(output_path);
+}
+
+}  // namespace colmap_lidar

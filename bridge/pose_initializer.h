@@ -1,0 +1,64 @@
+// Initial station poses and cam_from_lidar for the joint problem (the seed's initialisation):
+// 1. image edges A_c: metric relative poses from matches with depth priors (bridge/image_pair_poses.h);
+// 2. LiDAR edges A_l: lidar_registrator's pairs.txt;
+// 3. cam_from_lidar: rig.json's guess if present, else hand-eye over the pairs with both an image and a
+//    LiDAR edge (bridge/hand_eye.h); degenerate motion without a guess is an error saying why;
+// 4. LiDAR edges become camera edges through cam_from_lidar; a maximum-weight spanning tree from the
+//    first station gives initial poses; a pose graph over all edges (Ceres) refines them. Stations that
+//    no edge reaches are reported and left out.
+// The world frame is the first station's camera frame; units are metres.
+#pragma once
+
+#include "bridge/hand_eye.h"
+#include "bridge/image_pair_poses.h"
+#include "colmap_ext/station_dataset.h"
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace colmap_lidar {
+
+struct PoseInitializerOptions {
+  ImagePairPoseOptions image_pairs;
+  HandEyeOptions hand_eye;
+  bool use_guess = true;  // false: hand-eye even when rig.json has a guess
+  double sigma_rotation_deg = 0.1;  // pose-graph edge weights
+  double sigma_translation_m = 0.005;
+
+  bool Check() const;
+};
+
+struct PoseGraphEdge {
+  colmap::image_t image_i = 0, image_j = 0;
+  colmap::Rigid3d cam_i_from_cam_j;
+  double weight = 0;  // inliers
+  bool from_lidar = false;
+};
+
+struct PoseInitialization {
+  std::map<colmap::image_t, colmap::Rigid3d>
+      cam_from_world;                    // reachable stations
+  std::vector<std::string> unreachable;  // image names
+  colmap::Rigid3d cam_from_lidar;
+  std::string extrinsic_source;  // "rig.json guess" or "hand-eye"
+  HandEyeResult hand_eye;
+  std::vector<PoseGraphEdge> edges;
+  int num_image_edges = 0;
+  int num_lidar_edges = 0;
+};
+
+// `registration_path`: lidar_registrator's output folder (pairs.txt); may be empty (no LiDAR edges).
+PoseInitialization InitializePoses(const std::string& database_path,
+                                   const StationDataset& dataset,
+                                   const std::string& registration_path,
+                                   const PoseInitializerOptions& options);
+
+// Writes a COLMAP sparse model with the initial poses and landmarks triangulated by COLMAP's own
+// triangulator (IncrementalMapperController::TriangulateReconstruction with the poses held fixed).
+void TriangulateInitialModel(const std::string& database_path,
+                             const std::string& image_path,
+                             const PoseInitialization& initialization,
+                             const std::string& output_path);
+
+}  // namespace colmap_lidar
