@@ -501,6 +501,14 @@ JointAdjustmentSummary JointAdjuster::Run(
                                                       depth_scale_derivative,
                                                       summary.motion,
                                                       options_.observability);
+    if (last->reprojection_ids.empty() && last->depth_ids.empty()) {
+      summary.uncertainty.unobservable.insert(
+          summary.uncertainty.unobservable.begin(),
+          "cam_from_lidar cannot be calibrated: no image landmark ties the "
+          "cameras together, so the LiDAR fixes only the LiDAR poses and "
+          "cam_from_lidar keeps its initial value; add overlapping images "
+          "(more stations, or closer spacing)");
+    }
 
     // The seed's perturbation curves: only E_l depends on T_e, so the total is the rest (constant) plus
     // the LiDAR term at the perturbed T_e.

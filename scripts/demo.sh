@@ -19,23 +19,14 @@ mkdir -p "$kWorkspace"
 $cli simulate_dataset --scene t_specimen --output_path "$kWorkspace/dataset" \
   --lidar_points "${LIDAR_POINTS:-400000}" --overwrite 1
 
-echo "== 2. stereo depth per station (OpenCV SGBM, left-right check; depth in the left image grid)"
-$cli stereo_depth --dataset_path "$kWorkspace/dataset" --output_path "$kWorkspace/stereo"
+echo "== 2. the pipeline: import (COLMAP SIFT), stereo depth, depth priors, LiDAR registration,"
+echo "         initialisation (hand-eye cam_from_lidar: the guess is not used), joint adjustment, evaluation"
+$cli pipeline --dataset_path "$kWorkspace/dataset" --workspace_path "$kWorkspace" --use_guess 0 \
+  --overwrite 1 2>&1 | grep -v '^I20'
 
-echo "== 3. import into a COLMAP database (camera from rig.json, COLMAP SIFT + matching, rig, LiDAR frames)"
-rm -f "$kWorkspace/database.db"
-$cli import_dataset --dataset_path "$kWorkspace/dataset" --database_path "$kWorkspace/database.db" \
-  2>&1 | grep -v '^I20'
-$cli depth_prior_extractor --database_path "$kWorkspace/database.db" --depth_path "$kWorkspace/stereo"
-$cli database_info --database_path "$kWorkspace/database.db"
-
-echo "== 4. LiDAR registration and pose graph (BSC + RANSAC + ICP; each station with its 4 most similar)"
-$cli lidar_registrator --lidar_path "$kWorkspace/dataset/lidar" --output_path "$kWorkspace/lidar" \
-  --max_neighbors 4
-
-echo "== 5. the evaluator on the ground truth (the reference every model is measured against)"
-$cli evaluate_model --model_path "$kWorkspace/dataset/ground_truth/surface.ply" \
-  --ground_truth_path "$kWorkspace/dataset/ground_truth/surface.ply" --output_path "$kWorkspace/eval_truth"
+echo "== 3. accuracy of the reconstruction against the simulator's ground truth"
+$cli evaluate_calibration --dataset_path "$kWorkspace/dataset" --input_path "$kWorkspace/sparse/joint" \
+  2>&1 | grep 'evaluate_calibration:'
 
 cat <<MSG
 
@@ -44,6 +35,8 @@ cat <<MSG
   stereo depth     $kWorkspace/stereo/{depth_maps,confidence_maps,previews}/, stereo.json
   database         $kWorkspace/database.db (COLMAP's images, SIFT, matches + depth_priors, lidar_frames, rig)
   LiDAR graph      $kWorkspace/lidar/{pairs.txt, lidar_poses.txt, summary.txt}
-  not yet built    pose_initializer and pipeline (issue 7: joint_adjuster needs an initial model),
-                   densifier (issue 8)
+  initial model    $kWorkspace/sparse/initial (COLMAP model, cam_from_lidar.txt, initialization.json)
+  refined model    $kWorkspace/sparse/joint (COLMAP model, cam_from_lidar.txt, report.json, plots)
+  evaluation       $kWorkspace/evaluation/metrics.json
+  not yet built    densifier (issue 8)
 MSG

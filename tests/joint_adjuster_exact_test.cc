@@ -18,7 +18,8 @@
 namespace colmap_lidar {
 namespace {
 
-double RotationErrorDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+double RotationErrorDeg(const Eigen::Quaterniond& a,
+                        const Eigen::Quaterniond& b) {
   return Eigen::AngleAxisd(a * b.inverse()).angle() * 180 / M_PI;
 }
 
@@ -39,7 +40,8 @@ TEST(JointAdjusterExactTest, NoiseFreeRecoversExtrinsicAndPosesFromAFarGuess) {
   camera.camera_id = 1;
   reconstruction.AddCamera(camera);
   std::vector<std::vector<Eigen::Vector2d>> points2D(truth.size());
-  std::vector<std::vector<std::pair<size_t, size_t>>> tracks;  // (station, point2D index)
+  std::vector<std::vector<std::pair<size_t, size_t>>>
+      tracks;  // (station, point2D index)
   const PointCloud surface = scene.SampleObjectSurface(0.04);
   std::vector<Eigen::Vector3d> landmarks;
   for (size_t p = 0; p < surface.Size(); p += 3) {
@@ -56,8 +58,8 @@ TEST(JointAdjusterExactTest, NoiseFreeRecoversExtrinsicAndPosesFromAFarGuess) {
       const Eigen::Vector3d center = colmap::Inverse(truth[s]).translation;
       sim::RayHit hit;
       const double distance = (point - center).norm();
-      if (scene.Intersect(center, (point - center) / distance, distance + 1,
-                          &hit) &&
+      if (scene.Intersect(
+              center, (point - center) / distance, distance + 1, &hit) &&
           hit.t < distance - 1e-3) {
         continue;  // occluded
       }
@@ -93,11 +95,13 @@ TEST(JointAdjusterExactTest, NoiseFreeRecoversExtrinsicAndPosesFromAFarGuess) {
       // The exact depth prior, weighted as the seed does.
       const double depth = (truth[s] * landmarks[k]).z();
       data.depth_priors[static_cast<colmap::image_t>(s + 1)][index] = {
-          static_cast<colmap::point2D_t>(index), depth,
+          static_cast<colmap::point2D_t>(index),
+          depth,
           DepthSigma(depth, baseline, focal, 1.0)};
     }
     const Eigen::Vector3d start =
-        landmarks[k] + 0.01 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+        landmarks[k] +
+        0.01 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
     reconstruction.AddPoint3D(start, track);
   }
 
@@ -132,21 +136,22 @@ TEST(JointAdjusterExactTest, NoiseFreeRecoversExtrinsicAndPosesFromAFarGuess) {
   const double rotation_error =
       RotationErrorDeg(cam_from_lidar.rotation, true_cam_from_lidar.rotation);
   const double translation_error_mm =
-      1000 * (cam_from_lidar.translation - true_cam_from_lidar.translation).norm();
+      1000 *
+      (cam_from_lidar.translation - true_cam_from_lidar.translation).norm();
   double max_pose_error_mm = 0;
   for (size_t s = 0; s < truth.size(); ++s) {
     const colmap::Rigid3d& estimate =
-        reconstruction.Image(static_cast<colmap::image_t>(s + 1)).CamFromWorld();
-    max_pose_error_mm = std::max(
-        max_pose_error_mm,
-        1000 * (colmap::Inverse(estimate).translation -
-                colmap::Inverse(truth[s]).translation)
-                   .norm());
+        reconstruction.Image(static_cast<colmap::image_t>(s + 1))
+            .CamFromWorld();
+    max_pose_error_mm = std::max(max_pose_error_mm,
+                                 1000 * (colmap::Inverse(estimate).translation -
+                                         colmap::Inverse(truth[s]).translation)
+                                            .norm());
   }
   std::cout << "exact data: cam_from_lidar error " << rotation_error << " deg, "
             << translation_error_mm << " mm; station positions max "
-            << max_pose_error_mm << " mm (" << landmarks.size()
-            << " landmarks)" << std::endl;
+            << max_pose_error_mm << " mm (" << landmarks.size() << " landmarks)"
+            << std::endl;
   EXPECT_LT(rotation_error, 0.01);
   EXPECT_LT(translation_error_mm, 0.5);
   EXPECT_LT(max_pose_error_mm, 0.5);
