@@ -32,7 +32,7 @@ int RunWithArguments(int (*command)(int, char**),
 }  // namespace
 
 int RunPoseInitializer(int argc, char** argv) {
-  std::string dataset_path, registration_path, output_path;
+  std::string dataset_path, registration_path, output_path, input_path;
   PoseInitializerOptions initializer;
   colmap::OptionManager options;
   options.AddDatabaseOptions();
@@ -42,6 +42,11 @@ int RunPoseInitializer(int argc, char** argv) {
                            "lidar_registrator's output (pairs.txt); empty: no "
                            "LiDAR edges");
   options.AddRequiredOption("output_path", &output_path);
+  options.AddDefaultOption("input_path",
+                           &input_path,
+                           "an existing COLMAP model of the same database (e.g. "
+                           "colmap mapper's): rescaled to metres instead of "
+                           "initialising poses");
   options.AddDefaultOption("use_guess",
                            &initializer.use_guess,
                            "use rig.json's cam_from_lidar_guess if present "
@@ -51,24 +56,38 @@ int RunPoseInitializer(int argc, char** argv) {
   options.Parse(argc, argv);
   const auto start = std::chrono::steady_clock::now();
   const StationDataset dataset = ReadStationDataset(dataset_path);
-  const PoseInitialization init = InitializePoses(
-      *options.database_path, dataset, registration_path, initializer);
-  std::cout << "Pose graph: " << init.num_image_edges << " image edges (A_c), "
-            << init.num_lidar_edges << " LiDAR edges (A_l); "
-            << init.cam_from_world.size() << " stations reachable" << std::endl;
-  std::cout << "cam_from_lidar: " << init.extrinsic_source
-            << "; hand-eye: " << init.hand_eye.message << std::endl;
-  for (const std::string& name : init.unreachable) {
-    std::cout << "WARNING: station image " << name
-              << " is reached by no image or LiDAR edge; left out" << std::endl;
-  }
-
   const fs::path partial = output_path + ".partial";
   fs::remove_all(partial);
-  TriangulateInitialModel(*options.database_path,
-                          (fs::path(dataset.root) / "images").string(),
-                          init,
-                          partial.string());
+  PoseInitialization init;
+  double scale = 1;
+  if (input_path.empty()) {
+    init = InitializePoses(*options.database_path, dataset, registration_path,
+                           initializer);
+    std::cout << "Pose graph: " << init.num_image_edges << " image edges (A_c), "
+              << init.num_lidar_edges << " LiDAR edges (A_l); "
+              << init.cam_from_world.size() << " stations reachable" << std::endl;
+    TriangulateInitialModel(*options.database_path,
+                            (fs::path(dataset.root) / "images").string(), init,
+                            partial.string());
+  } else {
+    THROW_CHECK(fs::is_directory(input_path)) << "no sparse model folder " << input_path;
+    colmap::Reconstruction model;
+    model.Read(input_path);
+    init = InitializeFromModel(*options.database_path, dataset, registration_path,
+                               initializer, &model, &scale);
+    std::cout << "Rescaled " << input_path << " to metres by " << scale
+              << " (median of depth prior / model depth); "
+              << model.NumRegImages() << " registered images" << std::endl;
+    fs::create_directories(partial);
+    model.WriteBinary(partial.string());
+  }
+  std::cout << "cam_from_lidar: " << init.extrinsic_source << "; hand-eye: "
+            << init.hand_eye.message << std::endl;
+  for (const std::string& name : init.unreachable) {
+    std::cout << "WARNING: station image " << name
+              << " is not in the model (no image or LiDAR edge reaches it)"
+              << std::endl;
+  }
   WritePoseFile((partial / "cam_from_lidar.txt").string(),
                 "initial cam_from_lidar (" + init.extrinsic_source +
                     "); qw qx qy qz tx ty tz",
@@ -84,6 +103,8 @@ int RunPoseInitializer(int argc, char** argv) {
   report["lidar_edges"] = init.num_lidar_edges;
   report["stations"] = init.cam_from_world.size();
   report["unreachable"] = init.unreachable;
+  report["input_model"] = input_path;
+  report["scale_to_metres"] = scale;
   WriteFileAtomically((partial / "initialization.json").string(),
                       report.dump(2) + "\n");
   fs::remove_all(output_path);

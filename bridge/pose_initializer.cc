@@ -51,6 +51,30 @@ std::vector<LidarPair> ReadLidarPairs(const std::string& path) {
   return pairs;
 }
 
+// cam_from_lidar: rig.json's guess if allowed and present, else hand-eye, else the guess anyway (with
+// the hand-eye failure recorded), else an error saying why.
+void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
+                     const StationDataset& dataset,
+                     const PoseInitializerOptions& options,
+                     PoseInitialization* init) {
+  init->hand_eye = SolveHandEye(motions, options.hand_eye);
+  if (options.use_guess && dataset.rig.cam_from_lidar_guess) {
+    init->cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
+    init->extrinsic_source = "rig.json guess";
+  } else if (init->hand_eye.unique) {
+    init->cam_from_lidar = init->hand_eye.cam_from_lidar;
+    init->extrinsic_source = "hand-eye";
+  } else if (dataset.rig.cam_from_lidar_guess) {
+    init->cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
+    init->extrinsic_source =
+        "rig.json guess (hand-eye: " + init->hand_eye.message + ")";
+  } else {
+    throw std::runtime_error(
+        "cannot initialise cam_from_lidar: " + init->hand_eye.message +
+        "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
+  }
+}
+
 }  // namespace
 
 bool PoseInitializerOptions::Check() const {
@@ -133,22 +157,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
           {colmap::Inverse(image_edge.at({j, i})), lidar_i_from_lidar_j});
     }
   }
-  init.hand_eye = SolveHandEye(motions, options.hand_eye);
-  if (options.use_guess && dataset.rig.cam_from_lidar_guess) {
-    init.cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
-    init.extrinsic_source = "rig.json guess";
-  } else if (init.hand_eye.unique) {
-    init.cam_from_lidar = init.hand_eye.cam_from_lidar;
-    init.extrinsic_source = "hand-eye";
-  } else if (dataset.rig.cam_from_lidar_guess) {
-    init.cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
-    init.extrinsic_source =
-        "rig.json guess (hand-eye: " + init.hand_eye.message + ")";
-  } else {
-    throw std::runtime_error(
-        "cannot initialise cam_from_lidar: " + init.hand_eye.message +
-        "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
-  }
+  ChooseExtrinsic(motions, dataset, options, &init);
   for (const auto& [i, j, lidar_i_from_lidar_j, weight] : lidar_edges) {
     init.edges.push_back({i,
                           j,
@@ -226,6 +235,72 @@ PoseInitialization InitializePoses(const std::string& database_path,
     solver_options.max_num_iterations = 100;
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
+  }
+  return init;
+}
+
+PoseInitialization InitializeFromModel(const std::string& database_path,
+                                       const StationDataset& dataset,
+                                       const std::string& registration_path,
+                                       const PoseInitializerOptions& options,
+                                       colmap::Reconstruction* model,
+                                       double* scale) {
+  THROW_CHECK(options.Check());
+  THROW_CHECK_NOTNULL(model);
+  THROW_CHECK_GE(model->NumRegImages(), 2) << "the model has fewer than 2 "
+                                              "registered images";
+  const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
+  // Metres: the median of prior depth / model depth over every landmark observation with a prior.
+  std::vector<double> ratios;
+  std::map<std::string, colmap::image_t> image_of_station;
+  for (const colmap::image_t image_id : model->RegImageIds()) {
+    const colmap::Image& image = model->Image(image_id);
+    image_of_station[fs::path(image.Name()).stem().string()] = image_id;
+    for (const DepthPrior& prior : extension.ReadDepthPriors(image_id)) {
+      if (prior.point2D_idx >= image.NumPoints2D()) {
+        throw std::runtime_error("the model's image " + image.Name() +
+                                 " does not match the database's keypoints");
+      }
+      const colmap::Point2D& point2D = image.Point2D(prior.point2D_idx);
+      if (!point2D.HasPoint3D()) continue;
+      const double depth =
+          (image.CamFromWorld() * model->Point3D(point2D.point3D_id).xyz).z();
+      if (depth > 0) ratios.push_back(prior.depth / depth);
+    }
+  }
+  if (ratios.size() < 10) {
+    throw std::runtime_error(
+        "cannot rescale the model to metres: only " + std::to_string(ratios.size()) +
+        " landmark observations carry a depth prior (run depth_prior_extractor on "
+        "the model's database)");
+  }
+  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  *scale = ratios[ratios.size() / 2];
+  model->Transform(colmap::Sim3d(*scale, Eigen::Quaterniond::Identity(),
+                                 Eigen::Vector3d::Zero()));
+
+  PoseInitialization init;
+  std::vector<HandEyeMotion> motions;
+  if (!registration_path.empty()) {
+    for (const LidarPair& pair :
+         ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
+      if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) {
+        continue;
+      }
+      const colmap::image_t i = image_of_station.at(pair.target);
+      const colmap::image_t j = image_of_station.at(pair.source);
+      motions.push_back({model->Image(i).CamFromWorld() *
+                             colmap::Inverse(model->Image(j).CamFromWorld()),
+                         pair.target_from_source});
+      ++init.num_lidar_edges;
+    }
+  }
+  ChooseExtrinsic(motions, dataset, options, &init);
+  for (const colmap::image_t image_id : model->RegImageIds()) {
+    init.cam_from_world[image_id] = model->Image(image_id).CamFromWorld();
+  }
+  for (const std::string& station : dataset.stations) {
+    if (!image_of_station.count(station)) init.unreachable.push_back("left/" + station + ".png");
   }
   return init;
 }

@@ -13,6 +13,8 @@
 #include "bridge/image_pair_poses.h"
 #include "colmap_ext/station_dataset.h"
 
+#include "colmap/scene/reconstruction.h"
+
 #include <map>
 #include <string>
 #include <vector>
@@ -53,6 +55,17 @@ PoseInitialization InitializePoses(const std::string& database_path,
                                    const StationDataset& dataset,
                                    const std::string& registration_path,
                                    const PoseInitializerOptions& options);
+
+// The existing-COLMAP-workflow variant: `model` (e.g. from `colmap mapper` on the same database) is
+// rescaled to metres in place by the median ratio of depth prior to model depth over its landmark
+// observations (`scale` returns the factor), and cam_from_lidar comes from the guess or hand-eye with
+// the model's relative poses as image motions. Stations the model did not register are listed.
+PoseInitialization InitializeFromModel(const std::string& database_path,
+                                       const StationDataset& dataset,
+                                       const std::string& registration_path,
+                                       const PoseInitializerOptions& options,
+                                       colmap::Reconstruction* model,
+                                       double* scale);
 
 // Writes a COLMAP sparse model with the initial poses and landmarks triangulated by COLMAP's own
 // triangulator (IncrementalMapperController::TriangulateReconstruction with the poses held fixed).
