@@ -42,11 +42,12 @@ int RunPoseInitializer(int argc, char** argv) {
                            "lidar_registrator's output (pairs.txt); empty: no "
                            "LiDAR edges");
   options.AddRequiredOption("output_path", &output_path);
-  options.AddDefaultOption("input_path",
-                           &input_path,
-                           "an existing COLMAP model of the same database (e.g. "
-                           "colmap mapper's): rescaled to metres instead of "
-                           "initialising poses");
+  options.AddDefaultOption(
+      "input_path",
+      &input_path,
+      "an existing COLMAP model of the same database (e.g. "
+      "colmap mapper's): rescaled to metres instead of "
+      "initialising poses");
   options.AddDefaultOption("use_guess",
                            &initializer.use_guess,
                            "use rig.json's cam_from_lidar_guess if present "
@@ -61,28 +62,35 @@ int RunPoseInitializer(int argc, char** argv) {
   PoseInitialization init;
   double scale = 1;
   if (input_path.empty()) {
-    init = InitializePoses(*options.database_path, dataset, registration_path,
-                           initializer);
-    std::cout << "Pose graph: " << init.num_image_edges << " image edges (A_c), "
-              << init.num_lidar_edges << " LiDAR edges (A_l); "
-              << init.cam_from_world.size() << " stations reachable" << std::endl;
+    init = InitializePoses(
+        *options.database_path, dataset, registration_path, initializer);
+    std::cout << "Pose graph: " << init.num_image_edges
+              << " image edges (A_c), " << init.num_lidar_edges
+              << " LiDAR edges (A_l); " << init.cam_from_world.size()
+              << " stations reachable" << std::endl;
     TriangulateInitialModel(*options.database_path,
-                            (fs::path(dataset.root) / "images").string(), init,
+                            (fs::path(dataset.root) / "images").string(),
+                            init,
                             partial.string());
   } else {
-    THROW_CHECK(fs::is_directory(input_path)) << "no sparse model folder " << input_path;
+    THROW_CHECK(fs::is_directory(input_path))
+        << "no sparse model folder " << input_path;
     colmap::Reconstruction model;
     model.Read(input_path);
-    init = InitializeFromModel(*options.database_path, dataset, registration_path,
-                               initializer, &model, &scale);
+    init = InitializeFromModel(*options.database_path,
+                               dataset,
+                               registration_path,
+                               initializer,
+                               &model,
+                               &scale);
     std::cout << "Rescaled " << input_path << " to metres by " << scale
               << " (median of depth prior / model depth); "
               << model.NumRegImages() << " registered images" << std::endl;
     fs::create_directories(partial);
     model.WriteBinary(partial.string());
   }
-  std::cout << "cam_from_lidar: " << init.extrinsic_source << "; hand-eye: "
-            << init.hand_eye.message << std::endl;
+  std::cout << "cam_from_lidar: " << init.extrinsic_source
+            << "; hand-eye: " << init.hand_eye.message << std::endl;
   for (const std::string& name : init.unreachable) {
     std::cout << "WARNING: station image " << name
               << " is not in the model (no image or LiDAR edge reaches it)"

@@ -249,7 +249,8 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
   THROW_CHECK_NOTNULL(model);
   THROW_CHECK_GE(model->NumRegImages(), 2) << "the model has fewer than 2 "
                                               "registered images";
-  const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
+  const ExtensionDatabase extension(database_path,
+                                    ExtensionDatabase::Mode::kReadOnly);
   // Metres: the median of prior depth / model depth over every landmark observation with a prior.
   std::vector<double> ratios;
   std::map<std::string, colmap::image_t> image_of_station;
@@ -269,22 +270,25 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
     }
   }
   if (ratios.size() < 10) {
-    throw std::runtime_error(
-        "cannot rescale the model to metres: only " + std::to_string(ratios.size()) +
-        " landmark observations carry a depth prior (run depth_prior_extractor on "
-        "the model's database)");
+    throw std::runtime_error("cannot rescale the model to metres: only " +
+                             std::to_string(ratios.size()) +
+                             " landmark observations carry a depth prior (run "
+                             "depth_prior_extractor on "
+                             "the model's database)");
   }
-  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  std::nth_element(
+      ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
   *scale = ratios[ratios.size() / 2];
-  model->Transform(colmap::Sim3d(*scale, Eigen::Quaterniond::Identity(),
-                                 Eigen::Vector3d::Zero()));
+  model->Transform(colmap::Sim3d(
+      *scale, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()));
 
   PoseInitialization init;
   std::vector<HandEyeMotion> motions;
   if (!registration_path.empty()) {
     for (const LidarPair& pair :
          ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
-      if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) {
+      if (!image_of_station.count(pair.target) ||
+          !image_of_station.count(pair.source)) {
         continue;
       }
       const colmap::image_t i = image_of_station.at(pair.target);
@@ -300,7 +304,8 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
     init.cam_from_world[image_id] = model->Image(image_id).CamFromWorld();
   }
   for (const std::string& station : dataset.stations) {
-    if (!image_of_station.count(station)) init.unreachable.push_back("left/" + station + ".png");
+    if (!image_of_station.count(station))
+      init.unreachable.push_back("left/" + station + ".png");
   }
   return init;
 }

@@ -104,13 +104,15 @@ TEST(PipelineTest, DefaultSceneWithoutAGuessEndToEndAndRestartable) {
             " --image_path " + dataset + "/images --output_path " +
             dir.File("ws/mapper") + " --Mapper.ba_refine_focal_length 0" +
             " --Mapper.ba_refine_extra_params 0 --Mapper.num_threads 2",
-        kCli + " pose_initializer --database_path " + dir.File("ws/database.db") +
-            " --dataset_path " + dataset + " --registration_path " +
-            dir.File("ws/lidar") + " --input_path " + dir.File("ws/mapper/0") +
-            " --output_path " + dir.File("ws/mapper_initial"),
+        kCli + " pose_initializer --database_path " +
+            dir.File("ws/database.db") + " --dataset_path " + dataset +
+            " --registration_path " + dir.File("ws/lidar") + " --input_path " +
+            dir.File("ws/mapper/0") + " --output_path " +
+            dir.File("ws/mapper_initial"),
         kCli + " joint_adjuster --database_path " + dir.File("ws/database.db") +
-            " --input_path " + dir.File("ws/mapper_initial") + " --dataset_path " +
-            dataset + " --output_path " + dir.File("ws/mapper_joint"),
+            " --input_path " + dir.File("ws/mapper_initial") +
+            " --dataset_path " + dataset + " --output_path " +
+            dir.File("ws/mapper_joint"),
         kCli + " evaluate_calibration --dataset_path " + dataset +
             " --input_path " + dir.File("ws/mapper_joint") + " --output_path " +
             dir.File("ws/mapper_evaluation")}) {
@@ -121,18 +123,22 @@ TEST(PipelineTest, DefaultSceneWithoutAGuessEndToEndAndRestartable) {
       ReadJson(dir.File("ws/mapper_initial/initialization.json"));
   EXPECT_EQ(mapper_init["extrinsic_source"], "hand-eye");
   EXPECT_NE(mapper_init["scale_to_metres"].get<double>(), 1.0);
-  const nlohmann::json from_mapper = ReadJson(dir.File("ws/mapper_evaluation/metrics.json"));
-  std::cout << "from colmap mapper's model (scale " << mapper_init["scale_to_metres"]
-            << "): cam_from_lidar error "
+  const nlohmann::json from_mapper =
+      ReadJson(dir.File("ws/mapper_evaluation/metrics.json"));
+  std::cout << "from colmap mapper's model (scale "
+            << mapper_init["scale_to_metres"] << "): cam_from_lidar error "
             << from_mapper["cam_from_lidar_rotation_error_deg"] << " deg, "
-            << from_mapper["cam_from_lidar_translation_error_mm"] << " mm; poses mean "
-            << from_mapper["pose_position_error_mean_mm"] << " mm ("
-            << from_mapper["num_stations_evaluated"] << " stations)" << std::endl;
+            << from_mapper["cam_from_lidar_translation_error_mm"]
+            << " mm; poses mean " << from_mapper["pose_position_error_mean_mm"]
+            << " mm (" << from_mapper["num_stations_evaluated"] << " stations)"
+            << std::endl;
   // COLMAP's incremental mapper registers only part of 8 stations 45 deg apart (3 here); the
   // rescaled model must still be metric and calibrate cam_from_lidar.
   EXPECT_GE(from_mapper["num_stations_evaluated"].get<int>(), 3);
-  EXPECT_LE(from_mapper["cam_from_lidar_rotation_error_deg"].get<double>(), 0.05);
-  EXPECT_LE(from_mapper["cam_from_lidar_translation_error_mm"].get<double>(), 5.0);
+  EXPECT_LE(from_mapper["cam_from_lidar_rotation_error_deg"].get<double>(),
+            0.05);
+  EXPECT_LE(from_mapper["cam_from_lidar_translation_error_mm"].get<double>(),
+            5.0);
   EXPECT_LE(from_mapper["pose_position_error_mean_mm"].get<double>(), 2.0);
 
   // A second run finds every step done.
