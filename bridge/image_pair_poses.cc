@@ -41,6 +41,16 @@ std::vector<ImagePairPose> EstimateImagePairPoses(
   std::vector<colmap::image_pair_t> pair_ids;
   std::vector<colmap::TwoViewGeometry> geometries;
   database.ReadTwoViewGeometries(&pair_ids, &geometries);
+  // Each image's keypoints are read once, not once per pair.
+  std::unordered_map<colmap::image_t, colmap::FeatureKeypoints> keypoints;
+  const auto keypoints_of =
+      [&](colmap::image_t image_id) -> const colmap::FeatureKeypoints& {
+    auto it = keypoints.find(image_id);
+    if (it == keypoints.end()) {
+      it = keypoints.emplace(image_id, database.ReadKeypoints(image_id)).first;
+    }
+    return it->second;
+  };
   std::mt19937_64 rng(options.seed);
   std::vector<ImagePairPose> poses;
   for (size_t p = 0; p < pair_ids.size(); ++p) {
@@ -50,10 +60,8 @@ std::vector<ImagePairPose> EstimateImagePairPoses(
     const auto priors_j = depth_priors.find(image_j);
     if (priors_i == depth_priors.end() || priors_j == depth_priors.end())
       continue;
-    const colmap::FeatureKeypoints keypoints_i =
-        database.ReadKeypoints(image_i);
-    const colmap::FeatureKeypoints keypoints_j =
-        database.ReadKeypoints(image_j);
+    const colmap::FeatureKeypoints& keypoints_i = keypoints_of(image_i);
+    const colmap::FeatureKeypoints& keypoints_j = keypoints_of(image_j);
     const colmap::Camera& camera_i = cameras.at(images.at(image_i).CameraId());
     const colmap::Camera& camera_j = cameras.at(images.at(image_j).CameraId());
     std::vector<Eigen::Vector3d> points_i, points_j;

@@ -75,6 +75,21 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(
     station_of_image[image_id] = it->second;
   }
 
+  // The model's image ids must be the database's (depth priors and matches are keyed by them).
+  {
+    const colmap::Database database(database_path);
+    for (const colmap::image_t image_id : image_ids) {
+      const std::string& name = reconstruction.Image(image_id).Name();
+      if (!database.ExistsImage(image_id) ||
+          database.ReadImage(image_id).Name() != name) {
+        throw std::runtime_error(
+            "image " + std::to_string(image_id) + " ('" + name +
+            "') of the model is not the same image in " + database_path +
+            ": the model was not made from this database");
+      }
+    }
+  }
+
   // Depth priors.
   {
     const ExtensionDatabase extension(database_path,

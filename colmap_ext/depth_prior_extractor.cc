@@ -105,11 +105,15 @@ std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(
   ExtensionDatabase extension(database_path);
   std::vector<colmap::Image> images;
   std::map<colmap::image_t, colmap::FeatureKeypoints> keypoints;
+  std::map<colmap::camera_t, colmap::Camera> cameras;
   {
     const colmap::Database database(database_path);
     images = database.ReadAllImages();
     for (const colmap::Image& image : images) {
       keypoints[image.ImageId()] = database.ReadKeypoints(image.ImageId());
+    }
+    for (const colmap::Camera& camera : database.ReadAllCameras()) {
+      cameras[camera.camera_id] = camera;
     }
   }
   std::sort(images.begin(),
@@ -130,6 +134,17 @@ std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(
       colmap::mvs::DepthMap depth_map;
       depth_map.Read(map_path);
       THROW_CHECK_GT(depth_map.GetWidth(), 0) << "cannot read " << map_path;
+      // The map must be in this image's pixel grid, or every prior would be read at the wrong place.
+      const colmap::Camera& camera = cameras.at(image.CameraId());
+      if (depth_map.GetWidth() != camera.width ||
+          depth_map.GetHeight() != camera.height) {
+        throw std::runtime_error(
+            map_path + " is " + std::to_string(depth_map.GetWidth()) + "x" +
+            std::to_string(depth_map.GetHeight()) + " but image " +
+            image.Name() + " is " + std::to_string(camera.width) + "x" +
+            std::to_string(camera.height) +
+            ": the depth maps belong to another dataset or rig");
+      }
       std::vector<DepthPrior>& image_priors = priors[image.ImageId()];
       image_priors = ExtractDepthPriors(keypoints.at(image.ImageId()),
                                         depth_map,

@@ -289,7 +289,32 @@ TEST(FrontEndTest, BadInputNamesTheStationAndLeavesTheDatabaseUnchanged) {
 
   // The repaired dataset imports.
   const auto result = RunCommand(import);
-  EXPECT_EQ(result.exit_code, 0) << result.output;
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+
+  // Depth maps of another rig (another image size) must not become priors at the wrong pixels.
+  sim::SimulationOptions other;
+  other.output_path = dir.File("other");
+  other.num_stations = 2;
+  other.motion = "fixed_rotation";
+  other.image_scale = 0.2;
+  other.lidar_points = 2000;
+  sim::SimulateDataset(other);
+  ASSERT_EQ(
+      RunCommand(kCli + " stereo_depth --dataset_path " + other.output_path +
+                 " --output_path " + dir.File("other_stereo"))
+          .exit_code,
+      0);
+  const auto mismatch =
+      RunCommand(kCli + " depth_prior_extractor --database_path " + db +
+                 " --depth_path " + dir.File("other_stereo"));
+  EXPECT_NE(mismatch.exit_code, 0);
+  EXPECT_NE(mismatch.output.find("belong to another dataset or rig"),
+            std::string::npos)
+      << mismatch.output;
+  // No prior was written (COLMAP's own connection may rewrite the WAL header, so bytes are not compared).
+  EXPECT_EQ(ExtensionDatabase(db, ExtensionDatabase::Mode::kReadOnly)
+                .NumDepthPriors(),
+            0u);
 }
 
 }  // namespace
