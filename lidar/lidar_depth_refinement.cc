@@ -1,0 +1,268 @@
+#include "lidar/lidar_depth_refinement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace colmap_lidar {
+namespace {
+
+using IndexImage =
+    Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+double DegToRad(double degrees) { return degrees * M_PI / 180; }
+
+// Projected centre of every sample (NaN behind the camera).
+std::vector<Eigen::Vector2d> ProjectSamples(const LidarSurface& surface,
+                                            const PinholeIntrinsics& intrinsics) {
+  std::vector<Eigen::Vector2d> xy(
+      surface.Size(),
+      Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  for (size_t i = 0; i < surface.Size(); ++i) {
+    intrinsics.Project(surface.points[i], &xy[i]);
+  }
+  return xy;
+}
+
+IndexImage Splat(const LidarSurface& surface,
+                 const std::vector<Eigen::Vector2d>& xy,
+                 const PinholeIntrinsics& intrinsics,
+                 int max_radius_px) {
+  IndexImage index = IndexImage::Constant(intrinsics.height, intrinsics.width, -1);
+  DepthImage zbuffer = DepthImage::Constant(
+      intrinsics.height, intrinsics.width, std::numeric_limits<float>::infinity());
+  for (size_t i = 0; i < surface.Size(); ++i) {
+    if (!std::isfinite(xy[i].x())) continue;
+    const double z = surface.points[i].z();
+    const int radius = std::min(
+        max_radius_px,
+        static_cast<int>(0.5 * surface.spacing[i] * intrinsics.fx / z + 0.5));
+    const int col0 = static_cast<int>(std::floor(xy[i].x()));
+    const int row0 = static_cast<int>(std::floor(xy[i].y()));
+    for (int row = std::max(0, row0 - radius);
+         row <= std::min(intrinsics.height - 1, row0 + radius);
+         ++row) {
+      for (int col = std::max(0, col0 - radius);
+           col <= std::min(intrinsics.width - 1, col0 + radius);
+           ++col) {
+        if ((row - row0) * (row - row0) + (col - col0) * (col - col0) >
+            radius * radius) {
+          continue;
+        }
+        if (z < zbuffer(row, col)) {
+          zbuffer(row, col) = float(z);
+          index(row, col) = static_cast<int>(i);
+        }
+      }
+    }
+  }
+  return index;
+}
+
+}  // namespace
+
+bool LidarDepthRefinementOptions::Check() const {
+  auto fail = [](const char* what) {
+    throw std::invalid_argument(std::string("LidarDepthRefinementOptions: ") +
+                                what);
+  };
+  if (window_radius_px < 1) fail("window_radius_px must be >= 1");
+  if (!(max_abs_diff_m >= 0) || !(max_rel_diff >= 0)) {
+    fail("max_abs_diff_m and max_rel_diff must be >= 0");
+  }
+  if (!(plane_tolerance_m > 0)) fail("plane_tolerance_m must be > 0");
+  if (!(max_normal_angle_deg > 0 && max_normal_angle_deg < 90)) {
+    fail("max_normal_angle_deg must be in (0, 90)");
+  }
+  if (min_fill_samples < 1) fail("min_fill_samples must be >= 1");
+  if (min_fill_quadrants < 0 || min_fill_quadrants > 4) {
+    fail("min_fill_quadrants must be in [0, 4]");
+  }
+  if (!(max_fill_curvature >= 0)) fail("max_fill_curvature must be >= 0");
+  if (!(max_fill_view_angle_deg > 0 && max_fill_view_angle_deg < 90)) {
+    fail("max_fill_view_angle_deg must be in (0, 90)");
+  }
+  return true;
+}
+
+IndexImage SplatLidarSurface(const LidarSurface& surface,
+                             const PinholeIntrinsics& intrinsics,
+                             int max_radius_px) {
+  intrinsics.Check();
+  return Splat(
+      surface, ProjectSamples(surface, intrinsics), intrinsics, max_radius_px);
+}
+
+RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
+                                  const LidarSurface& surface,
+                                  const PinholeIntrinsics& intrinsics,
+                                  const LidarDepthRefinementOptions& options) {
+  options.Check();
+  intrinsics.Check();
+  if (stereo.rows() != intrinsics.height || stereo.cols() != intrinsics.width) {
+    throw std::invalid_argument(
+        "RefineDepthWithLidar: the depth map is " +
+        std::to_string(stereo.cols()) + "x" + std::to_string(stereo.rows()) +
+        " but the camera is " + std::to_string(intrinsics.width) + "x" +
+        std::to_string(intrinsics.height));
+  }
+  const int width = intrinsics.width;
+  const int height = intrinsics.height;
+  const int radius = options.window_radius_px;
+  const std::vector<Eigen::Vector2d> xy = ProjectSamples(surface, intrinsics);
+  // Footprints reach at most half the window: a sample never hides a whole window.
+  const IndexImage index =
+      Splat(surface, xy, intrinsics, std::max(1, radius / 2));
+  const double min_normal_cos = std::cos(DegToRad(options.max_normal_angle_deg));
+  const double min_view_cos = std::cos(DegToRad(options.max_fill_view_angle_deg));
+  const double kMinRayCos = std::cos(DegToRad(85));
+
+  RefinedDepth result;
+  result.depth = DepthImage::Zero(height, width);
+  result.normals = NormalImage(width, height);
+  result.source.assign(size_t(width) * height, DepthSource::kNone);
+  LidarDepthRefinementStats stats;
+
+#pragma omp parallel
+  {
+    LidarDepthRefinementStats local;
+    std::vector<int> window;
+    std::vector<int> layer;
+#pragma omp for schedule(dynamic, 8)
+    for (int row = 0; row < height; ++row) {
+      for (int col = 0; col < width; ++col) {
+        const size_t pixel = size_t(row) * width + col;
+        const float stereo_z = stereo(row, col);
+        const bool has_stereo = stereo_z > 0 && std::isfinite(stereo_z);
+        local.stereo_pixels += has_stereo;
+
+        // The window's visible samples.
+        window.clear();
+        for (int dr = -radius; dr <= radius; ++dr) {
+          const int r = row + dr;
+          if (r < 0 || r >= height) continue;
+          for (int dc = -radius; dc <= radius; ++dc) {
+            const int c = col + dc;
+            if (c < 0 || c >= width || dr * dr + dc * dc > radius * radius) {
+              continue;
+            }
+            if (index(r, c) >= 0) window.push_back(index(r, c));
+          }
+        }
+        std::sort(window.begin(), window.end());
+        window.erase(std::unique(window.begin(), window.end()), window.end());
+
+        // The layer of the visible sample nearest the pixel, and its plane.
+        const Eigen::Vector2d centre(col + 0.5, row + 0.5);
+        const Eigen::Vector3d ray = intrinsics.PixelRay(col, row);
+        const Eigen::Vector3d unit_ray = ray.normalized();
+        bool has_plane = false;
+        double lidar_z = 0;
+        Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+        layer.clear();
+        if (!window.empty()) {
+          int nearest = index(row, col);
+          if (nearest < 0) {
+            double best = std::numeric_limits<double>::infinity();
+            for (int s : window) {
+              const double d = (xy[s] - centre).squaredNorm();
+              if (d < best) best = d, nearest = s;
+            }
+          }
+          const Eigen::Vector3d& n0 = surface.normals[nearest];
+          const Eigen::Vector3d& x0 = surface.points[nearest];
+          Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
+          Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+          for (int s : window) {
+            if (std::abs(n0.dot(surface.points[s] - x0)) <=
+                    options.plane_tolerance_m &&
+                n0.dot(surface.normals[s]) >= min_normal_cos) {
+              layer.push_back(s);
+              normal_sum += surface.normals[s];
+              centroid += surface.points[s];
+            }
+          }
+          normal = normal_sum.normalized();
+          centroid /= double(layer.size());
+          const double denominator = normal.dot(ray);
+          if (std::abs(normal.dot(unit_ray)) > kMinRayCos) {
+            lidar_z = normal.dot(centroid) / denominator;
+            has_plane = lidar_z > 0;
+          }
+        }
+
+        float depth = 0;
+        if (has_stereo) {
+          if (!has_plane) {
+            ++local.stereo_without_lidar;
+            depth = stereo_z;
+          } else if (std::abs(stereo_z - lidar_z) <=
+                     options.max_abs_diff_m + options.max_rel_diff * lidar_z) {
+            ++local.stereo_confirmed;
+            depth = stereo_z;
+            result.normals.normals[pixel] = normal.cast<float>();
+          } else if (!options.remove_inconsistent) {
+            depth = stereo_z;  // disagrees, kept on request; normal from the depth map
+          } else {
+            ++local.stereo_removed;  // fold 1 (paper, mapping step (1))
+          }
+        }
+        if (depth > 0) {
+          result.depth(row, col) = depth;
+          result.source[pixel] = DepthSource::kStereo;
+          continue;
+        }
+
+        // Fold 2 (paper, mapping step (2)): only inside one flat, well-observed LiDAR layer that
+        // surrounds the pixel. A second layer in the window is a depth edge: no fill.
+        if (!options.fill_holes || !has_plane ||
+            layer.size() != window.size() ||
+            static_cast<int>(layer.size()) < options.min_fill_samples ||
+            std::abs(normal.dot(unit_ray)) < min_view_cos) {
+          continue;
+        }
+        bool flat = true;
+        int quadrants = 0;
+        for (int s : layer) {
+          flat = flat && surface.curvature[s] <= options.max_fill_curvature;
+          const Eigen::Vector2d d = xy[s] - centre;
+          if (d.squaredNorm() < 0.25) {
+            quadrants = 0xF;
+          } else {
+            quadrants |= 1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3)
+                                           : (d.y() >= 0 ? 1 : 2));
+          }
+        }
+        int num_quadrants = 0;
+        for (int q = 0; q < 4; ++q) num_quadrants += (quadrants >> q) & 1;
+        if (!flat || num_quadrants < options.min_fill_quadrants) continue;
+        result.depth(row, col) = float(lidar_z);
+        result.normals.normals[pixel] = normal.cast<float>();
+        result.source[pixel] = DepthSource::kLidar;
+        ++local.filled;
+      }
+    }
+#pragma omp critical
+    {
+      stats.stereo_pixels += local.stereo_pixels;
+      stats.stereo_without_lidar += local.stereo_without_lidar;
+      stats.stereo_confirmed += local.stereo_confirmed;
+      stats.stereo_removed += local.stereo_removed;
+      stats.filled += local.filled;
+    }
+  }
+
+  // Stereo pixels without a LiDAR layer take their normal from the depth map.
+  const NormalImage from_depth = NormalsFromDepth(result.depth, intrinsics);
+  for (size_t pixel = 0; pixel < result.source.size(); ++pixel) {
+    if (result.source[pixel] != DepthSource::kNone &&
+        result.normals.normals[pixel].isZero()) {
+      result.normals.normals[pixel] = from_depth.normals[pixel];
+    }
+  }
+  result.stats = stats;
+  return result;
+}
+
+}  // namespace colmap_lidar

@@ -1,0 +1,73 @@
+// LiDAR-guided refinement of one station's stereo depth map (the paper's mapping step):
+//   fold 1  stereo depths that disagree with the local LiDAR surface are removed;
+//   fold 2  holes are filled from the LiDAR surface where it is flat (low curvature), well observed
+//           (small angle between its normal and the viewing ray) and surrounds the pixel without a
+//           depth edge, by intersecting the pixel's ray with the local plane.
+//
+// The local LiDAR surface at a pixel: the LiDAR surface samples (lidar_surface.h) are splatted into a
+// z-buffer, each over its footprint (half its spacing, in pixels), so that a sample hidden behind a
+// nearer surface from the camera's viewpoint (LiDAR and camera see from different places) is not used.
+// The samples within `window_radius_px` form the window; the visible sample nearest the pixel defines
+// the layer: the window samples on its plane (distance and normal agree). The layer's plane (mean normal
+// through the centroid) gives the LiDAR depth z_l along the pixel's ray.
+#pragma once
+
+#include "lidar/lidar_surface.h"
+#include "lidar/pinhole_depth_image.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace colmap_lidar {
+
+struct LidarDepthRefinementOptions {
+  int window_radius_px = 5;
+  // Fold 1: a stereo depth z is removed when |z - z_l| > max_abs_diff_m + max_rel_diff * z_l.
+  bool remove_inconsistent = true;
+  double max_abs_diff_m = 0.01;
+  double max_rel_diff = 0.005;
+  // Layer membership: a window sample is on the nearest sample's surface when its point lies within
+  // plane_tolerance_m of that plane and its normal within max_normal_angle_deg.
+  double plane_tolerance_m = 0.006;
+  double max_normal_angle_deg = 20;
+  // Fold 2.
+  bool fill_holes = true;
+  int min_fill_samples = 4;  // layer samples in the window
+  int min_fill_quadrants = 3;  // of the 4 quadrants around the pixel holding a sample (interpolate,
+                               // never extrapolate past the LiDAR's coverage)
+  double max_fill_curvature = 0.03;   // LidarSurface::curvature of every window sample
+  double max_fill_view_angle_deg = 60;  // between the plane normal and the viewing ray
+
+  bool Check() const;  // throws std::invalid_argument
+};
+
+enum class DepthSource : uint8_t { kNone = 0, kStereo = 1, kLidar = 2 };
+
+struct LidarDepthRefinementStats {
+  size_t stereo_pixels = 0;         // valid in the input
+  size_t stereo_without_lidar = 0;  // kept unchecked: no LiDAR surface near
+  size_t stereo_confirmed = 0;      // kept: agrees with the LiDAR
+  size_t stereo_removed = 0;        // fold 1
+  size_t filled = 0;                // fold 2
+};
+
+struct RefinedDepth {
+  DepthImage depth;
+  NormalImage normals;  // LiDAR plane normal where a layer exists, else from the depth map
+  std::vector<DepthSource> source;  // row-major
+  LidarDepthRefinementStats stats;
+};
+
+// The z-buffer of splatted samples: per pixel the index of the nearest covering sample, -1 for none.
+Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>
+SplatLidarSurface(const LidarSurface& surface,
+                  const PinholeIntrinsics& intrinsics,
+                  int max_radius_px);
+
+// `stereo` must have the intrinsics' size (throws std::invalid_argument otherwise).
+RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
+                                  const LidarSurface& surface,
+                                  const PinholeIntrinsics& intrinsics,
+                                  const LidarDepthRefinementOptions& options);
+
+}  // namespace colmap_lidar

@@ -1,0 +1,43 @@
+// A station's LiDAR surface as the densifier needs it: the cloud (already in the camera frame and cropped
+// to the camera's view) thinned to one centroid per small voxel, then each sample moved onto the plane
+// fitted to its neighbourhood (PCA; a moving-least-squares projection of order 0), with that plane's
+// normal and curvature. A VLP-16's 1-3 cm range noise drops to a few millimetres this way, and the
+// curvature says where the surface is flat enough to fill stereo holes from (paper, mapping step).
+#pragma once
+
+#include "lidar/point_cloud.h"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace colmap_lidar {
+
+struct LidarSurfaceOptions {
+  double sample_spacing_m = 0.005;  // voxel edge of the thinning
+  double radius_m = 0.04;           // PCA neighbourhood radius
+  int min_neighbors = 8;  // fewer samples in the radius: the sample is dropped
+  int max_neighbors = 96;  // larger neighbourhoods are subsampled evenly
+
+  bool Check() const;  // throws std::invalid_argument
+};
+
+struct LidarSurface {
+  std::vector<Eigen::Vector3d> points;   // on the fitted plane, camera frame
+  std::vector<Eigen::Vector3d> normals;  // unit, facing the viewpoint
+  // lambda_min / (lambda_1 + lambda_2 + lambda_3) of the neighbourhood: 0 on a plane, 1/3 at most.
+  // With range noise sigma on a flat patch it is about 3 sigma^2 / radius^2.
+  std::vector<float> curvature;
+  // Mean distance between neighbouring samples around each sample, from the neighbourhood's count:
+  // sqrt(pi radius^2 / count). How far a sample's footprint reaches.
+  std::vector<float> spacing;
+
+  size_t Size() const { return points.size(); }
+};
+
+// `points_in_cam`: the LiDAR points in the camera frame. Normals face the camera (the origin): LiDAR
+// and camera see the same side of any surface both see.
+LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam,
+                               const LidarSurfaceOptions& options);
+
+}  // namespace colmap_lidar
