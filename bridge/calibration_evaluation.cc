@@ -65,6 +65,8 @@ CalibrationEvaluation EvaluateCalibration(
   result.alignment_scale = std::cbrt(scaled_rotation.determinant());
   const Eigen::Matrix3d rotation = scaled_rotation / result.alignment_scale;
   const Eigen::Vector3d translation = alignment.topRightCorner<3, 1>();
+  result.truth_from_model =
+      colmap::Rigid3d(Eigen::Quaterniond(rotation), translation);
 
   double sum_rotation = 0, sum_position = 0;
   for (size_t i = 0; i < names.size(); ++i) {

@@ -21,6 +21,9 @@ struct CalibrationEvaluation {
       Eigen::Vector3d::Zero();
   std::string alignment;  // "rigid" or "similarity"
   double alignment_scale = 1;
+  // The alignment's rotation and translation: true_world_from_model_world without the scale (the
+  // transform evaluate_model applies to a dense model of this sparse model).
+  colmap::Rigid3d truth_from_model;
   size_t num_stations_evaluated = 0;
   std::vector<std::string>
       missing_stations;  // in the truth, not registered in the model

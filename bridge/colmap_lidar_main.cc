@@ -69,6 +69,10 @@ const std::vector<Command>& Commands() {
        &RunPoseInitializer,
        "Initial station poses, cam_from_lidar and landmarks (a metric COLMAP "
        "model)"},
+      {"densifier",
+       &RunDensifier,
+       "Dense model: stereo depth refined by LiDAR, fused.ply, lidar_map.ply, "
+       "COLMAP dense workspace"},
       {"pipeline",
        &RunPipeline,
        "Run every step on a dataset into a workspace (restartable)"},

@@ -34,6 +34,10 @@ int RunJointAdjuster(int argc, char** argv);
 // landmarks by COLMAP's triangulator: a metric COLMAP model for the joint adjuster.
 int RunPoseInitializer(int argc, char** argv);
 
+// The dense model: stereo depth refined by LiDAR (remove, fill), fused.ply, lidar_map.ply and COLMAP's
+// dense workspace (bridge/densifier.h).
+int RunDensifier(int argc, char** argv);
+
 // Every step from a station dataset to the refined model, restartable (bridge/pipeline_commands.cc).
 int RunPipeline(int argc, char** argv);
 

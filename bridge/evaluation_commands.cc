@@ -57,6 +57,11 @@ int RunEvaluateModel(int argc, char** argv) {
       "ground_truth_path", &ground_truth_path, "surface.ply with normals");
   manager.AddRequiredOption(
       "output_path", &output_path, "directory for metrics.json and plots");
+  std::string truth_from_model_path;
+  manager.AddDefaultOption("truth_from_model",
+                           &truth_from_model_path,
+                           "pose file moving the model into the truth's "
+                           "frame first (evaluate_calibration writes one)");
   manager.AddDefaultOption(
       "align_icp", &options.align_icp, "rigid point-to-plane ICP first");
   manager.AddDefaultOption("crop_distance_m", &options.crop_distance_m);
@@ -69,7 +74,15 @@ int RunEvaluateModel(int argc, char** argv) {
       << thresholds << "'";
 
   // Inputs first: a missing or bad cloud must not leave an output folder behind.
-  const PointCloud model = ReadPointCloud(model_path);
+  PointCloud model = ReadPointCloud(model_path);
+  if (!truth_from_model_path.empty()) {
+    const colmap::Rigid3d truth_from_model =
+        ReadPoseFile(truth_from_model_path);
+    for (Eigen::Vector3d& point : model.points) point = truth_from_model * point;
+    for (Eigen::Vector3d& normal : model.normals) {
+      normal = truth_from_model.rotation * normal;
+    }
+  }
   const PointCloud truth = ReadPointCloud(ground_truth_path);
   THROW_CHECK(truth.HasNormals()) << ground_truth_path << " has no normals";
   std::cout << "evaluate_model: " << model.Size() << " model points against "
@@ -218,6 +231,12 @@ int RunEvaluateCalibration(int argc, char** argv) {
     fs::create_directories(output_path);
     WriteFileAtomically((fs::path(output_path) / "metrics.json").string(),
                         metrics.dump(2) + "\n");
+    WritePoseFile((fs::path(output_path) / "truth_from_model.txt").string(),
+                  "true_world_from_model_world by " + result.alignment +
+                      " alignment of the camera centres (scale " +
+                      std::to_string(result.alignment_scale) +
+                      " not included); qw qx qy qz tx ty tz",
+                  result.truth_from_model);
   } else {
     std::cout << metrics.dump(2) << std::endl;
   }

@@ -206,6 +206,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
             depth = stereo_z;  // disagrees, kept on request; normal from the depth map
           } else {
             ++local.stereo_removed;  // fold 1 (paper, mapping step (1))
+            result.source[pixel] = DepthSource::kRemoved;
           }
         }
         if (depth > 0) {
@@ -256,7 +257,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
   // Stereo pixels without a LiDAR layer take their normal from the depth map.
   const NormalImage from_depth = NormalsFromDepth(result.depth, intrinsics);
   for (size_t pixel = 0; pixel < result.source.size(); ++pixel) {
-    if (result.source[pixel] != DepthSource::kNone &&
+    if (result.depth.data()[pixel] > 0 &&
         result.normals.normals[pixel].isZero()) {
       result.normals.normals[pixel] = from_depth.normals[pixel];
     }

@@ -41,7 +41,8 @@ struct LidarDepthRefinementOptions {
   bool Check() const;  // throws std::invalid_argument
 };
 
-enum class DepthSource : uint8_t { kNone = 0, kStereo = 1, kLidar = 2 };
+// kRemoved: no depth, the stereo depth was removed by fold 1 and not filled.
+enum class DepthSource : uint8_t { kNone = 0, kStereo = 1, kLidar = 2, kRemoved = 3 };
 
 struct LidarDepthRefinementStats {
   size_t stereo_pixels = 0;         // valid in the input

@@ -1,0 +1,462 @@
+#include "bridge/densifier.h"
+
+#include "colmap_ext/dense_workspace.h"
+#include "colmap_ext/stereo_depth.h"
+#include "lidar/cloud_io.h"
+#include "lidar/pinhole_depth_image.h"
+#include "lidar/voxel_accumulator.h"
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <map>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct StationView {
+  size_t station = 0;  // index into the dataset
+  colmap::image_t image_id = colmap::kInvalidImageId;
+  std::string image_name;
+};
+
+PinholeIntrinsics IntrinsicsOf(const colmap::Camera& camera) {
+  PinholeIntrinsics intrinsics;
+  intrinsics.width = static_cast<int>(camera.width);
+  intrinsics.height = static_cast<int>(camera.height);
+  intrinsics.fx = camera.FocalLengthX();
+  intrinsics.fy = camera.FocalLengthY();
+  intrinsics.cx = camera.PrincipalPointX();
+  intrinsics.cy = camera.PrincipalPointY();
+  return intrinsics;
+}
+
+// The registered images that are stations of the dataset, in station order.
+std::vector<StationView> StationViews(const colmap::Reconstruction& reconstruction,
+                                      const StationDataset& dataset) {
+  std::map<std::string, colmap::image_t> by_name;
+  for (const colmap::image_t image_id : reconstruction.RegImageIds()) {
+    by_name[reconstruction.Image(image_id).Name()] = image_id;
+  }
+  std::vector<StationView> views;
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    const auto found = by_name.find(dataset.LeftImageName(i));
+    if (found == by_name.end()) {
+      std::cout << "densifier: station " << dataset.stations[i]
+                << " is not registered in the model; skipped" << std::endl;
+      continue;
+    }
+    views.push_back({i, found->second, found->first});
+  }
+  if (views.empty()) {
+    throw std::runtime_error(
+        "densifier: no registered image of the model is a station of the "
+        "dataset (images must be named like " +
+        dataset.LeftImageName(0) + ")");
+  }
+  return views;
+}
+
+// For each view, the other views sharing the most sparse points with it (at most `max_views`).
+std::vector<std::vector<size_t>> NeighborViews(
+    const colmap::Reconstruction& reconstruction,
+    const std::vector<StationView>& views,
+    int max_views) {
+  std::map<colmap::image_t, size_t> index;
+  for (size_t k = 0; k < views.size(); ++k) index[views[k].image_id] = k;
+  std::vector<std::map<size_t, int>> shared(views.size());
+  for (const auto& [point_id, point] : reconstruction.Points3D()) {
+    std::vector<size_t> seen;
+    for (const colmap::TrackElement& element : point.track.Elements()) {
+      const auto found = index.find(element.image_id);
+      if (found != index.end()) seen.push_back(found->second);
+    }
+    std::sort(seen.begin(), seen.end());
+    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    for (size_t a : seen) {
+      for (size_t b : seen) {
+        if (a != b) ++shared[a][b];
+      }
+    }
+  }
+  std::vector<std::vector<size_t>> neighbors(views.size());
+  for (size_t k = 0; k < views.size(); ++k) {
+    std::vector<std::pair<int, size_t>> ranked;
+    for (const auto& [other, count] : shared[k]) ranked.emplace_back(-count, other);
+    std::sort(ranked.begin(), ranked.end());
+    for (size_t r = 0; r < ranked.size() && r < size_t(max_views); ++r) {
+      neighbors[k].push_back(ranked[r].second);
+    }
+  }
+  return neighbors;
+}
+
+cv::Mat NormalsToMat(const NormalImage& normals) {
+  cv::Mat mat(normals.height, normals.width, CV_32FC3);
+  for (int row = 0; row < normals.height; ++row) {
+    for (int col = 0; col < normals.width; ++col) {
+      const Eigen::Vector3f& n = normals.At(row, col);
+      mat.at<cv::Vec3f>(row, col) = cv::Vec3f(n.x(), n.y(), n.z());
+    }
+  }
+  return mat;
+}
+
+cv::Mat SourcePreview(const std::vector<DepthSource>& source, int width, int height) {
+  cv::Mat preview(height, width, CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int row = 0; row < height; ++row) {
+    for (int col = 0; col < width; ++col) {
+      cv::Vec3b& bgr = preview.at<cv::Vec3b>(row, col);
+      switch (source[size_t(row) * width + col]) {
+        case DepthSource::kStereo: bgr = cv::Vec3b(220, 120, 40); break;
+        case DepthSource::kLidar: bgr = cv::Vec3b(60, 200, 60); break;
+        case DepthSource::kRemoved: bgr = cv::Vec3b(40, 40, 230); break;
+        case DepthSource::kNone: break;
+      }
+    }
+  }
+  return preview;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// Fold 1 and 2 for one station; writes its maps, image and preview into the workspace and adds its
+// LiDAR cloud to the LiDAR map.
+StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
+                                   const StationView& view,
+                                   const colmap::Rigid3d& cam_from_lidar,
+                                   const StationDataset& dataset,
+                                   const std::string& depth_path,
+                                   const DenseWorkspace& workspace,
+                                   const DensifierOptions& options,
+                                   VoxelAccumulator* lidar_map) {
+  const std::string& station = dataset.stations[view.station];
+  StationDensification result;
+  result.station = station;
+  const colmap::Image& image = reconstruction.Image(view.image_id);
+  const colmap::Camera& camera = reconstruction.Camera(image.CameraId());
+  const PinholeIntrinsics intrinsics = IntrinsicsOf(camera);
+
+  const std::string stereo_path = StereoDepthMapPath(depth_path, station);
+  cv::Mat stereo = ReadColmapDepthMap(stereo_path);
+  if (stereo.cols != intrinsics.width || stereo.rows != intrinsics.height) {
+    throw std::runtime_error("station " + station + ": the depth map " +
+                             stereo_path + " is " + std::to_string(stereo.cols) +
+                             "x" + std::to_string(stereo.rows) +
+                             " but the camera is " +
+                             std::to_string(intrinsics.width) + "x" +
+                             std::to_string(intrinsics.height));
+  }
+  const Eigen::Map<const DepthImage> stereo_depth(
+      stereo.ptr<float>(), stereo.rows, stereo.cols);
+
+  // The station's cloud: into the LiDAR map (world frame), and cropped to the camera's view.
+  const PointCloud cloud = ReadPointCloud(dataset.cloud_paths[view.station]);
+  const colmap::Rigid3d world_from_lidar =
+      colmap::Inverse(image.CamFromWorld()) * cam_from_lidar;
+  std::vector<Eigen::Vector3d> in_view;
+  for (const Eigen::Vector3d& point_in_lidar : cloud.points) {
+    lidar_map->Add(world_from_lidar * point_in_lidar,
+                   Eigen::Vector3f::Zero(),
+                   Color3ub(128, 128, 128));
+    const Eigen::Vector3d point_in_cam = cam_from_lidar * point_in_lidar;
+    Eigen::Vector2d xy;
+    if (point_in_cam.z() < options.min_depth_m ||
+        point_in_cam.z() > options.max_depth_m ||
+        !intrinsics.Project(point_in_cam, &xy)) {
+      continue;
+    }
+    const double margin = 0.05 * intrinsics.width;
+    if (xy.x() < -margin || xy.y() < -margin ||
+        xy.x() > intrinsics.width + margin ||
+        xy.y() > intrinsics.height + margin) {
+      continue;
+    }
+    in_view.push_back(point_in_cam);
+  }
+  result.lidar_points_in_view = in_view.size();
+
+  RefinedDepth refined;
+  if (options.refine_with_lidar) {
+    const LidarSurface surface = BuildLidarSurface(in_view, options.surface);
+    refined = RefineDepthWithLidar(
+        stereo_depth, surface, intrinsics, options.refinement);
+  } else {
+    refined.depth = stereo_depth;
+    refined.normals = NormalsFromDepth(refined.depth, intrinsics);
+    refined.source.assign(refined.depth.size(), DepthSource::kNone);
+    for (Eigen::Index k = 0; k < refined.depth.size(); ++k) {
+      if (refined.depth.data()[k] > 0) {
+        refined.source[k] = DepthSource::kStereo;
+        ++refined.stats.stereo_pixels;
+        ++refined.stats.stereo_without_lidar;
+      }
+    }
+  }
+  result.refinement = refined.stats;
+
+  const cv::Mat depth_mat(intrinsics.height,
+                          intrinsics.width,
+                          CV_32F,
+                          refined.depth.data());
+  workspace.WriteDepthMap(view.image_name, depth_mat);
+  workspace.WriteNormalMap(view.image_name, NormalsToMat(refined.normals));
+  workspace.CopyImage(view.image_name, dataset.LeftImagePath(view.station));
+  const fs::path preview_dir = fs::path(workspace.Root()) / "stereo" / "previews";
+  fs::create_directories(preview_dir);
+  cv::imwrite((preview_dir / (station + ".png")).string(),
+              SourcePreview(refined.source, intrinsics.width, intrinsics.height));
+  return result;
+}
+
+// Back-projects one station's refined map (with colour and normals) into the fused grid.
+void FuseStation(const colmap::Reconstruction& reconstruction,
+                 const std::vector<StationView>& views,
+                 size_t view_index,
+                 const std::vector<size_t>& neighbors,
+                 const DenseWorkspace& workspace,
+                 const DensifierOptions& options,
+                 StationDensification* result,
+                 VoxelAccumulator* fused) {
+  const StationView& view = views[view_index];
+  const colmap::Image& image = reconstruction.Image(view.image_id);
+  const PinholeIntrinsics intrinsics =
+      IntrinsicsOf(reconstruction.Camera(image.CameraId()));
+  const cv::Mat depth = workspace.ReadDepthMap(view.image_name);
+  const cv::Mat normals = workspace.ReadNormalMap(view.image_name);
+  const std::string image_path = workspace.ImagePath(view.image_name);
+  const cv::Mat bgr = cv::imread(image_path, cv::IMREAD_COLOR);
+  if (bgr.empty() || bgr.cols != depth.cols || bgr.rows != depth.rows) {
+    throw std::runtime_error("densifier: cannot read " + image_path +
+                             " at the depth map's size");
+  }
+  struct Other {
+    cv::Mat depth;
+    PinholeIntrinsics intrinsics;
+    colmap::Rigid3d cam_from_world;
+  };
+  std::vector<Other> others;
+  if (options.min_consistent_views > 0) {
+    for (size_t k : neighbors) {
+      const colmap::Image& other = reconstruction.Image(views[k].image_id);
+      others.push_back({workspace.ReadDepthMap(views[k].image_name),
+                        IntrinsicsOf(reconstruction.Camera(other.CameraId())),
+                        other.CamFromWorld()});
+    }
+  }
+  const colmap::Rigid3d world_from_cam = colmap::Inverse(image.CamFromWorld());
+  const Eigen::Matrix3d world_from_cam_rotation =
+      world_from_cam.rotation.toRotationMatrix();
+
+  struct Sample {
+    Eigen::Vector3d point;
+    Eigen::Vector3f normal;
+    Color3ub color;
+  };
+  std::vector<std::vector<Sample>> rows(depth.rows);
+  size_t inconsistent = 0;
+#pragma omp parallel for schedule(dynamic, 8) reduction(+ : inconsistent)
+  for (int row = 0; row < depth.rows; ++row) {
+    for (int col = 0; col < depth.cols; ++col) {
+      const float z = depth.at<float>(row, col);
+      if (!(z > 0)) continue;
+      const Eigen::Vector3d ray = intrinsics.PixelRay(col, row);
+      const Eigen::Vector3d point_in_world = world_from_cam * (ray * double(z));
+      if (options.min_consistent_views > 0) {
+        int agreeing = 0;
+        for (const Other& other : others) {
+          const Eigen::Vector3d point_in_other = other.cam_from_world * point_in_world;
+          Eigen::Vector2d xy;
+          if (!other.intrinsics.Project(point_in_other, &xy) ||
+              !other.intrinsics.Contains(xy)) {
+            continue;
+          }
+          const float other_z = other.depth.at<float>(static_cast<int>(xy.y()),
+                                                      static_cast<int>(xy.x()));
+          agreeing += other_z > 0 &&
+                      std::abs(other_z - point_in_other.z()) <=
+                          options.consistency_abs_m +
+                              options.consistency_rel * point_in_other.z();
+        }
+        if (agreeing < options.min_consistent_views) {
+          ++inconsistent;
+          continue;
+        }
+      }
+      const cv::Vec3f& n = normals.at<cv::Vec3f>(row, col);
+      Eigen::Vector3d normal_in_cam(n[0], n[1], n[2]);
+      if (normal_in_cam.isZero()) normal_in_cam = -ray.normalized();
+      const cv::Vec3b& color = bgr.at<cv::Vec3b>(row, col);
+      rows[row].push_back({point_in_world,
+                           (world_from_cam_rotation * normal_in_cam).cast<float>(),
+                           Color3ub(color[2], color[1], color[0])});
+    }
+  }
+  for (const auto& samples : rows) {
+    for (const Sample& sample : samples) {
+      fused->Add(sample.point, sample.normal, sample.color);
+      ++result->points;
+    }
+  }
+  result->inconsistent = inconsistent;
+}
+
+nlohmann::json StationReport(const StationDensification& station) {
+  const LidarDepthRefinementStats& s = station.refinement;
+  return {{"station", station.station},
+          {"lidar_points_in_view", station.lidar_points_in_view},
+          {"stereo_pixels", s.stereo_pixels},
+          {"stereo_confirmed", s.stereo_confirmed},
+          {"stereo_without_lidar", s.stereo_without_lidar},
+          {"stereo_removed", s.stereo_removed},
+          {"filled", s.filled},
+          {"inconsistent", station.inconsistent},
+          {"points", station.points},
+          {"seconds", station.seconds}};
+}
+
+}  // namespace
+
+bool DensifierOptions::Check() const {
+  surface.Check();
+  refinement.Check();
+  auto fail = [](const std::string& what) {
+    throw std::invalid_argument("DensifierOptions: " + what);
+  };
+  if (!(min_depth_m > 0) || !(max_depth_m > min_depth_m)) {
+    fail("need 0 < min_depth_m < max_depth_m");
+  }
+  if (min_consistent_views < 0 || max_neighbor_views < min_consistent_views) {
+    fail("need 0 <= min_consistent_views <= max_neighbor_views");
+  }
+  if (!(consistency_abs_m >= 0) || !(consistency_rel >= 0)) {
+    fail("consistency_abs_m and consistency_rel must be >= 0");
+  }
+  if (!(fused_voxel_size_m > 0) || !(lidar_map_voxel_size_m > 0)) {
+    fail("voxel sizes must be > 0");
+  }
+  return true;
+}
+
+DensifierSummary Densify(const colmap::Reconstruction& reconstruction,
+                         const colmap::Rigid3d& cam_from_lidar,
+                         const StationDataset& dataset,
+                         const std::string& depth_path,
+                         const std::string& output_path,
+                         const DensifierOptions& options) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<StationView> views = StationViews(reconstruction, dataset);
+  for (const StationView& view : views) {
+    const colmap::Camera& camera = reconstruction.Camera(
+        reconstruction.Image(view.image_id).CameraId());
+    if (!IsPinholeCamera(camera)) {
+      throw std::runtime_error(
+          "densifier: camera " + std::to_string(camera.camera_id) + " is " +
+          camera.ModelName() +
+          "; the densifier needs an undistorted (SIMPLE_PINHOLE or PINHOLE) "
+          "camera");
+    }
+  }
+  const fs::path partial = output_path + ".partial";
+  fs::remove_all(partial);
+  DensifierSummary summary;
+  try {
+    const DenseWorkspace workspace(partial.string());
+    VoxelAccumulator lidar_map(options.lidar_map_voxel_size_m);
+    std::cout << "densifier: " << views.size() << " stations, "
+              << (options.refine_with_lidar ? "LiDAR-refined" : "stereo only")
+              << std::endl;
+    for (size_t k = 0; k < views.size(); ++k) {
+      const auto station_start = std::chrono::steady_clock::now();
+      StationDensification station = RefineStation(reconstruction,
+                                                    views[k],
+                                                    cam_from_lidar,
+                                                    dataset,
+                                                    depth_path,
+                                                    workspace,
+                                                    options,
+                                                    &lidar_map);
+      station.seconds = SecondsSince(station_start);
+      const LidarDepthRefinementStats& s = station.refinement;
+      std::cout << "densifier: [" << k + 1 << "/" << views.size() << "] station "
+                << station.station << ": " << s.stereo_pixels
+                << " stereo pixels (" << s.stereo_confirmed << " confirmed by LiDAR, "
+                << s.stereo_removed << " removed), " << s.filled
+                << " filled from " << station.lidar_points_in_view
+                << " LiDAR points in view (" << std::fixed << std::setprecision(1)
+                << station.seconds << " s)" << std::endl;
+      summary.stations.push_back(station);
+    }
+
+    VoxelAccumulator fused(options.fused_voxel_size_m);
+    const std::vector<std::vector<size_t>> neighbors =
+        NeighborViews(reconstruction, views, options.max_neighbor_views);
+    for (size_t k = 0; k < views.size(); ++k) {
+      const auto station_start = std::chrono::steady_clock::now();
+      FuseStation(reconstruction,
+                  views,
+                  k,
+                  neighbors[k],
+                  workspace,
+                  options,
+                  &summary.stations[k],
+                  &fused);
+      summary.stations[k].seconds += SecondsSince(station_start);
+    }
+    const PointCloud fused_cloud = fused.Extract();
+    summary.fused_points = fused_cloud.Size();
+    std::cout << "densifier: fused " << fused.NumPointsAdded() << " points into "
+              << fused_cloud.Size() << " voxels of "
+              << options.fused_voxel_size_m * 1000 << " mm" << std::endl;
+    WritePointCloud((partial / "fused.ply").string(), fused_cloud);
+    PointCloud lidar_cloud = lidar_map.Extract();
+    lidar_cloud.normals.clear();
+    summary.lidar_map_points = lidar_cloud.Size();
+    WritePointCloud((partial / "lidar_map.ply").string(), lidar_cloud);
+
+    workspace.WriteSparse(reconstruction);
+    std::vector<std::string> names;
+    for (const StationView& view : views) names.push_back(view.image_name);
+    workspace.WriteConfigs(names);
+
+    summary.seconds = SecondsSince(start);
+    nlohmann::json report;
+    report["refine_with_lidar"] = options.refine_with_lidar;
+    report["min_consistent_views"] = options.min_consistent_views;
+    report["fused_voxel_size_m"] = options.fused_voxel_size_m;
+    report["fused_points"] = summary.fused_points;
+    report["lidar_map_points"] = summary.lidar_map_points;
+    report["seconds"] = summary.seconds;
+    const LidarDepthRefinementOptions& r = options.refinement;
+    report["refinement"] = {{"window_radius_px", r.window_radius_px},
+                            {"max_abs_diff_m", r.max_abs_diff_m},
+                            {"max_rel_diff", r.max_rel_diff},
+                            {"plane_tolerance_m", r.plane_tolerance_m},
+                            {"max_normal_angle_deg", r.max_normal_angle_deg},
+                            {"max_fill_curvature", r.max_fill_curvature},
+                            {"max_fill_view_angle_deg", r.max_fill_view_angle_deg}};
+    for (const StationDensification& station : summary.stations) {
+      report["stations"].push_back(StationReport(station));
+    }
+    WriteFileAtomically((partial / "densifier.json").string(),
+                        report.dump(2) + "\n");
+  } catch (...) {
+    fs::remove_all(partial);
+    throw;
+  }
+  fs::remove_all(output_path);
+  fs::rename(partial, output_path);
+  return summary;
+}
+
+}  // namespace colmap_lidar

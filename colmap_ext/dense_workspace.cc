@@ -1,0 +1,172 @@
+#include "colmap_ext/dense_workspace.h"
+
+#include "colmap/mvs/depth_map.h"
+#include "colmap/mvs/normal_map.h"
+#include "colmap/sensor/models.h"
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+
+void EnsureParent(const std::string& path) {
+  fs::create_directories(fs::path(path).parent_path());
+}
+
+}  // namespace
+
+bool IsPinholeCamera(const colmap::Camera& camera) {
+  return camera.model_id == colmap::SimplePinholeCameraModel::model_id ||
+         camera.model_id == colmap::PinholeCameraModel::model_id;
+}
+
+cv::Mat ReadColmapDepthMap(const std::string& path) {
+  if (!fs::is_regular_file(path)) {
+    throw std::runtime_error("No depth map at " + path);
+  }
+  colmap::mvs::DepthMap map;
+  try {
+    map.Read(path);
+  } catch (const std::exception& error) {
+    throw std::runtime_error("Cannot read the depth map " + path + ": " +
+                             error.what());
+  }
+  if (map.GetWidth() == 0 || map.GetHeight() == 0 || map.GetDepth() != 1) {
+    throw std::runtime_error("Not a depth map (empty or several channels): " +
+                             path);
+  }
+  cv::Mat depth(static_cast<int>(map.GetHeight()),
+                static_cast<int>(map.GetWidth()),
+                CV_32F);
+  std::copy(map.GetData().begin(), map.GetData().end(), depth.ptr<float>());
+  return depth;
+}
+
+DenseWorkspace::DenseWorkspace(std::string root) : root_(std::move(root)) {
+  for (const char* folder :
+       {"images", "sparse", "stereo/depth_maps", "stereo/normal_maps"}) {
+    fs::create_directories(fs::path(root_) / folder);
+  }
+}
+
+std::string DenseWorkspace::ImagePath(const std::string& image_name) const {
+  return (fs::path(root_) / "images" / image_name).string();
+}
+
+std::string DenseWorkspace::DepthMapPath(const std::string& image_name) const {
+  return (fs::path(root_) / "stereo" / "depth_maps" /
+          (image_name + ".geometric.bin"))
+      .string();
+}
+
+std::string DenseWorkspace::NormalMapPath(const std::string& image_name) const {
+  return (fs::path(root_) / "stereo" / "normal_maps" /
+          (image_name + ".geometric.bin"))
+      .string();
+}
+
+void DenseWorkspace::WriteSparse(
+    const colmap::Reconstruction& reconstruction) const {
+  colmap::Reconstruction workspace_model = reconstruction;
+  for (const auto& [camera_id, original] : reconstruction.Cameras()) {
+    if (!IsPinholeCamera(original)) {
+      throw std::invalid_argument(
+          "The dense workspace needs undistorted images: camera " +
+          std::to_string(camera_id) + " is " + original.ModelName() +
+          " (only SIMPLE_PINHOLE and PINHOLE are supported)");
+    }
+    colmap::Camera& camera = workspace_model.Camera(camera_id);
+    camera.model_id = colmap::PinholeCameraModel::model_id;
+    camera.params = {original.FocalLengthX(),
+                     original.FocalLengthY(),
+                     original.PrincipalPointX() - 0.5,
+                     original.PrincipalPointY() - 0.5};
+  }
+  workspace_model.Write((fs::path(root_) / "sparse").string());
+}
+
+void DenseWorkspace::WriteConfigs(const std::vector<std::string>& image_names,
+                                  int num_source_images) const {
+  std::ofstream fusion(fs::path(root_) / "stereo" / "fusion.cfg");
+  std::ofstream patch_match(fs::path(root_) / "stereo" / "patch-match.cfg");
+  for (const std::string& name : image_names) {
+    fusion << name << "\n";
+    patch_match << name << "\n__auto__, " << num_source_images << "\n";
+  }
+  if (!fusion || !patch_match) {
+    throw std::runtime_error("Cannot write the configuration files in " +
+                             root_ + "/stereo");
+  }
+}
+
+void DenseWorkspace::CopyImage(const std::string& image_name,
+                               const std::string& source_path) const {
+  const std::string path = ImagePath(image_name);
+  EnsureParent(path);
+  fs::copy_file(source_path, path, fs::copy_options::overwrite_existing);
+}
+
+void DenseWorkspace::WriteDepthMap(const std::string& image_name,
+                                   const cv::Mat& depth) const {
+  if (depth.type() != CV_32F) {
+    throw std::invalid_argument("WriteDepthMap: depth must be CV_32F");
+  }
+  colmap::mvs::DepthMap map(depth.cols, depth.rows, 0, 0);  // the range is not stored
+  for (int row = 0; row < depth.rows; ++row) {
+    for (int col = 0; col < depth.cols; ++col) {
+      map.Set(row, col, depth.at<float>(row, col));
+    }
+  }
+  const std::string path = DepthMapPath(image_name);
+  EnsureParent(path);
+  map.Write(path);
+}
+
+void DenseWorkspace::WriteNormalMap(const std::string& image_name,
+                                    const cv::Mat& normals) const {
+  if (normals.type() != CV_32FC3) {
+    throw std::invalid_argument("WriteNormalMap: normals must be CV_32FC3");
+  }
+  colmap::mvs::NormalMap map(normals.cols, normals.rows);
+  for (int row = 0; row < normals.rows; ++row) {
+    for (int col = 0; col < normals.cols; ++col) {
+      const cv::Vec3f& n = normals.at<cv::Vec3f>(row, col);
+      for (int d = 0; d < 3; ++d) map.Set(row, col, d, n[d]);
+    }
+  }
+  const std::string path = NormalMapPath(image_name);
+  EnsureParent(path);
+  map.Write(path);
+}
+
+cv::Mat DenseWorkspace::ReadDepthMap(const std::string& image_name) const {
+  return ReadColmapDepthMap(DepthMapPath(image_name));
+}
+
+cv::Mat DenseWorkspace::ReadNormalMap(const std::string& image_name) const {
+  const std::string path = NormalMapPath(image_name);
+  if (!fs::is_regular_file(path)) {
+    throw std::runtime_error("No normal map at " + path);
+  }
+  colmap::mvs::NormalMap map;
+  map.Read(path);
+  if (map.GetDepth() != 3) {
+    throw std::runtime_error("Not a normal map: " + path);
+  }
+  cv::Mat normals(static_cast<int>(map.GetHeight()),
+                  static_cast<int>(map.GetWidth()),
+                  CV_32FC3);
+  for (int row = 0; row < normals.rows; ++row) {
+    for (int col = 0; col < normals.cols; ++col) {
+      cv::Vec3f& n = normals.at<cv::Vec3f>(row, col);
+      for (int d = 0; d < 3; ++d) n[d] = map.Get(row, col, d);
+    }
+  }
+  return normals;
+}
+
+}  // namespace colmap_lidar
