@@ -63,36 +63,46 @@ std::vector<StationView> StationViews(const colmap::Reconstruction& reconstructi
   return views;
 }
 
-// For each view, the other views sharing the most sparse points with it (at most `max_views`).
-std::vector<std::vector<size_t>> NeighborViews(
-    const colmap::Reconstruction& reconstruction,
-    const std::vector<StationView>& views,
-    int max_views) {
-  std::map<colmap::image_t, size_t> index;
-  for (size_t k = 0; k < views.size(); ++k) index[views[k].image_id] = k;
-  std::vector<std::map<size_t, int>> shared(views.size());
-  for (const auto& [point_id, point] : reconstruction.Points3D()) {
-    std::vector<size_t> seen;
-    for (const colmap::TrackElement& element : point.track.Elements()) {
-      const auto found = index.find(element.image_id);
-      if (found != index.end()) seen.push_back(found->second);
-    }
-    std::sort(seen.begin(), seen.end());
-    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
-    for (size_t a : seen) {
-      for (size_t b : seen) {
-        if (a != b) ++shared[a][b];
-      }
+// The views that see most of this view's depth map: a coarse grid of its points is projected into
+// every other view; the views where most land inside the image, in front of the camera, are kept (at
+// most `max_views`, each seeing at least 5 % of the grid).
+std::vector<size_t> OverlappingViews(const colmap::Reconstruction& reconstruction,
+                                     const std::vector<StationView>& views,
+                                     size_t view_index,
+                                     const cv::Mat& depth,
+                                     int max_views) {
+  const colmap::Image& image = reconstruction.Image(views[view_index].image_id);
+  const PinholeIntrinsics intrinsics =
+      IntrinsicsOf(reconstruction.Camera(image.CameraId()));
+  const colmap::Rigid3d world_from_cam = colmap::Inverse(image.CamFromWorld());
+  std::vector<Eigen::Vector3d> grid;
+  const int step = std::max(1, std::min(depth.cols, depth.rows) / 32);
+  for (int row = step / 2; row < depth.rows; row += step) {
+    for (int col = step / 2; col < depth.cols; col += step) {
+      const float z = depth.at<float>(row, col);
+      if (z > 0) grid.push_back(world_from_cam * (intrinsics.PixelRay(col, row) * double(z)));
     }
   }
-  std::vector<std::vector<size_t>> neighbors(views.size());
+  std::vector<std::pair<size_t, size_t>> ranked;  // (-count, view)
   for (size_t k = 0; k < views.size(); ++k) {
-    std::vector<std::pair<int, size_t>> ranked;
-    for (const auto& [other, count] : shared[k]) ranked.emplace_back(-count, other);
-    std::sort(ranked.begin(), ranked.end());
-    for (size_t r = 0; r < ranked.size() && r < size_t(max_views); ++r) {
-      neighbors[k].push_back(ranked[r].second);
+    if (k == view_index) continue;
+    const colmap::Image& other = reconstruction.Image(views[k].image_id);
+    const PinholeIntrinsics other_intrinsics =
+        IntrinsicsOf(reconstruction.Camera(other.CameraId()));
+    size_t count = 0;
+    for (const Eigen::Vector3d& point : grid) {
+      Eigen::Vector2d xy;
+      count += other_intrinsics.Project(other.CamFromWorld() * point, &xy) &&
+               other_intrinsics.Contains(xy);
     }
+    if (count * 20 >= grid.size() && count > 0) {
+      ranked.emplace_back(grid.size() - count, k);
+    }
+  }
+  std::sort(ranked.begin(), ranked.end());
+  std::vector<size_t> neighbors;
+  for (size_t r = 0; r < ranked.size() && r < size_t(max_views); ++r) {
+    neighbors.push_back(ranked[r].second);
   }
   return neighbors;
 }
@@ -222,7 +232,6 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
 void FuseStation(const colmap::Reconstruction& reconstruction,
                  const std::vector<StationView>& views,
                  size_t view_index,
-                 const std::vector<size_t>& neighbors,
                  const DenseWorkspace& workspace,
                  const DensifierOptions& options,
                  StationDensification* result,
@@ -246,7 +255,11 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
   };
   std::vector<Other> others;
   if (options.min_consistent_views > 0) {
-    for (size_t k : neighbors) {
+    for (size_t k : OverlappingViews(reconstruction,
+                                     views,
+                                     view_index,
+                                     depth,
+                                     options.max_neighbor_views)) {
       const colmap::Image& other = reconstruction.Image(views[k].image_id);
       others.push_back({workspace.ReadDepthMap(views[k].image_name),
                         IntrinsicsOf(reconstruction.Camera(other.CameraId())),
@@ -319,6 +332,11 @@ nlohmann::json StationReport(const StationDensification& station) {
           {"stereo_without_lidar", s.stereo_without_lidar},
           {"stereo_removed", s.stereo_removed},
           {"filled", s.filled},
+          {"fill_refused_edge", s.fill_refused_edge},
+          {"fill_refused_sparse", s.fill_refused_sparse},
+          {"fill_refused_view_angle", s.fill_refused_view_angle},
+          {"fill_refused_curvature", s.fill_refused_curvature},
+          {"window_radius_px", s.window_radius_px},
           {"inconsistent", station.inconsistent},
           {"points", station.points},
           {"seconds", station.seconds}};
@@ -399,14 +417,11 @@ DensifierSummary Densify(const colmap::Reconstruction& reconstruction,
     }
 
     VoxelAccumulator fused(options.fused_voxel_size_m);
-    const std::vector<std::vector<size_t>> neighbors =
-        NeighborViews(reconstruction, views, options.max_neighbor_views);
     for (size_t k = 0; k < views.size(); ++k) {
       const auto station_start = std::chrono::steady_clock::now();
       FuseStation(reconstruction,
                   views,
                   k,
-                  neighbors[k],
                   workspace,
                   options,
                   &summary.stations[k],

@@ -35,8 +35,8 @@ struct DensifierOptions {
   double min_depth_m = 0.3;
   double max_depth_m = 30;
   // Cross-station consistency, as in COLMAP's fusion: a pixel is kept only if its point agrees with the
-  // depth maps of at least this many other stations (0 = off). Compared: the stations sharing the most
-  // sparse points with it, at most max_neighbor_views of them.
+  // depth maps of at least this many other stations (0 = off). Compared: the stations that see most of
+  // its depth map, at most max_neighbor_views of them.
   int min_consistent_views = 0;
   int max_neighbor_views = 6;
   double consistency_abs_m = 0.01;

@@ -60,6 +60,24 @@ IndexImage Splat(const LidarSurface& surface,
   return index;
 }
 
+int AutomaticWindowRadius(const LidarSurface& surface,
+                          const std::vector<Eigen::Vector2d>& xy,
+                          const PinholeIntrinsics& intrinsics) {
+  std::vector<double> spacing_px;
+  for (size_t i = 0; i < surface.Size(); ++i) {
+    if (std::isfinite(xy[i].x()) && intrinsics.Contains(xy[i])) {
+      spacing_px.push_back(surface.spacing[i] * intrinsics.fx /
+                           surface.points[i].z());
+    }
+  }
+  if (spacing_px.empty()) return 3;
+  std::nth_element(spacing_px.begin(),
+                   spacing_px.begin() + spacing_px.size() / 2,
+                   spacing_px.end());
+  return std::clamp(
+      static_cast<int>(std::lround(1.5 * spacing_px[spacing_px.size() / 2])), 3, 30);
+}
+
 }  // namespace
 
 bool LidarDepthRefinementOptions::Check() const {
@@ -67,9 +85,10 @@ bool LidarDepthRefinementOptions::Check() const {
     throw std::invalid_argument(std::string("LidarDepthRefinementOptions: ") +
                                 what);
   };
-  if (window_radius_px < 1) fail("window_radius_px must be >= 1");
-  if (!(max_abs_diff_m >= 0) || !(max_rel_diff >= 0)) {
-    fail("max_abs_diff_m and max_rel_diff must be >= 0");
+  if (window_radius_px < 0) fail("window_radius_px must be >= 0 (0: automatic)");
+  if (!(max_abs_diff_m >= 0) || !(max_rel_diff >= 0) ||
+      !(max_check_curvature >= 0)) {
+    fail("max_abs_diff_m, max_rel_diff and max_check_curvature must be >= 0");
   }
   if (!(plane_tolerance_m > 0)) fail("plane_tolerance_m must be > 0");
   if (!(max_normal_angle_deg > 0 && max_normal_angle_deg < 90)) {
@@ -109,8 +128,10 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
   }
   const int width = intrinsics.width;
   const int height = intrinsics.height;
-  const int radius = options.window_radius_px;
   const std::vector<Eigen::Vector2d> xy = ProjectSamples(surface, intrinsics);
+  const int radius = options.window_radius_px > 0
+                         ? options.window_radius_px
+                         : AutomaticWindowRadius(surface, xy, intrinsics);
   // Footprints reach at most half the window: a sample never hides a whole window.
   const IndexImage index =
       Splat(surface, xy, intrinsics, std::max(1, radius / 2));
@@ -159,6 +180,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
         const Eigen::Vector3d unit_ray = ray.normalized();
         bool has_plane = false;
         double lidar_z = 0;
+        double layer_curvature = 0;
         Eigen::Vector3d normal = Eigen::Vector3d::Zero();
         layer.clear();
         if (!window.empty()) {
@@ -183,6 +205,9 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
               centroid += surface.points[s];
             }
           }
+          for (int s : layer) {
+            layer_curvature = std::max(layer_curvature, double(surface.curvature[s]));
+          }
           normal = normal_sum.normalized();
           centroid /= double(layer.size());
           const double denominator = normal.dot(ray);
@@ -194,7 +219,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
 
         float depth = 0;
         if (has_stereo) {
-          if (!has_plane) {
+          if (!has_plane || layer_curvature > options.max_check_curvature) {
             ++local.stereo_without_lidar;
             depth = stereo_z;
           } else if (std::abs(stereo_z - lidar_z) <=
@@ -217,16 +242,22 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
 
         // Fold 2 (paper, mapping step (2)): only inside one flat, well-observed LiDAR layer that
         // surrounds the pixel. A second layer in the window is a depth edge: no fill.
-        if (!options.fill_holes || !has_plane ||
-            layer.size() != window.size() ||
-            static_cast<int>(layer.size()) < options.min_fill_samples ||
-            std::abs(normal.dot(unit_ray)) < min_view_cos) {
+        if (!options.fill_holes || !has_plane) continue;
+        if (layer.size() != window.size()) {
+          ++local.fill_refused_edge;
           continue;
         }
-        bool flat = true;
+        if (static_cast<int>(layer.size()) < options.min_fill_samples) {
+          ++local.fill_refused_sparse;
+          continue;
+        }
+        if (std::abs(normal.dot(unit_ray)) < min_view_cos) {
+          ++local.fill_refused_view_angle;
+          continue;
+        }
+        const bool flat = layer_curvature <= options.max_fill_curvature;
         int quadrants = 0;
         for (int s : layer) {
-          flat = flat && surface.curvature[s] <= options.max_fill_curvature;
           const Eigen::Vector2d d = xy[s] - centre;
           if (d.squaredNorm() < 0.25) {
             quadrants = 0xF;
@@ -237,7 +268,14 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
         }
         int num_quadrants = 0;
         for (int q = 0; q < 4; ++q) num_quadrants += (quadrants >> q) & 1;
-        if (!flat || num_quadrants < options.min_fill_quadrants) continue;
+        if (num_quadrants < options.min_fill_quadrants) {
+          ++local.fill_refused_sparse;
+          continue;
+        }
+        if (!flat) {
+          ++local.fill_refused_curvature;
+          continue;
+        }
         result.depth(row, col) = float(lidar_z);
         result.normals.normals[pixel] = normal.cast<float>();
         result.source[pixel] = DepthSource::kLidar;
@@ -251,6 +289,10 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
       stats.stereo_confirmed += local.stereo_confirmed;
       stats.stereo_removed += local.stereo_removed;
       stats.filled += local.filled;
+      stats.fill_refused_edge += local.fill_refused_edge;
+      stats.fill_refused_sparse += local.fill_refused_sparse;
+      stats.fill_refused_view_angle += local.fill_refused_view_angle;
+      stats.fill_refused_curvature += local.fill_refused_curvature;
     }
   }
 
@@ -262,6 +304,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
       result.normals.normals[pixel] = from_depth.normals[pixel];
     }
   }
+  stats.window_radius_px = radius;
   result.stats = stats;
   return result;
 }

@@ -21,22 +21,28 @@
 namespace colmap_lidar {
 
 struct LidarDepthRefinementOptions {
-  int window_radius_px = 5;
+  // 0: automatic, 1.5x the median spacing of the LiDAR samples in pixels (at least 3 px): the window
+  // then holds the 5-10 nearest samples whatever the LiDAR density and image resolution.
+  int window_radius_px = 0;
   // Fold 1: a stereo depth z is removed when |z - z_l| > max_abs_diff_m + max_rel_diff * z_l.
   bool remove_inconsistent = true;
-  double max_abs_diff_m = 0.01;
-  double max_rel_diff = 0.005;
+  double max_abs_diff_m = 0.005;
+  double max_rel_diff = 0.0005;
+  // The LiDAR plane is a reference only where the layer is flat: near a corner the smoothed LiDAR
+  // surface is rounded off, and judging stereo by it would remove correct depths. Layers with a
+  // sample above this curvature leave the stereo unchecked.
+  double max_check_curvature = 0.05;
   // Layer membership: a window sample is on the nearest sample's surface when its point lies within
   // plane_tolerance_m of that plane and its normal within max_normal_angle_deg.
-  double plane_tolerance_m = 0.006;
-  double max_normal_angle_deg = 20;
+  double plane_tolerance_m = 0.01;
+  double max_normal_angle_deg = 30;
   // Fold 2.
   bool fill_holes = true;
   int min_fill_samples = 4;  // layer samples in the window
   int min_fill_quadrants = 3;  // of the 4 quadrants around the pixel holding a sample (interpolate,
                                // never extrapolate past the LiDAR's coverage)
-  double max_fill_curvature = 0.03;   // LidarSurface::curvature of every window sample
-  double max_fill_view_angle_deg = 60;  // between the plane normal and the viewing ray
+  double max_fill_curvature = 0.05;   // LidarSurface::curvature of every window sample
+  double max_fill_view_angle_deg = 75;  // between the plane normal and the viewing ray
 
   bool Check() const;  // throws std::invalid_argument
 };
@@ -46,10 +52,16 @@ enum class DepthSource : uint8_t { kNone = 0, kStereo = 1, kLidar = 2, kRemoved 
 
 struct LidarDepthRefinementStats {
   size_t stereo_pixels = 0;         // valid in the input
-  size_t stereo_without_lidar = 0;  // kept unchecked: no LiDAR surface near
+  size_t stereo_without_lidar = 0;  // kept unchecked: no flat LiDAR surface near
   size_t stereo_confirmed = 0;      // kept: agrees with the LiDAR
   size_t stereo_removed = 0;        // fold 1
   size_t filled = 0;                // fold 2
+  // Pixels without depth next to a LiDAR layer that fold 2 did not fill, by the first failed test.
+  size_t fill_refused_edge = 0;       // a second layer in the window
+  size_t fill_refused_sparse = 0;     // too few samples or quadrants
+  size_t fill_refused_view_angle = 0;
+  size_t fill_refused_curvature = 0;
+  int window_radius_px = 0;         // the window used
 };
 
 struct RefinedDepth {

@@ -10,11 +10,50 @@
 #include <stdexcept>
 
 namespace colmap_lidar {
+namespace {
+
+struct Pca {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();  // ascending
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();       // smallest eigenvector
+};
+
+// PCA of the indexed samples, at most `max_count` of them taken evenly.
+Pca NeighbourhoodPca(const std::vector<Eigen::Vector3d>& samples,
+                     const std::vector<size_t>& indices,
+                     int max_count) {
+  const size_t stride = (indices.size() + max_count - 1) / max_count;
+  Pca pca;
+  size_t count = 0;
+  for (size_t k = 0; k < indices.size(); k += stride, ++count) {
+    pca.mean += samples[indices[k]];
+  }
+  pca.mean /= double(count);
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < indices.size(); k += stride) {
+    const Eigen::Vector3d d = samples[indices[k]] - pca.mean;
+    covariance += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  pca.eigenvalues = solver.eigenvalues();
+  pca.normal = solver.eigenvectors().col(0);
+  return pca;
+}
+
+double Curvature(const Pca& pca) {
+  const double sum = pca.eigenvalues.sum();
+  return sum > 0 ? std::max(0.0, pca.eigenvalues(0)) / sum : 0.0;
+}
+
+}  // namespace
 
 bool LidarSurfaceOptions::Check() const {
   if (!(sample_spacing_m > 0) || !(radius_m > sample_spacing_m)) {
     throw std::invalid_argument(
         "LidarSurfaceOptions: need 0 < sample_spacing_m < radius_m");
+  }
+  if (!(curvature_radius_m > 0)) {
+    throw std::invalid_argument("LidarSurfaceOptions: curvature_radius_m must be > 0");
   }
   if (min_neighbors < 3 || max_neighbors < min_neighbors) {
     throw std::invalid_argument(
@@ -45,28 +84,18 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
     for (size_t i = 0; i < samples.size(); ++i) {
       tree.RadiusSearch(samples[i], options.radius_m, &indices);
       if (static_cast<int>(indices.size()) < options.min_neighbors) continue;
-      const size_t stride =
-          (indices.size() + options.max_neighbors - 1) / options.max_neighbors;
-      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      size_t count = 0;
-      for (size_t k = 0; k < indices.size(); k += stride, ++count) {
-        mean += samples[indices[k]];
-      }
-      mean /= double(count);
-      Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-      for (size_t k = 0; k < indices.size(); k += stride) {
-        const Eigen::Vector3d d = samples[indices[k]] - mean;
-        covariance += d * d.transpose();
-      }
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-      Eigen::Vector3d normal = solver.eigenvectors().col(0);
+      const Pca pca = NeighbourhoodPca(samples, indices, options.max_neighbors);
+      Eigen::Vector3d normal = pca.normal;
       if (normal.dot(samples[i]) > 0) normal = -normal;  // face the camera
-      const double sum = solver.eigenvalues().sum();
-      points[i] = samples[i] - normal * normal.dot(samples[i] - mean);
+      points[i] = samples[i] - normal * normal.dot(samples[i] - pca.mean);
       normals[i] = normal;
       spacing[i] = float(options.radius_m * std::sqrt(M_PI / indices.size()));
-      curvature[i] = float(
-          sum > 0 ? std::max(0.0, solver.eigenvalues()(0)) / sum : 0.0);
+      double c = Curvature(pca);
+      if (options.curvature_radius_m != options.radius_m) {
+        tree.RadiusSearch(samples[i], options.curvature_radius_m, &indices);
+        c = Curvature(NeighbourhoodPca(samples, indices, options.max_neighbors));
+      }
+      curvature[i] = float(c);
     }
   }
   for (size_t i = 0; i < samples.size(); ++i) {

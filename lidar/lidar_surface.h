@@ -15,7 +15,10 @@ namespace colmap_lidar {
 
 struct LidarSurfaceOptions {
   double sample_spacing_m = 0.005;  // voxel edge of the thinning
-  double radius_m = 0.04;           // PCA neighbourhood radius
+  double radius_m = 0.04;           // PCA neighbourhood radius (normal, position)
+  // Neighbourhood of the curvature. Larger than radius_m: range noise sigma alone gives a flat patch
+  // a curvature of about 3 sigma^2 / r^2 (0.19 for a VLP-16's 1 cm at 4 cm, 0.03 at 10 cm).
+  double curvature_radius_m = 0.1;
   int min_neighbors = 8;  // fewer samples in the radius: the sample is dropped
   int max_neighbors = 96;  // larger neighbourhoods are subsampled evenly
 
@@ -25,8 +28,8 @@ struct LidarSurfaceOptions {
 struct LidarSurface {
   std::vector<Eigen::Vector3d> points;   // on the fitted plane, camera frame
   std::vector<Eigen::Vector3d> normals;  // unit, facing the viewpoint
-  // lambda_min / (lambda_1 + lambda_2 + lambda_3) of the neighbourhood: 0 on a plane, 1/3 at most.
-  // With range noise sigma on a flat patch it is about 3 sigma^2 / radius^2.
+  // lambda_min / (lambda_1 + lambda_2 + lambda_3) of the curvature_radius_m neighbourhood: 0 on a
+  // plane, 1/3 at most.
   std::vector<float> curvature;
   // Mean distance between neighbouring samples around each sample, from the neighbourhood's count:
   // sqrt(pi radius^2 / count). How far a sample's footprint reaches.
