@@ -150,6 +150,7 @@ int RunPipeline(int argc, char** argv) {
   const std::string lidar = (ws / "lidar").string();
   const std::string initial = (ws / "sparse" / "initial").string();
   const std::string joint = (ws / "sparse" / "joint").string();
+  const std::string dense = (ws / "dense").string();
   fs::create_directories(ws / "sparse");
 
   struct Step {
@@ -199,8 +200,21 @@ int RunPipeline(int argc, char** argv) {
         joint,
         "--mode",
         mode}},
+      {"densifier",
+       &RunDensifier,
+       {"--input_path",
+        joint,
+        "--dataset_path",
+        dataset.root,
+        "--depth_path",
+        stereo,
+        "--output_path",
+        dense,
+        "--refine_with_lidar",
+        mode == "stereo_only" ? "0" : "1"}},
   };
   if (dataset.HasGroundTruth()) {
+    const std::string evaluation = (ws / "evaluation").string();
     steps.push_back({"evaluate_calibration",
                      &RunEvaluateCalibration,
                      {"--dataset_path",
@@ -208,7 +222,17 @@ int RunPipeline(int argc, char** argv) {
                       "--input_path",
                       joint,
                       "--output_path",
-                      (ws / "evaluation").string()}});
+                      evaluation}});
+    steps.push_back({"evaluate_model",
+                     &RunEvaluateModel,
+                     {"--model_path",
+                      (fs::path(dense) / "fused.ply").string(),
+                      "--ground_truth_path",
+                      dataset.GroundTruthPath("surface.ply"),
+                      "--truth_from_model",
+                      (fs::path(evaluation) / "truth_from_model.txt").string(),
+                      "--output_path",
+                      (fs::path(evaluation) / "model").string()}});
   }
   std::vector<std::tuple<std::string, std::string, double>> table;
   for (size_t k = 0; k < steps.size(); ++k) {
@@ -245,7 +269,9 @@ int RunPipeline(int argc, char** argv) {
               << status << std::right << std::fixed << std::setprecision(1)
               << std::setw(8) << seconds << " s\n";
   }
-  std::cout << "  model: " << joint << " (cam_from_lidar.txt, report.json)"
+  std::cout << "  model: " << joint << " (cam_from_lidar.txt, report.json)\n"
+            << "  dense: " << dense
+            << " (fused.ply, lidar_map.ply, COLMAP dense workspace)"
             << std::endl;
   return EXIT_SUCCESS;
 }

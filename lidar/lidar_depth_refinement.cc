@@ -241,12 +241,11 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
         }
 
         // Fold 2 (paper, mapping step (2)): only inside one flat, well-observed LiDAR layer that
-        // surrounds the pixel. A second layer in the window is a depth edge: no fill.
+        // surrounds the pixel. With a second surface in the window (a depth edge or a crease) the
+        // layer must surround the pixel on all four sides: a pixel beyond the layer's border, on
+        // the other surface, never has layer samples on the other surface's side.
         if (!options.fill_holes || !has_plane) continue;
-        if (layer.size() != window.size()) {
-          ++local.fill_refused_edge;
-          continue;
-        }
+        const bool single_layer = layer.size() == window.size();
         if (static_cast<int>(layer.size()) < options.min_fill_samples) {
           ++local.fill_refused_sparse;
           continue;
@@ -268,6 +267,10 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
         }
         int num_quadrants = 0;
         for (int q = 0; q < 4; ++q) num_quadrants += (quadrants >> q) & 1;
+        if (!single_layer && num_quadrants < 4) {
+          ++local.fill_refused_edge;
+          continue;
+        }
         if (num_quadrants < options.min_fill_quadrants) {
           ++local.fill_refused_sparse;
           continue;

@@ -1,8 +1,9 @@
 // LiDAR-guided refinement of one station's stereo depth map (the paper's mapping step):
 //   fold 1  stereo depths that disagree with the local LiDAR surface are removed;
 //   fold 2  holes are filled from the LiDAR surface where it is flat (low curvature), well observed
-//           (small angle between its normal and the viewing ray) and surrounds the pixel without a
-//           depth edge, by intersecting the pixel's ray with the local plane.
+//           (small angle between its normal and the viewing ray) and surrounds the pixel (on all four
+//           sides when another surface is near: never across a depth edge), by intersecting the
+//           pixel's ray with the local plane.
 //
 // The local LiDAR surface at a pixel: the LiDAR surface samples (lidar_surface.h) are splatted into a
 // z-buffer, each over its footprint (half its spacing, in pixels), so that a sample hidden behind a
@@ -57,7 +58,7 @@ struct LidarDepthRefinementStats {
   size_t stereo_removed = 0;        // fold 1
   size_t filled = 0;                // fold 2
   // Pixels without depth next to a LiDAR layer that fold 2 did not fill, by the first failed test.
-  size_t fill_refused_edge = 0;       // a second layer in the window
+  size_t fill_refused_edge = 0;       // a second surface in the window, the layer not all round
   size_t fill_refused_sparse = 0;     // too few samples or quadrants
   size_t fill_refused_view_angle = 0;
   size_t fill_refused_curvature = 0;

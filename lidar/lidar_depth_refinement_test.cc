@@ -29,7 +29,7 @@ double TrueDepth(const PinholeIntrinsics& intrinsics, int col, int row) {
   return ray.x() * z < 0 ? z : kWallZ;
 }
 
-// What a LiDAR 0.2 m to the camera's right sees, on a 4 mm grid with 1 mm noise: the plate, and the
+// What a LiDAR 0.2 m to the camera's right sees, on a 6 mm grid with 1 mm noise: the plate, and the
 // wall except the plate's shadow. It sees a strip of wall behind the plate's edge that the camera
 // does not: those samples project onto the plate's pixels and must stay hidden.
 std::vector<Eigen::Vector3d> LidarPoints() {
@@ -37,8 +37,8 @@ std::vector<Eigen::Vector3d> LidarPoints() {
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0, 0.001);
   std::vector<Eigen::Vector3d> points;
-  for (double y = -0.9; y <= 0.9; y += 0.004) {
-    for (double x = -1.4; x <= 1.4; x += 0.004) {
+  for (double y = -0.9; y <= 0.9; y += 0.006) {
+    for (double x = -1.4; x <= 1.4; x += 0.006) {
       if (x < 0) points.emplace_back(x, y, ForegroundZ(x) + noise(rng));
       // Wall point: hidden when the segment to the LiDAR crosses the plate.
       const Eigen::Vector3d wall(x, y, kWallZ);
@@ -55,8 +55,9 @@ std::vector<Eigen::Vector3d> LidarPoints() {
 TEST(LidarDepthRefinement, RemovesWrongStereoAndFillsHolesWithoutCrossingTheStepEdge) {
   const PinholeIntrinsics intrinsics = Camera();
   LidarSurfaceOptions surface_options;
-  surface_options.sample_spacing_m = 0.004;
+  surface_options.sample_spacing_m = 0.006;
   surface_options.radius_m = 0.03;
+  surface_options.curvature_radius_m = 0.06;
   const LidarSurface surface = BuildLidarSurface(LidarPoints(), surface_options);
   ASSERT_GT(surface.Size(), 10000u);
 
@@ -112,7 +113,7 @@ TEST(LidarDepthRefinement, RemovesWrongStereoAndFillsHolesWithoutCrossingTheStep
   EXPECT_GE(refined.stats.stereo_removed, outliers.size() + 4 * 30 - 5);
 
   // Fold 2: every filled depth lies on the surface the pixel sees: no depth between the plate and the
-  // wall, and none of the wall where the plate is, however close to the edge.
+  // wall, and none of the wall where the plate is, however close to the edge (0.4 m off).
   size_t filled = 0, filled_in_plate_hole = 0, filled_in_band = 0;
   double max_fill_error = 0;
   for (int row = 0; row < intrinsics.height; ++row) {
@@ -133,15 +134,8 @@ TEST(LidarDepthRefinement, RemovesWrongStereoAndFillsHolesWithoutCrossingTheStep
             << "/1200, edge band " << filled_in_band << "/1600" << std::endl;
   EXPECT_LT(max_fill_error, 0.003);  // 1 mm LiDAR noise, interpolated on the local plane
   EXPECT_GE(filled_in_plate_hole, 1200u * 95 / 100);
-  // The band is filled on both sides of the edge, but not within a window of it.
-  EXPECT_GE(filled_in_band, 1600u / 2);
-  for (int row = 60; row < 100; ++row) {
-    for (int col = edge_col - 2; col < edge_col + 2; ++col) {
-      EXPECT_NE(refined.source[size_t(row) * intrinsics.width + col],
-                DepthSource::kLidar)
-          << row << "," << col;
-    }
-  }
+  // The band is filled on both sides of the edge, each side with its own surface (the bound above).
+  EXPECT_GE(filled_in_band, 1600u * 3 / 4);
   // Normals of confirmed and filled pixels face the camera.
   const Eigen::Vector3f& normal = refined.normals.At(35, 50);
   EXPECT_LT(normal.dot(intrinsics.PixelRay(50, 35).cast<float>()), 0);
@@ -152,8 +146,9 @@ TEST(LidarDepthRefinement, RemovesWrongStereoAndFillsHolesWithoutCrossingTheStep
 TEST(LidarDepthRefinement, DoesNotFillGrazingOrCurvedSurfaces) {
   const PinholeIntrinsics intrinsics = Camera();
   LidarSurfaceOptions surface_options;
-  surface_options.sample_spacing_m = 0.004;
+  surface_options.sample_spacing_m = 0.006;
   surface_options.radius_m = 0.03;
+  surface_options.curvature_radius_m = 0.06;
   const DepthImage empty = DepthImage::Zero(intrinsics.height, intrinsics.width);
 
   // A plane tilted 70 degrees about the camera's y axis: seen at 55-85 degrees from its normal.

@@ -79,17 +79,47 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
   std::vector<float> spacing(samples.size(), 0.f);
 #pragma omp parallel
   {
-    std::vector<size_t> indices;
+    std::vector<size_t> indices, candidates, shifted, nearest;
+    std::vector<double> squared;
 #pragma omp for schedule(dynamic, 256)
     for (size_t i = 0; i < samples.size(); ++i) {
       tree.RadiusSearch(samples[i], options.radius_m, &indices);
       if (static_cast<int>(indices.size()) < options.min_neighbors) continue;
-      const Pca pca = NeighbourhoodPca(samples, indices, options.max_neighbors);
+      Pca pca = NeighbourhoodPca(samples, indices, options.max_neighbors);
+      // Spacing: mean distance to the 4 nearest other samples (a count in the radius would double
+      // it at a border, where half the disc is empty, and fatten the border's splats).
+      tree.KNearest(samples[i], 5, &nearest, &squared);
+      double sum = 0;
+      for (size_t k = 1; k < nearest.size(); ++k) sum += std::sqrt(squared[k]);
+      spacing[i] = float(nearest.size() > 1 ? sum / (nearest.size() - 1)
+                                            : options.sample_spacing_m);
+      if (options.num_shifted_neighbourhoods > 0) {
+        // Neighbourhood shifting: also fit the neighbourhoods centred on samples half a radius
+        // away and keep the flattest. Near a corner that is a neighbourhood on the sample's own face,
+        // so the corner stays sharp instead of being rounded off by a radius.
+        candidates.clear();
+        for (size_t j : indices) {
+          const double d = (samples[j] - samples[i]).norm();
+          if (d > 0.35 * options.radius_m && d < 0.65 * options.radius_m) {
+            candidates.push_back(j);
+          }
+        }
+        const size_t stride = std::max<size_t>(
+            1, candidates.size() / options.num_shifted_neighbourhoods);
+        double best = Curvature(pca);
+        for (size_t k = 0; k < candidates.size(); k += stride) {
+          tree.RadiusSearch(samples[candidates[k]], options.radius_m, &shifted);
+          if (static_cast<int>(shifted.size()) < options.min_neighbors) continue;
+          const Pca other =
+              NeighbourhoodPca(samples, shifted, options.max_neighbors);
+          const double c = Curvature(other);
+          if (c < best) best = c, pca = other;
+        }
+      }
       Eigen::Vector3d normal = pca.normal;
       if (normal.dot(samples[i]) > 0) normal = -normal;  // face the camera
       points[i] = samples[i] - normal * normal.dot(samples[i] - pca.mean);
       normals[i] = normal;
-      spacing[i] = float(options.radius_m * std::sqrt(M_PI / indices.size()));
       double c = Curvature(pca);
       if (options.curvature_radius_m != options.radius_m) {
         tree.RadiusSearch(samples[i], options.curvature_radius_m, &indices);

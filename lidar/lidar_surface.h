@@ -1,7 +1,8 @@
 // A station's LiDAR surface as the densifier needs it: the cloud (already in the camera frame and cropped
 // to the camera's view) thinned to one centroid per small voxel, then each sample moved onto the plane
-// fitted to its neighbourhood (PCA; a moving-least-squares projection of order 0), with that plane's
-// normal and curvature. A VLP-16's 1-3 cm range noise drops to a few millimetres this way, and the
+// fitted to its neighbourhood (PCA; a moving-least-squares projection of order 0; the flattest of the
+// sample's own and some shifted neighbourhoods, so that corners stay sharp), with that plane's normal
+// and a curvature. A VLP-16's 1-3 cm range noise drops to a few millimetres this way, and the
 // curvature says where the surface is flat enough to fill stereo holes from (paper, mapping step).
 #pragma once
 
@@ -19,6 +20,9 @@ struct LidarSurfaceOptions {
   // Neighbourhood of the curvature. Larger than radius_m: range noise sigma alone gives a flat patch
   // a curvature of about 3 sigma^2 / r^2 (0.19 for a VLP-16's 1 cm at 4 cm, 0.03 at 10 cm).
   double curvature_radius_m = 0.1;
+  // Neighbourhoods centred on samples half a radius away that compete with the sample's own; the
+  // flattest one gives the plane (0: only the sample's own).
+  int num_shifted_neighbourhoods = 8;
   int min_neighbors = 8;  // fewer samples in the radius: the sample is dropped
   int max_neighbors = 96;  // larger neighbourhoods are subsampled evenly
 
@@ -31,8 +35,7 @@ struct LidarSurface {
   // lambda_min / (lambda_1 + lambda_2 + lambda_3) of the curvature_radius_m neighbourhood: 0 on a
   // plane, 1/3 at most.
   std::vector<float> curvature;
-  // Mean distance between neighbouring samples around each sample, from the neighbourhood's count:
-  // sqrt(pi radius^2 / count). How far a sample's footprint reaches.
+  // Mean distance from each sample to its 4 nearest samples: how far its footprint reaches.
   std::vector<float> spacing;
 
   size_t Size() const { return points.size(); }
