@@ -134,16 +134,21 @@ void CheckDenseModel(const testing::ScopedTempDir& dir, const std::string& datas
   PrintCloudMetrics("stereo, joint poses, unrefined", unrefined);
   PrintCloudMetrics("stereo-only pipeline", stereo_only);
   PrintCloudMetrics("LiDAR map", lidar_map);
-  // Measured 2.1 vs 2.5 vs 4.1 mm; fold 2 fills holes: completeness at 2 mm 0.59 vs 0.57 vs 0.52.
-  EXPECT_LT(refined["mean_m"].get<double>(), 0.95 * unrefined["mean_m"].get<double>());
-  EXPECT_LT(refined["mean_m"].get<double>(), 0.8 * stereo_only["mean_m"].get<double>());
-  EXPECT_LT(refined["mean_m"].get<double>(), 0.003);
-  EXPECT_GT(refined["completeness_2mm"].get<double>(),
-            unrefined["completeness_2mm"].get<double>());
-  EXPECT_GT(refined["completeness_2mm"].get<double>(),
-            stereo_only["completeness_2mm"].get<double>());
-  EXPECT_GE(refined["completeness_10mm"].get<double>(),
-            unrefined["completeness_10mm"].get<double>() - 0.005);
+  // Measured: mean 1.96 vs 2.51 vs 2.59 mm; completeness at 2 mm 0.61 vs 0.56 vs 0.53 (the removed
+  // stereo is refilled from the LiDAR surface, closer to the truth); at 5 and 10 mm equal within
+  // 0.006: what fold 1 removes and fold 2 cannot fill (next to creases and depth edges) was 3-10 mm
+  // off, so it counted at 10 mm.
+  EXPECT_LT(refined["mean_m"].get<double>(), 0.9 * unrefined["mean_m"].get<double>());
+  EXPECT_LT(refined["mean_m"].get<double>(), 0.9 * stereo_only["mean_m"].get<double>());
+  EXPECT_LT(refined["mean_m"].get<double>(), 0.0025);
+  for (const auto* other : {&unrefined, &stereo_only}) {
+    EXPECT_GT(refined["completeness_2mm"].get<double>(),
+              (*other)["completeness_2mm"].get<double>() + 0.02);
+    EXPECT_GT(refined["completeness_5mm"].get<double>(),
+              (*other)["completeness_5mm"].get<double>() - 0.01);
+    EXPECT_GT(refined["completeness_10mm"].get<double>(),
+              (*other)["completeness_10mm"].get<double>() - 0.01);
+  }
   EXPECT_GT(refined["density_points_per_cm2"].get<double>(), 20);
   // The LiDAR map is in the model's frame (1 cm range noise: mean distance about 8 mm).
   EXPECT_LT(lidar_map["mean_m"].get<double>(), 0.012);
@@ -175,7 +180,7 @@ void CheckDenseModel(const testing::ScopedTempDir& dir, const std::string& datas
       colmap_fused, dataset, truth_from_joint, ws + "/evaluation/colmap_fusion");
   PrintCloudMetrics("colmap stereo_fusion of our maps", fused_by_colmap);
   EXPECT_GT(fused_by_colmap["num_evaluated"].get<size_t>(), 50000u);
-  // Within 0.5 px of where we measured (the workspace's -0.5 px principal point): measured 1.3 mm.
+  // Where we measured (the workspace's -0.5 px principal point), multi-view consistent: 1.1-1.3 mm.
   EXPECT_LT(fused_by_colmap["mean_m"].get<double>(), 0.002);
   EXPECT_GT(fs::file_size(ws + "/dense/meshed-poisson.ply"), 10000u);
 
