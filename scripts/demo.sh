@@ -20,13 +20,27 @@ $cli simulate_dataset --scene t_specimen --output_path "$kWorkspace/dataset" \
   --lidar_points "${LIDAR_POINTS:-400000}" --overwrite 1
 
 echo "== 2. the pipeline: import (COLMAP SIFT), stereo depth, depth priors, LiDAR registration,"
-echo "         initialisation (hand-eye cam_from_lidar: the guess is not used), joint adjustment, evaluation"
+echo "         initialisation (hand-eye cam_from_lidar: the guess is not used), joint adjustment,"
+echo "         dense model (LiDAR-refined stereo), evaluation"
 $cli pipeline --dataset_path "$kWorkspace/dataset" --workspace_path "$kWorkspace" --use_guess 0 \
   --overwrite 1 2>&1 | grep -v '^I20'
 
 echo "== 3. accuracy of the reconstruction against the simulator's ground truth"
 $cli evaluate_calibration --dataset_path "$kWorkspace/dataset" --input_path "$kWorkspace/sparse/joint" \
   2>&1 | grep 'evaluate_calibration:'
+$cli evaluate_model --model_path "$kWorkspace/dense/fused.ply" \
+  --ground_truth_path "$kWorkspace/dataset/ground_truth/surface.ply" \
+  --truth_from_model "$kWorkspace/evaluation/truth_from_model.txt" \
+  --output_path "$kWorkspace/evaluation/model" 2>&1 | grep -A3 'evaluate_model: mean'
+
+echo "== 4. the same stereo depth without LiDAR refinement, for comparison"
+$cli densifier --input_path "$kWorkspace/sparse/joint" --dataset_path "$kWorkspace/dataset" \
+  --depth_path "$kWorkspace/stereo" --output_path "$kWorkspace/dense_unrefined" \
+  --refine_with_lidar 0 2>&1 | grep 'stations in'
+$cli evaluate_model --model_path "$kWorkspace/dense_unrefined/fused.ply" \
+  --ground_truth_path "$kWorkspace/dataset/ground_truth/surface.ply" \
+  --truth_from_model "$kWorkspace/evaluation/truth_from_model.txt" \
+  --output_path "$kWorkspace/evaluation/model_unrefined" 2>&1 | grep -A3 'evaluate_model: mean'
 
 cat <<MSG
 
@@ -37,6 +51,7 @@ cat <<MSG
   LiDAR graph      $kWorkspace/lidar/{pairs.txt, lidar_poses.txt, summary.txt}
   initial model    $kWorkspace/sparse/initial (COLMAP model, cam_from_lidar.txt, initialization.json)
   refined model    $kWorkspace/sparse/joint (COLMAP model, cam_from_lidar.txt, report.json, plots)
-  evaluation       $kWorkspace/evaluation/metrics.json
-  not yet built    densifier (issue 8)
+  dense model      $kWorkspace/dense/{fused.ply, lidar_map.ply, densifier.json, stereo/previews/}
+                   and COLMAP's dense workspace there (colmap stereo_fusion / poisson_mesher run on it)
+  evaluation       $kWorkspace/evaluation/{metrics.json, truth_from_model.txt, model/}
 MSG
