@@ -1,10 +1,13 @@
 #include "bridge/densifier.h"
 
+#include "colmap_ext/camera_undistortion.h"
 #include "colmap_ext/dense_workspace.h"
 #include "colmap_ext/stereo_depth.h"
 #include "lidar/cloud_io.h"
 #include "lidar/pinhole_depth_image.h"
 #include "lidar/voxel_accumulator.h"
+
+#include "colmap/image/undistortion.h"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -14,6 +17,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <memory>
 
 namespace colmap_lidar {
 namespace {
@@ -148,6 +152,8 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
                                    const std::string& depth_path,
                                    const DenseWorkspace& workspace,
                                    const DensifierOptions& options,
+                                   const colmap::Camera& original_camera,
+                                   const CameraUndistorter* undistorter,
                                    VoxelAccumulator* lidar_map) {
   const std::string& station = dataset.stations[view.station];
   StationDensification result;
@@ -158,14 +164,16 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
 
   const std::string stereo_path = StereoDepthMapPath(depth_path, station);
   cv::Mat stereo = ReadColmapDepthMap(stereo_path);
-  if (stereo.cols != intrinsics.width || stereo.rows != intrinsics.height) {
+  if (stereo.cols != static_cast<int>(original_camera.width) ||
+      stereo.rows != static_cast<int>(original_camera.height)) {
     throw std::runtime_error("station " + station + ": the depth map " +
                              stereo_path + " is " + std::to_string(stereo.cols) +
                              "x" + std::to_string(stereo.rows) +
                              " but the camera is " +
-                             std::to_string(intrinsics.width) + "x" +
-                             std::to_string(intrinsics.height));
+                             std::to_string(original_camera.width) + "x" +
+                             std::to_string(original_camera.height));
   }
+  if (undistorter) stereo = undistorter->UndistortDepthMap(stereo);
   const Eigen::Map<const DepthImage> stereo_depth(
       stereo.ptr<float>(), stereo.rows, stereo.cols);
 
@@ -220,7 +228,16 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
                           refined.depth.data());
   workspace.WriteDepthMap(view.image_name, depth_mat);
   workspace.WriteNormalMap(view.image_name, NormalsToMat(refined.normals));
-  workspace.CopyImage(view.image_name, dataset.LeftImagePath(view.station));
+  if (undistorter) {
+    const std::string image_path = dataset.LeftImagePath(view.station);
+    const cv::Mat distorted = cv::imread(image_path, cv::IMREAD_COLOR);
+    if (distorted.empty()) {
+      throw std::runtime_error("station " + station + ": cannot read " + image_path);
+    }
+    workspace.WriteImage(view.image_name, undistorter->UndistortImage(distorted));
+  } else {
+    workspace.CopyImage(view.image_name, dataset.LeftImagePath(view.station));
+  }
   const fs::path preview_dir = fs::path(workspace.Root()) / "stereo" / "previews";
   fs::create_directories(preview_dir);
   cv::imwrite((preview_dir / (station + ".png")).string(),
@@ -365,7 +382,7 @@ bool DensifierOptions::Check() const {
   return true;
 }
 
-DensifierSummary Densify(const colmap::Reconstruction& reconstruction,
+DensifierSummary Densify(const colmap::Reconstruction& input_model,
                          const colmap::Rigid3d& cam_from_lidar,
                          const StationDataset& dataset,
                          const std::string& depth_path,
@@ -373,16 +390,40 @@ DensifierSummary Densify(const colmap::Reconstruction& reconstruction,
                          const DensifierOptions& options) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<StationView> views = StationViews(reconstruction, dataset);
-  for (const StationView& view : views) {
-    const colmap::Camera& camera = reconstruction.Camera(
-        reconstruction.Image(view.image_id).CameraId());
-    if (!IsPinholeCamera(camera)) {
-      throw std::runtime_error(
-          "densifier: camera " + std::to_string(camera.camera_id) + " is " +
-          camera.ModelName() +
-          "; the densifier needs an undistorted (SIMPLE_PINHOLE or PINHOLE) "
-          "camera");
+  const std::vector<StationView> views = StationViews(input_model, dataset);
+  // Everything below works in undistorted pinhole cameras: distorted ones are replaced by COLMAP's
+  // undistorted camera (and the keypoints moved), their maps and images resampled.
+  colmap::Reconstruction reconstruction = input_model;
+  std::map<colmap::camera_t, std::unique_ptr<CameraUndistorter>> undistorters;
+  bool distorted = false;
+  for (const auto& [camera_id, camera] : input_model.Cameras()) {
+    distorted = distorted || !IsPinholeCamera(camera);
+  }
+  if (distorted) {
+    // As colmap::UndistortReconstruction, but for every non-pinhole model (it skips models whose
+    // coefficients happen to be zero, which the workspace could not hold).
+    for (const auto& [camera_id, camera] : input_model.Cameras()) {
+      if (IsPinholeCamera(camera)) continue;
+      reconstruction.Camera(camera_id) =
+          colmap::UndistortCamera(colmap::UndistortCameraOptions(), camera);
+    }
+    for (const auto& [image_id, image] : input_model.Images()) {
+      const colmap::Camera& original = input_model.Camera(image.CameraId());
+      const colmap::Camera& pinhole = reconstruction.Camera(image.CameraId());
+      colmap::Image& moved = reconstruction.Image(image_id);
+      for (colmap::point2D_t k = 0; k < moved.NumPoints2D(); ++k) {
+        moved.Point2D(k).xy =
+            pinhole.ImgFromCam(original.CamFromImg(image.Point2D(k).xy));
+      }
+    }
+    for (const auto& [camera_id, camera] : input_model.Cameras()) {
+      if (IsPinholeCamera(camera)) continue;
+      undistorters[camera_id] = std::make_unique<CameraUndistorter>(
+          camera, reconstruction.Camera(camera_id));
+      std::cout << "densifier: camera " << camera_id << " (" << camera.ModelName()
+                << ") is undistorted to PINHOLE "
+                << reconstruction.Camera(camera_id).width << "x"
+                << reconstruction.Camera(camera_id).height << std::endl;
     }
   }
   const fs::path partial = output_path + ".partial";
@@ -396,14 +437,20 @@ DensifierSummary Densify(const colmap::Reconstruction& reconstruction,
               << std::endl;
     for (size_t k = 0; k < views.size(); ++k) {
       const auto station_start = std::chrono::steady_clock::now();
-      StationDensification station = RefineStation(reconstruction,
-                                                    views[k],
-                                                    cam_from_lidar,
-                                                    dataset,
-                                                    depth_path,
-                                                    workspace,
-                                                    options,
-                                                    &lidar_map);
+      const colmap::camera_t camera_id =
+          input_model.Image(views[k].image_id).CameraId();
+      const auto undistorter = undistorters.find(camera_id);
+      StationDensification station = RefineStation(
+          reconstruction,
+          views[k],
+          cam_from_lidar,
+          dataset,
+          depth_path,
+          workspace,
+          options,
+          input_model.Camera(camera_id),
+          undistorter == undistorters.end() ? nullptr : undistorter->second.get(),
+          &lidar_map);
       station.seconds = SecondsSince(station_start);
       const LidarDepthRefinementStats& s = station.refinement;
       std::cout << "densifier: [" << k + 1 << "/" << views.size() << "] station "

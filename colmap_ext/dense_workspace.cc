@@ -4,6 +4,8 @@
 #include "colmap/mvs/normal_map.h"
 #include "colmap/sensor/models.h"
 
+#include <opencv2/imgcodecs.hpp>
+
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -108,6 +110,15 @@ void DenseWorkspace::CopyImage(const std::string& image_name,
   const std::string path = ImagePath(image_name);
   EnsureParent(path);
   fs::copy_file(source_path, path, fs::copy_options::overwrite_existing);
+}
+
+void DenseWorkspace::WriteImage(const std::string& image_name,
+                                const cv::Mat& image) const {
+  const std::string path = ImagePath(image_name);
+  EnsureParent(path);
+  if (!cv::imwrite(path, image)) {
+    throw std::runtime_error("Cannot write the image " + path);
+  }
 }
 
 void DenseWorkspace::WriteDepthMap(const std::string& image_name,

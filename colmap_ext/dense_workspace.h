@@ -32,7 +32,8 @@ class DenseWorkspace {
   std::string NormalMapPath(const std::string& image_name) const;
 
   // The model with its cameras converted to the workspace's PINHOLE cameras. Throws
-  // std::invalid_argument naming a camera whose model has distortion (undistort the images first).
+  // std::invalid_argument naming a camera whose model has distortion (undistort first:
+  // colmap::UndistortReconstruction and camera_undistortion.h, as the densifier does).
   void WriteSparse(const colmap::Reconstruction& reconstruction) const;
   // fusion.cfg lists the images; patch-match.cfg gives each "__auto__, num_source_images".
   void WriteConfigs(const std::vector<std::string>& image_names,
@@ -40,6 +41,7 @@ class DenseWorkspace {
 
   void CopyImage(const std::string& image_name,
                  const std::string& source_path) const;
+  void WriteImage(const std::string& image_name, const cv::Mat& image) const;
   // depth: CV_32F, metres, 0 = none. normals: CV_32FC3 (x, y, z), zero = none.
   void WriteDepthMap(const std::string& image_name, const cv::Mat& depth) const;
   void WriteNormalMap(const std::string& image_name,
