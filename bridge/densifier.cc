@@ -42,8 +42,9 @@ PinholeIntrinsics IntrinsicsOf(const colmap::Camera& camera) {
 }
 
 // The registered images that are stations of the dataset, in station order.
-std::vector<StationView> StationViews(const colmap::Reconstruction& reconstruction,
-                                      const StationDataset& dataset) {
+std::vector<StationView> StationViews(
+    const colmap::Reconstruction& reconstruction,
+    const StationDataset& dataset) {
   std::map<std::string, colmap::image_t> by_name;
   for (const colmap::image_t image_id : reconstruction.RegImageIds()) {
     by_name[reconstruction.Image(image_id).Name()] = image_id;
@@ -70,11 +71,12 @@ std::vector<StationView> StationViews(const colmap::Reconstruction& reconstructi
 // The views that see most of this view's depth map: a coarse grid of its points is projected into
 // every other view; the views where most land inside the image, in front of the camera, are kept (at
 // most `max_views`, each seeing at least 5 % of the grid).
-std::vector<size_t> OverlappingViews(const colmap::Reconstruction& reconstruction,
-                                     const std::vector<StationView>& views,
-                                     size_t view_index,
-                                     const cv::Mat& depth,
-                                     int max_views) {
+std::vector<size_t> OverlappingViews(
+    const colmap::Reconstruction& reconstruction,
+    const std::vector<StationView>& views,
+    size_t view_index,
+    const cv::Mat& depth,
+    int max_views) {
   const colmap::Image& image = reconstruction.Image(views[view_index].image_id);
   const PinholeIntrinsics intrinsics =
       IntrinsicsOf(reconstruction.Camera(image.CameraId()));
@@ -84,7 +86,9 @@ std::vector<size_t> OverlappingViews(const colmap::Reconstruction& reconstructio
   for (int row = step / 2; row < depth.rows; row += step) {
     for (int col = step / 2; col < depth.cols; col += step) {
       const float z = depth.at<float>(row, col);
-      if (z > 0) grid.push_back(world_from_cam * (intrinsics.PixelRay(col, row) * double(z)));
+      if (z > 0)
+        grid.push_back(world_from_cam *
+                       (intrinsics.PixelRay(col, row) * double(z)));
     }
   }
   std::vector<std::pair<size_t, size_t>> ranked;  // (-count, view)
@@ -122,16 +126,25 @@ cv::Mat NormalsToMat(const NormalImage& normals) {
   return mat;
 }
 
-cv::Mat SourcePreview(const std::vector<DepthSource>& source, int width, int height) {
+cv::Mat SourcePreview(const std::vector<DepthSource>& source,
+                      int width,
+                      int height) {
   cv::Mat preview(height, width, CV_8UC3, cv::Scalar(0, 0, 0));
   for (int row = 0; row < height; ++row) {
     for (int col = 0; col < width; ++col) {
       cv::Vec3b& bgr = preview.at<cv::Vec3b>(row, col);
       switch (source[size_t(row) * width + col]) {
-        case DepthSource::kStereo: bgr = cv::Vec3b(220, 120, 40); break;
-        case DepthSource::kLidar: bgr = cv::Vec3b(60, 200, 60); break;
-        case DepthSource::kRemoved: bgr = cv::Vec3b(40, 40, 230); break;
-        case DepthSource::kNone: break;
+        case DepthSource::kStereo:
+          bgr = cv::Vec3b(220, 120, 40);
+          break;
+        case DepthSource::kLidar:
+          bgr = cv::Vec3b(60, 200, 60);
+          break;
+        case DepthSource::kRemoved:
+          bgr = cv::Vec3b(40, 40, 230);
+          break;
+        case DepthSource::kNone:
+          break;
       }
     }
   }
@@ -166,12 +179,11 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   cv::Mat stereo = ReadColmapDepthMap(stereo_path);
   if (stereo.cols != static_cast<int>(original_camera.width) ||
       stereo.rows != static_cast<int>(original_camera.height)) {
-    throw std::runtime_error("station " + station + ": the depth map " +
-                             stereo_path + " is " + std::to_string(stereo.cols) +
-                             "x" + std::to_string(stereo.rows) +
-                             " but the camera is " +
-                             std::to_string(original_camera.width) + "x" +
-                             std::to_string(original_camera.height));
+    throw std::runtime_error(
+        "station " + station + ": the depth map " + stereo_path + " is " +
+        std::to_string(stereo.cols) + "x" + std::to_string(stereo.rows) +
+        " but the camera is " + std::to_string(original_camera.width) + "x" +
+        std::to_string(original_camera.height));
   }
   if (undistorter) stereo = undistorter->UndistortDepthMap(stereo);
   const Eigen::Map<const DepthImage> stereo_depth(
@@ -222,26 +234,28 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   }
   result.refinement = refined.stats;
 
-  const cv::Mat depth_mat(intrinsics.height,
-                          intrinsics.width,
-                          CV_32F,
-                          refined.depth.data());
+  const cv::Mat depth_mat(
+      intrinsics.height, intrinsics.width, CV_32F, refined.depth.data());
   workspace.WriteDepthMap(view.image_name, depth_mat);
   workspace.WriteNormalMap(view.image_name, NormalsToMat(refined.normals));
   if (undistorter) {
     const std::string image_path = dataset.LeftImagePath(view.station);
     const cv::Mat distorted = cv::imread(image_path, cv::IMREAD_COLOR);
     if (distorted.empty()) {
-      throw std::runtime_error("station " + station + ": cannot read " + image_path);
+      throw std::runtime_error("station " + station + ": cannot read " +
+                               image_path);
     }
-    workspace.WriteImage(view.image_name, undistorter->UndistortImage(distorted));
+    workspace.WriteImage(view.image_name,
+                         undistorter->UndistortImage(distorted));
   } else {
     workspace.CopyImage(view.image_name, dataset.LeftImagePath(view.station));
   }
-  const fs::path preview_dir = fs::path(workspace.Root()) / "stereo" / "previews";
+  const fs::path preview_dir =
+      fs::path(workspace.Root()) / "stereo" / "previews";
   fs::create_directories(preview_dir);
-  cv::imwrite((preview_dir / (station + ".png")).string(),
-              SourcePreview(refined.source, intrinsics.width, intrinsics.height));
+  cv::imwrite(
+      (preview_dir / (station + ".png")).string(),
+      SourcePreview(refined.source, intrinsics.width, intrinsics.height));
   return result;
 }
 
@@ -304,7 +318,8 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
       if (options.min_consistent_views > 0) {
         int agreeing = 0;
         for (const Other& other : others) {
-          const Eigen::Vector3d point_in_other = other.cam_from_world * point_in_world;
+          const Eigen::Vector3d point_in_other =
+              other.cam_from_world * point_in_world;
           Eigen::Vector2d xy;
           if (!other.intrinsics.Project(point_in_other, &xy) ||
               !other.intrinsics.Contains(xy)) {
@@ -326,9 +341,10 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
       Eigen::Vector3d normal_in_cam(n[0], n[1], n[2]);
       if (normal_in_cam.isZero()) normal_in_cam = -ray.normalized();
       const cv::Vec3b& color = bgr.at<cv::Vec3b>(row, col);
-      rows[row].push_back({point_in_world,
-                           (world_from_cam_rotation * normal_in_cam).cast<float>(),
-                           Color3ub(color[2], color[1], color[0])});
+      rows[row].push_back(
+          {point_in_world,
+           (world_from_cam_rotation * normal_in_cam).cast<float>(),
+           Color3ub(color[2], color[1], color[0])});
     }
   }
   for (const auto& samples : rows) {
@@ -420,8 +436,8 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
       if (IsPinholeCamera(camera)) continue;
       undistorters[camera_id] = std::make_unique<CameraUndistorter>(
           camera, reconstruction.Camera(camera_id));
-      std::cout << "densifier: camera " << camera_id << " (" << camera.ModelName()
-                << ") is undistorted to PINHOLE "
+      std::cout << "densifier: camera " << camera_id << " ("
+                << camera.ModelName() << ") is undistorted to PINHOLE "
                 << reconstruction.Camera(camera_id).width << "x"
                 << reconstruction.Camera(camera_id).height << std::endl;
     }
@@ -449,17 +465,19 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
           workspace,
           options,
           input_model.Camera(camera_id),
-          undistorter == undistorters.end() ? nullptr : undistorter->second.get(),
+          undistorter == undistorters.end() ? nullptr
+                                            : undistorter->second.get(),
           &lidar_map);
       station.seconds = SecondsSince(station_start);
       const LidarDepthRefinementStats& s = station.refinement;
-      std::cout << "densifier: [" << k + 1 << "/" << views.size() << "] station "
-                << station.station << ": " << s.stereo_pixels
-                << " stereo pixels (" << s.stereo_confirmed << " confirmed by LiDAR, "
-                << s.stereo_removed << " removed), " << s.filled
-                << " filled from " << station.lidar_points_in_view
-                << " LiDAR points in view (" << std::fixed << std::setprecision(1)
-                << station.seconds << " s)" << std::endl;
+      std::cout << "densifier: [" << k + 1 << "/" << views.size()
+                << "] station " << station.station << ": " << s.stereo_pixels
+                << " stereo pixels (" << s.stereo_confirmed
+                << " confirmed by LiDAR, " << s.stereo_removed << " removed), "
+                << s.filled << " filled from " << station.lidar_points_in_view
+                << " LiDAR points in view (" << std::fixed
+                << std::setprecision(1) << station.seconds << " s)"
+                << std::endl;
       summary.stations.push_back(station);
     }
 
@@ -477,8 +495,8 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
     }
     const PointCloud fused_cloud = fused.Extract();
     summary.fused_points = fused_cloud.Size();
-    std::cout << "densifier: fused " << fused.NumPointsAdded() << " points into "
-              << fused_cloud.Size() << " voxels of "
+    std::cout << "densifier: fused " << fused.NumPointsAdded()
+              << " points into " << fused_cloud.Size() << " voxels of "
               << options.fused_voxel_size_m * 1000 << " mm" << std::endl;
     WritePointCloud((partial / "fused.ply").string(), fused_cloud);
     PointCloud lidar_cloud = lidar_map.Extract();
@@ -500,13 +518,14 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
     report["lidar_map_points"] = summary.lidar_map_points;
     report["seconds"] = summary.seconds;
     const LidarDepthRefinementOptions& r = options.refinement;
-    report["refinement"] = {{"window_radius_px", r.window_radius_px},
-                            {"max_abs_diff_m", r.max_abs_diff_m},
-                            {"max_rel_diff", r.max_rel_diff},
-                            {"plane_tolerance_m", r.plane_tolerance_m},
-                            {"max_normal_angle_deg", r.max_normal_angle_deg},
-                            {"max_fill_curvature", r.max_fill_curvature},
-                            {"max_fill_view_angle_deg", r.max_fill_view_angle_deg}};
+    report["refinement"] = {
+        {"window_radius_px", r.window_radius_px},
+        {"max_abs_diff_m", r.max_abs_diff_m},
+        {"max_rel_diff", r.max_rel_diff},
+        {"plane_tolerance_m", r.plane_tolerance_m},
+        {"max_normal_angle_deg", r.max_normal_angle_deg},
+        {"max_fill_curvature", r.max_fill_curvature},
+        {"max_fill_view_angle_deg", r.max_fill_view_angle_deg}};
     for (const StationDensification& station : summary.stations) {
       report["stations"].push_back(StationReport(station));
     }

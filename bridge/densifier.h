@@ -41,8 +41,8 @@ struct DensifierOptions {
   int max_neighbor_views = 6;
   double consistency_abs_m = 0.01;
   double consistency_rel = 0.005;
-  double fused_voxel_size_m = 0.001;      // merge of fused.ply
-  double lidar_map_voxel_size_m = 0.01;   // lidar_map.ply
+  double fused_voxel_size_m = 0.001;     // merge of fused.ply
+  double lidar_map_voxel_size_m = 0.01;  // lidar_map.ply
 
   bool Check() const;  // throws std::invalid_argument
 };

@@ -1,9 +1,9 @@
 #include "bridge/commands.h"
 #include "bridge/densifier.h"
+#include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 
 #include "colmap/controllers/option_manager.h"
-#include "colmap_ext/logging.h"
 
 #include <filesystem>
 #include <iomanip>
@@ -32,7 +32,8 @@ int RunDensifier(int argc, char** argv) {
                            "0: fuse the stereo depth maps as they are");
   options.AddDefaultOption("lidar_sample_spacing_m",
                            &densifier.surface.sample_spacing_m);
-  options.AddDefaultOption("lidar_normal_radius_m", &densifier.surface.radius_m);
+  options.AddDefaultOption("lidar_normal_radius_m",
+                           &densifier.surface.radius_m);
   options.AddDefaultOption("window_radius_px", &refinement.window_radius_px);
   options.AddDefaultOption("remove_inconsistent",
                            &refinement.remove_inconsistent);
@@ -56,12 +57,10 @@ int RunDensifier(int argc, char** argv) {
   options.AddDefaultOption("min_consistent_views",
                            &densifier.min_consistent_views,
                            "cross-station check (0 = off)");
-  options.AddDefaultOption("max_neighbor_views",
-                           &densifier.max_neighbor_views);
+  options.AddDefaultOption("max_neighbor_views", &densifier.max_neighbor_views);
   options.AddDefaultOption("consistency_abs_m", &densifier.consistency_abs_m);
   options.AddDefaultOption("consistency_rel", &densifier.consistency_rel);
-  options.AddDefaultOption("fused_voxel_size_m",
-                           &densifier.fused_voxel_size_m);
+  options.AddDefaultOption("fused_voxel_size_m", &densifier.fused_voxel_size_m);
   options.AddDefaultOption("lidar_map_voxel_size_m",
                            &densifier.lidar_map_voxel_size_m);
   options.Parse(argc, argv);
@@ -76,18 +75,22 @@ int RunDensifier(int argc, char** argv) {
       << "No sparse model at " << input_path;
   colmap::Reconstruction reconstruction;
   reconstruction.Read(input_path);
-  const DensifierSummary summary = Densify(
-      reconstruction, cam_from_lidar, dataset, depth_path, output_path, densifier);
+  const DensifierSummary summary = Densify(reconstruction,
+                                           cam_from_lidar,
+                                           dataset,
+                                           depth_path,
+                                           output_path,
+                                           densifier);
   size_t removed = 0, filled = 0, stereo = 0;
   for (const StationDensification& station : summary.stations) {
     removed += station.refinement.stereo_removed;
     filled += station.refinement.filled;
     stereo += station.refinement.stereo_pixels;
   }
-  std::cout << std::fixed << std::setprecision(1) << "densifier: "
-            << summary.stations.size() << " stations in " << summary.seconds
-            << " s; stereo pixels " << stereo << ", removed " << removed
-            << ", filled " << filled << "; " << summary.fused_points
+  std::cout << std::fixed << std::setprecision(1)
+            << "densifier: " << summary.stations.size() << " stations in "
+            << summary.seconds << " s; stereo pixels " << stereo << ", removed "
+            << removed << ", filled " << filled << "; " << summary.fused_points
             << " points in " << output_path << "/fused.ply, "
             << summary.lidar_map_points << " in lidar_map.ply; COLMAP dense "
             << "workspace in " << output_path << std::endl;

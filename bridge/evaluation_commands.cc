@@ -78,7 +78,8 @@ int RunEvaluateModel(int argc, char** argv) {
   if (!truth_from_model_path.empty()) {
     const colmap::Rigid3d truth_from_model =
         ReadPoseFile(truth_from_model_path);
-    for (Eigen::Vector3d& point : model.points) point = truth_from_model * point;
+    for (Eigen::Vector3d& point : model.points)
+      point = truth_from_model * point;
     for (Eigen::Vector3d& normal : model.normals) {
       normal = truth_from_model.rotation * normal;
     }

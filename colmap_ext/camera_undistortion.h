@@ -22,7 +22,8 @@ class CameraUndistorter {
 
  private:
   int distorted_width_ = 0, distorted_height_ = 0;
-  cv::Mat map_x_, map_y_;  // CV_32F, undistorted grid -> OpenCV coordinates in the distorted grid
+  cv::Mat map_x_,
+      map_y_;  // CV_32F, undistorted grid -> OpenCV coordinates in the distorted grid
 };
 
 }  // namespace colmap_lidar

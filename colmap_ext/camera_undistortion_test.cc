@@ -12,8 +12,8 @@ namespace {
 // A plane z = 2 + 0.3 x seen by a camera with strong radial distortion: the depth map in the distorted
 // grid, undistorted, must give the plane's depth along every undistorted pixel's ray.
 TEST(CameraUndistorter, DepthMapOfAPlaneMatchesThePlaneInThePinholeGrid) {
-  const colmap::Camera distorted = colmap::Camera::CreateFromModelName(
-      1, "OPENCV", 150, 200, 150);
+  const colmap::Camera distorted =
+      colmap::Camera::CreateFromModelName(1, "OPENCV", 150, 200, 150);
   colmap::Camera camera = distorted;
   camera.params = {150, 152, 101, 74, -0.25, 0.05, 0.001, -0.001};
   const colmap::Camera pinhole =
@@ -37,8 +37,9 @@ TEST(CameraUndistorter, DepthMapOfAPlaneMatchesThePlaneInThePinholeGrid) {
     for (int col = 0; col < undistorted.cols; ++col) {
       const float z = undistorted.at<float>(row, col);
       if (z <= 0) continue;
-      errors.push_back(std::abs(z - plane_depth(pinhole.CamFromImg(
-                                        Eigen::Vector2d(col + 0.5, row + 0.5)))));
+      errors.push_back(
+          std::abs(z - plane_depth(pinhole.CamFromImg(
+                           Eigen::Vector2d(col + 0.5, row + 0.5)))));
     }
   }
   ASSERT_GT(errors.size(), undistorted.total() * 9 / 10);
@@ -50,10 +51,11 @@ TEST(CameraUndistorter, DepthMapOfAPlaneMatchesThePlaneInThePinholeGrid) {
   double unresampled_max = 0;
   for (int row = 0; row < std::min(depth.rows, undistorted.rows); ++row) {
     for (int col = 0; col < std::min(depth.cols, undistorted.cols); ++col) {
-      unresampled_max = std::max(
-          unresampled_max,
-          std::abs(depth.at<float>(row, col) -
-                   plane_depth(pinhole.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5)))));
+      unresampled_max =
+          std::max(unresampled_max,
+                   std::abs(depth.at<float>(row, col) -
+                            plane_depth(pinhole.CamFromImg(
+                                Eigen::Vector2d(col + 0.5, row + 0.5)))));
     }
   }
   EXPECT_GT(unresampled_max, 0.02);

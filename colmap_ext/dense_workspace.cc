@@ -126,7 +126,8 @@ void DenseWorkspace::WriteDepthMap(const std::string& image_name,
   if (depth.type() != CV_32F) {
     throw std::invalid_argument("WriteDepthMap: depth must be CV_32F");
   }
-  colmap::mvs::DepthMap map(depth.cols, depth.rows, 0, 0);  // the range is not stored
+  colmap::mvs::DepthMap map(
+      depth.cols, depth.rows, 0, 0);  // the range is not stored
   for (int row = 0; row < depth.rows; ++row) {
     for (int col = 0; col < depth.cols; ++col) {
       map.Set(row, col, depth.at<float>(row, col));

@@ -14,8 +14,8 @@ using IndexImage =
 double DegToRad(double degrees) { return degrees * M_PI / 180; }
 
 // Projected centre of every sample (NaN behind the camera).
-std::vector<Eigen::Vector2d> ProjectSamples(const LidarSurface& surface,
-                                            const PinholeIntrinsics& intrinsics) {
+std::vector<Eigen::Vector2d> ProjectSamples(
+    const LidarSurface& surface, const PinholeIntrinsics& intrinsics) {
   std::vector<Eigen::Vector2d> xy(
       surface.Size(),
       Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
@@ -29,9 +29,12 @@ IndexImage Splat(const LidarSurface& surface,
                  const std::vector<Eigen::Vector2d>& xy,
                  const PinholeIntrinsics& intrinsics,
                  int max_radius_px) {
-  IndexImage index = IndexImage::Constant(intrinsics.height, intrinsics.width, -1);
-  DepthImage zbuffer = DepthImage::Constant(
-      intrinsics.height, intrinsics.width, std::numeric_limits<float>::infinity());
+  IndexImage index =
+      IndexImage::Constant(intrinsics.height, intrinsics.width, -1);
+  DepthImage zbuffer =
+      DepthImage::Constant(intrinsics.height,
+                           intrinsics.width,
+                           std::numeric_limits<float>::infinity());
   for (size_t i = 0; i < surface.Size(); ++i) {
     if (!std::isfinite(xy[i].x())) continue;
     const double z = surface.points[i].z();
@@ -75,7 +78,9 @@ int AutomaticWindowRadius(const LidarSurface& surface,
                    spacing_px.begin() + spacing_px.size() / 2,
                    spacing_px.end());
   return std::clamp(
-      static_cast<int>(std::lround(1.5 * spacing_px[spacing_px.size() / 2])), 3, 30);
+      static_cast<int>(std::lround(1.5 * spacing_px[spacing_px.size() / 2])),
+      3,
+      30);
 }
 
 }  // namespace
@@ -85,7 +90,8 @@ bool LidarDepthRefinementOptions::Check() const {
     throw std::invalid_argument(std::string("LidarDepthRefinementOptions: ") +
                                 what);
   };
-  if (window_radius_px < 0) fail("window_radius_px must be >= 0 (0: automatic)");
+  if (window_radius_px < 0)
+    fail("window_radius_px must be >= 0 (0: automatic)");
   if (!(max_abs_diff_m >= 0) || !(max_rel_diff >= 0) ||
       !(max_check_curvature >= 0)) {
     fail("max_abs_diff_m, max_rel_diff and max_check_curvature must be >= 0");
@@ -135,8 +141,10 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
   // Footprints reach at most half the window: a sample never hides a whole window.
   const IndexImage index =
       Splat(surface, xy, intrinsics, std::max(1, radius / 2));
-  const double min_normal_cos = std::cos(DegToRad(options.max_normal_angle_deg));
-  const double min_view_cos = std::cos(DegToRad(options.max_fill_view_angle_deg));
+  const double min_normal_cos =
+      std::cos(DegToRad(options.max_normal_angle_deg));
+  const double min_view_cos =
+      std::cos(DegToRad(options.max_fill_view_angle_deg));
   const double kMinRayCos = std::cos(DegToRad(85));
 
   RefinedDepth result;
@@ -206,7 +214,8 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
             }
           }
           for (int s : layer) {
-            layer_curvature = std::max(layer_curvature, double(surface.curvature[s]));
+            layer_curvature =
+                std::max(layer_curvature, double(surface.curvature[s]));
           }
           normal = normal_sum.normalized();
           centroid /= double(layer.size());
@@ -228,7 +237,8 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
             depth = stereo_z;
             result.normals.normals[pixel] = normal.cast<float>();
           } else if (!options.remove_inconsistent) {
-            depth = stereo_z;  // disagrees, kept on request; normal from the depth map
+            depth =
+                stereo_z;  // disagrees, kept on request; normal from the depth map
           } else {
             ++local.stereo_removed;  // fold 1 (paper, mapping step (1))
             result.source[pixel] = DepthSource::kRemoved;
@@ -261,8 +271,8 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
           if (d.squaredNorm() < 0.25) {
             quadrants = 0xF;
           } else {
-            quadrants |= 1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3)
-                                           : (d.y() >= 0 ? 1 : 2));
+            quadrants |=
+                1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3) : (d.y() >= 0 ? 1 : 2));
           }
         }
         int num_quadrants = 0;

@@ -44,7 +44,8 @@ std::vector<Eigen::Vector3d> LidarPoints() {
       const Eigen::Vector3d wall(x, y, kWallZ);
       const Eigen::Vector3d d = wall - lidar;
       // Intersection with the plate's plane z = 2 - 0.2 x along lidar + t d.
-      const double t = (2.0 - 0.2 * lidar.x() - lidar.z()) / (d.z() + 0.2 * d.x());
+      const double t =
+          (2.0 - 0.2 * lidar.x() - lidar.z()) / (d.z() + 0.2 * d.x());
       const bool hidden = t > 0 && t < 1 && (lidar + t * d).x() < 0;
       if (!hidden) points.emplace_back(x, y, kWallZ + noise(rng));
     }
@@ -52,13 +53,15 @@ std::vector<Eigen::Vector3d> LidarPoints() {
   return points;
 }
 
-TEST(LidarDepthRefinement, RemovesWrongStereoAndFillsHolesWithoutCrossingTheStepEdge) {
+TEST(LidarDepthRefinement,
+     RemovesWrongStereoAndFillsHolesWithoutCrossingTheStepEdge) {
   const PinholeIntrinsics intrinsics = Camera();
   LidarSurfaceOptions surface_options;
   surface_options.sample_spacing_m = 0.006;
   surface_options.radius_m = 0.03;
   surface_options.curvature_radius_m = 0.06;
-  const LidarSurface surface = BuildLidarSurface(LidarPoints(), surface_options);
+  const LidarSurface surface =
+      BuildLidarSurface(LidarPoints(), surface_options);
   ASSERT_GT(surface.Size(), 10000u);
 
   DepthImage truth(intrinsics.height, intrinsics.width);
@@ -123,16 +126,19 @@ TEST(LidarDepthRefinement, RemovesWrongStereoAndFillsHolesWithoutCrossingTheStep
         continue;
       }
       ++filled;
-      max_fill_error = std::max(
-          max_fill_error, double(std::abs(refined.depth(row, col) - truth(row, col))));
+      max_fill_error =
+          std::max(max_fill_error,
+                   double(std::abs(refined.depth(row, col) - truth(row, col))));
       filled_in_plate_hole += row >= 20 && row < 50 && col >= 30 && col < 70;
       filled_in_band += row >= 60 && row < 100 && col >= 100 && col < 140;
     }
   }
   std::cout << "filled " << filled << " pixels, max error "
-            << max_fill_error * 1000 << " mm; plate hole " << filled_in_plate_hole
-            << "/1200, edge band " << filled_in_band << "/1600" << std::endl;
-  EXPECT_LT(max_fill_error, 0.003);  // 1 mm LiDAR noise, interpolated on the local plane
+            << max_fill_error * 1000 << " mm; plate hole "
+            << filled_in_plate_hole << "/1200, edge band " << filled_in_band
+            << "/1600" << std::endl;
+  EXPECT_LT(max_fill_error,
+            0.003);  // 1 mm LiDAR noise, interpolated on the local plane
   EXPECT_GE(filled_in_plate_hole, 1200u * 95 / 100);
   // The band is filled on both sides of the edge, each side with its own surface (the bound above).
   EXPECT_GE(filled_in_band, 1600u * 3 / 4);
@@ -149,7 +155,8 @@ TEST(LidarDepthRefinement, DoesNotFillGrazingOrCurvedSurfaces) {
   surface_options.sample_spacing_m = 0.006;
   surface_options.radius_m = 0.03;
   surface_options.curvature_radius_m = 0.06;
-  const DepthImage empty = DepthImage::Zero(intrinsics.height, intrinsics.width);
+  const DepthImage empty =
+      DepthImage::Zero(intrinsics.height, intrinsics.width);
 
   // A plane tilted 70 degrees about the camera's y axis: seen at 55-85 degrees from its normal.
   std::vector<Eigen::Vector3d> tilted;
@@ -172,14 +179,15 @@ TEST(LidarDepthRefinement, DoesNotFillGrazingOrCurvedSurfaces) {
   size_t steep_filled = 0;
   for (int row = 0; row < intrinsics.height; ++row) {
     for (int col = 0; col < intrinsics.width; ++col) {
-      const double angle = std::acos(std::abs(
-                               normal.dot(intrinsics.PixelRay(col, row).normalized()))) *
+      const double angle = std::acos(std::abs(normal.dot(
+                               intrinsics.PixelRay(col, row).normalized()))) *
                            180 / M_PI;
       const size_t pixel = size_t(row) * intrinsics.width + col;
       if (by_angle.source[pixel] == DepthSource::kLidar) {
         EXPECT_LE(angle, 75.5) << row << "," << col;
       }
-      steep_filled += angle > 77 && permissive.source[pixel] == DepthSource::kLidar;
+      steep_filled +=
+          angle > 77 && permissive.source[pixel] == DepthSource::kLidar;
     }
   }
   EXPECT_GT(by_angle.stats.filled, 100u);

@@ -15,7 +15,7 @@ namespace {
 struct Pca {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();  // ascending
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();       // smallest eigenvector
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // smallest eigenvector
 };
 
 // PCA of the indexed samples, at most `max_count` of them taken evenly.
@@ -53,7 +53,8 @@ bool LidarSurfaceOptions::Check() const {
         "LidarSurfaceOptions: need 0 < sample_spacing_m < radius_m");
   }
   if (!(curvature_radius_m > 0)) {
-    throw std::invalid_argument("LidarSurfaceOptions: curvature_radius_m must be > 0");
+    throw std::invalid_argument(
+        "LidarSurfaceOptions: curvature_radius_m must be > 0");
   }
   if (min_neighbors < 3 || max_neighbors < min_neighbors) {
     throw std::invalid_argument(
@@ -62,8 +63,9 @@ bool LidarSurfaceOptions::Check() const {
   return true;
 }
 
-LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam,
-                               const LidarSurfaceOptions& options) {
+LidarSurface BuildLidarSurface(
+    const std::vector<Eigen::Vector3d>& points_in_cam,
+    const LidarSurfaceOptions& options) {
   options.Check();
   LidarSurface surface;
   if (points_in_cam.empty()) return surface;
@@ -109,7 +111,8 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
         double best = Curvature(pca);
         for (size_t k = 0; k < candidates.size(); k += stride) {
           tree.RadiusSearch(samples[candidates[k]], options.radius_m, &shifted);
-          if (static_cast<int>(shifted.size()) < options.min_neighbors) continue;
+          if (static_cast<int>(shifted.size()) < options.min_neighbors)
+            continue;
           const Pca other =
               NeighbourhoodPca(samples, shifted, options.max_neighbors);
           const double c = Curvature(other);
@@ -123,7 +126,8 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
       double c = Curvature(pca);
       if (options.curvature_radius_m != options.radius_m) {
         tree.RadiusSearch(samples[i], options.curvature_radius_m, &indices);
-        c = Curvature(NeighbourhoodPca(samples, indices, options.max_neighbors));
+        c = Curvature(
+            NeighbourhoodPca(samples, indices, options.max_neighbors));
       }
       curvature[i] = float(c);
     }

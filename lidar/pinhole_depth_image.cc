@@ -8,7 +8,8 @@ namespace colmap_lidar {
 
 bool PinholeIntrinsics::Check() const {
   if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("PinholeIntrinsics: image size must be positive");
+    throw std::invalid_argument(
+        "PinholeIntrinsics: image size must be positive");
   }
   if (!(fx > 0) || !(fy > 0) || !std::isfinite(cx) || !std::isfinite(cy)) {
     throw std::invalid_argument(
@@ -47,7 +48,8 @@ NormalImage NormalsFromDepth(const DepthImage& depth,
         const bool plus = usable(col + dc, row + dr, z);
         const bool minus = usable(col - dc, row - dr, z);
         if (plus && minus) {
-          tangents[axis] = point(col + dc, row + dr) - point(col - dc, row - dr);
+          tangents[axis] =
+              point(col + dc, row + dr) - point(col - dc, row - dr);
         } else if (plus) {
           tangents[axis] = point(col + dc, row + dr) - point(col, row);
         } else if (minus) {

@@ -47,7 +47,9 @@ struct NormalImage {
   NormalImage() = default;
   NormalImage(int w, int h)
       : width(w), height(h), normals(size_t(w) * h, Eigen::Vector3f::Zero()) {}
-  Eigen::Vector3f& At(int row, int col) { return normals[size_t(row) * width + col]; }
+  Eigen::Vector3f& At(int row, int col) {
+    return normals[size_t(row) * width + col];
+  }
   const Eigen::Vector3f& At(int row, int col) const {
     return normals[size_t(row) * width + col];
   }

@@ -55,9 +55,9 @@ PointCloud VoxelAccumulator::Extract(int min_points) const {
     if (voxel.count < static_cast<uint32_t>(std::max(1, min_points))) continue;
     cloud.points.push_back(voxel.sum_point / voxel.count);
     const Eigen::Vector3f normal = voxel.sum_normal;
-    cloud.normals.push_back(normal.norm() > 0
-                                ? Eigen::Vector3d(normal.normalized().cast<double>())
-                                : Eigen::Vector3d::Zero());
+    cloud.normals.push_back(
+        normal.norm() > 0 ? Eigen::Vector3d(normal.normalized().cast<double>())
+                          : Eigen::Vector3d::Zero());
     const Eigen::Vector3f color = voxel.sum_color / float(voxel.count);
     cloud.colors.push_back(
         (color.array() + 0.5f).min(255.f).cast<uint8_t>().matrix());

@@ -14,7 +14,8 @@ namespace colmap_lidar {
 
 class VoxelAccumulator {
  public:
-  explicit VoxelAccumulator(double voxel_size);  // throws std::invalid_argument for <= 0
+  explicit VoxelAccumulator(
+      double voxel_size);  // throws std::invalid_argument for <= 0
 
   // `normal` may be zero (no normal); `color` is ignored when the accumulator has none.
   void Add(const Eigen::Vector3d& point,

@@ -26,12 +26,14 @@ TEST(VoxelAccumulator, MergesPointsOfOneVoxelAndKeepsOthersApart) {
   ASSERT_EQ(merged.Size(), 2u);
   for (size_t i = 0; i < merged.Size(); ++i) {
     if (merged.points[i].x() < 0.01) {
-      EXPECT_TRUE(merged.points[i].isApprox(Eigen::Vector3d(0.003, 0.004, 0.005)));
+      EXPECT_TRUE(
+          merged.points[i].isApprox(Eigen::Vector3d(0.003, 0.004, 0.005)));
       EXPECT_NEAR(merged.normals[i].norm(), 1, 1e-6);  // float normals
       EXPECT_NEAR(merged.normals[i].y(), std::sqrt(0.5), 1e-6);
       EXPECT_EQ(merged.colors[i], Color3ub(150, 25, 0));
     } else {
-      EXPECT_TRUE(merged.normals[i].isZero());  // no normal given: none invented
+      EXPECT_TRUE(
+          merged.normals[i].isZero());  // no normal given: none invented
       EXPECT_EQ(merged.colors[i], Color3ub(0, 0, 255));
     }
   }

@@ -77,18 +77,19 @@ nlohmann::json EvaluateCloud(const std::string& cloud,
                              const std::string& dataset,
                              const std::string& truth_from_model,
                              const std::string& output) {
-  const auto run = RunCommand(
-      kCli + " evaluate_model --model_path " + cloud + " --ground_truth_path " +
-      dataset + "/ground_truth/surface.ply --truth_from_model " +
-      truth_from_model + " --output_path " + output);
+  const auto run = RunCommand(kCli + " evaluate_model --model_path " + cloud +
+                              " --ground_truth_path " + dataset +
+                              "/ground_truth/surface.ply --truth_from_model " +
+                              truth_from_model + " --output_path " + output);
   EXPECT_EQ(run.exit_code, 0) << run.output;
   return ReadJson(output + "/metrics.json");
 }
 
 void PrintCloudMetrics(const std::string& name, const nlohmann::json& m) {
   std::cout << std::fixed << std::setprecision(2) << "  " << std::left
-            << std::setw(34) << name << " mean " << 1000 * m["mean_m"].get<double>()
-            << " mm, median " << 1000 * m["median_m"].get<double>()
+            << std::setw(34) << name << " mean "
+            << 1000 * m["mean_m"].get<double>() << " mm, median "
+            << 1000 * m["median_m"].get<double>()
             << " mm, completeness 2/5/10 mm "
             << m["completeness_2mm"].get<double>() << "/"
             << m["completeness_5mm"].get<double>() << "/"
@@ -100,36 +101,45 @@ void PrintCloudMetrics(const std::string& name, const nlohmann::json& m) {
 // The dense model of a pipeline workspace (issue 8): LiDAR-refined fused.ply against the unrefined
 // stereo on the same poses and against the stereo-only pipeline; COLMAP's own fusion and Poisson
 // mesher on our dense workspace; the LiDAR map; a missing depth map.
-void CheckDenseModel(const testing::ScopedTempDir& dir, const std::string& dataset) {
+void CheckDenseModel(const testing::ScopedTempDir& dir,
+                     const std::string& dataset) {
   const std::string ws = dir.File("ws");
   const std::string truth_from_joint = ws + "/evaluation/truth_from_model.txt";
-  const nlohmann::json refined = ReadJson(ws + "/evaluation/model/metrics.json");
+  const nlohmann::json refined =
+      ReadJson(ws + "/evaluation/model/metrics.json");
   for (const std::string& step :
-       {kCli + " densifier --input_path " + ws + "/sparse/joint --dataset_path " +
-            dataset + " --depth_path " + ws + "/stereo --output_path " + ws +
+       {kCli + " densifier --input_path " + ws +
+            "/sparse/joint --dataset_path " + dataset + " --depth_path " + ws +
+            "/stereo --output_path " + ws +
             "/dense_unrefined --refine_with_lidar 0",
         kCli + " joint_adjuster --database_path " + ws +
-            "/database.db --input_path " + ws + "/sparse/initial --dataset_path " +
-            dataset + " --output_path " + ws + "/sparse/stereo_only --mode stereo_only",
+            "/database.db --input_path " + ws +
+            "/sparse/initial --dataset_path " + dataset + " --output_path " +
+            ws + "/sparse/stereo_only --mode stereo_only",
         kCli + " evaluate_calibration --dataset_path " + dataset +
             " --input_path " + ws + "/sparse/stereo_only --output_path " + ws +
             "/evaluation_stereo_only",
-        kCli + " densifier --input_path " + ws + "/sparse/stereo_only --dataset_path " +
-            dataset + " --depth_path " + ws + "/stereo --output_path " + ws +
+        kCli + " densifier --input_path " + ws +
+            "/sparse/stereo_only --dataset_path " + dataset + " --depth_path " +
+            ws + "/stereo --output_path " + ws +
             "/dense_stereo_only --refine_with_lidar 0"}) {
     const auto result = RunCommand(step);
     ASSERT_EQ(result.exit_code, 0) << step << "\n" << result.output;
   }
   const nlohmann::json unrefined =
-      EvaluateCloud(ws + "/dense_unrefined/fused.ply", dataset, truth_from_joint,
+      EvaluateCloud(ws + "/dense_unrefined/fused.ply",
+                    dataset,
+                    truth_from_joint,
                     ws + "/evaluation/model_unrefined");
-  const nlohmann::json stereo_only = EvaluateCloud(
-      ws + "/dense_stereo_only/fused.ply", dataset,
-      ws + "/evaluation_stereo_only/truth_from_model.txt",
-      ws + "/evaluation/model_stereo_only");
-  const nlohmann::json lidar_map =
-      EvaluateCloud(ws + "/dense/lidar_map.ply", dataset, truth_from_joint,
-                    ws + "/evaluation/lidar_map");
+  const nlohmann::json stereo_only =
+      EvaluateCloud(ws + "/dense_stereo_only/fused.ply",
+                    dataset,
+                    ws + "/evaluation_stereo_only/truth_from_model.txt",
+                    ws + "/evaluation/model_stereo_only");
+  const nlohmann::json lidar_map = EvaluateCloud(ws + "/dense/lidar_map.ply",
+                                                 dataset,
+                                                 truth_from_joint,
+                                                 ws + "/evaluation/lidar_map");
   std::cout << "dense models against the true surface:" << std::endl;
   PrintCloudMetrics("LiDAR-refined (fused.ply)", refined);
   PrintCloudMetrics("stereo, joint poses, unrefined", unrefined);
@@ -139,8 +149,10 @@ void CheckDenseModel(const testing::ScopedTempDir& dir, const std::string& datas
   // stereo is refilled from the LiDAR surface, closer to the truth); at 5 and 10 mm equal within
   // 0.006: what fold 1 removes and fold 2 cannot fill (next to creases and depth edges) was 3-10 mm
   // off, so it counted at 10 mm.
-  EXPECT_LT(refined["mean_m"].get<double>(), 0.9 * unrefined["mean_m"].get<double>());
-  EXPECT_LT(refined["mean_m"].get<double>(), 0.9 * stereo_only["mean_m"].get<double>());
+  EXPECT_LT(refined["mean_m"].get<double>(),
+            0.9 * unrefined["mean_m"].get<double>());
+  EXPECT_LT(refined["mean_m"].get<double>(),
+            0.9 * stereo_only["mean_m"].get<double>());
   EXPECT_LT(refined["mean_m"].get<double>(), 0.0025);
   for (const auto* other : {&unrefined, &stereo_only}) {
     EXPECT_GT(refined["completeness_2mm"].get<double>(),
@@ -162,7 +174,8 @@ void CheckDenseModel(const testing::ScopedTempDir& dir, const std::string& datas
   }
   EXPECT_GT(filled, 10000u);
   EXPECT_GT(removed, 10000u);
-  EXPECT_TRUE(fs::is_regular_file(ws + "/dense/stereo/depth_maps/left/000.png.geometric.bin"));
+  EXPECT_TRUE(fs::is_regular_file(
+      ws + "/dense/stereo/depth_maps/left/000.png.geometric.bin"));
   EXPECT_TRUE(fs::is_regular_file(ws + "/dense/stereo/previews/000.png"));
 
   // COLMAP's own tools on our dense workspace. Stations are few and far apart, so a fused point
@@ -177,8 +190,11 @@ void CheckDenseModel(const testing::ScopedTempDir& dir, const std::string& datas
     const auto result = RunCommand(step);
     ASSERT_EQ(result.exit_code, 0) << step << "\n" << result.output;
   }
-  const nlohmann::json fused_by_colmap = EvaluateCloud(
-      colmap_fused, dataset, truth_from_joint, ws + "/evaluation/colmap_fusion");
+  const nlohmann::json fused_by_colmap =
+      EvaluateCloud(colmap_fused,
+                    dataset,
+                    truth_from_joint,
+                    ws + "/evaluation/colmap_fusion");
   PrintCloudMetrics("colmap stereo_fusion of our maps", fused_by_colmap);
   EXPECT_GT(fused_by_colmap["num_evaluated"].get<size_t>(), 50000u);
   // Where we measured (the workspace's -0.5 px principal point), multi-view consistent: 1.1-1.3 mm.
@@ -193,38 +209,50 @@ void CheckDenseModel(const testing::ScopedTempDir& dir, const std::string& datas
     for (const auto& [camera_id, camera] : model.Cameras()) {
       colmap::Camera& opencv = model.Camera(camera_id);
       opencv.model_id = colmap::CameraModelNameToId("OPENCV");
-      opencv.params = {camera.FocalLengthX(), camera.FocalLengthY(),
-                       camera.PrincipalPointX(), camera.PrincipalPointY(),
-                       0, 0, 0, 0};
+      opencv.params = {camera.FocalLengthX(),
+                       camera.FocalLengthY(),
+                       camera.PrincipalPointX(),
+                       camera.PrincipalPointY(),
+                       0,
+                       0,
+                       0,
+                       0};
     }
     fs::create_directories(ws + "/sparse/joint_opencv");
     model.Write(ws + "/sparse/joint_opencv");
-    const auto run = RunCommand(
-        kCli + " densifier --input_path " + ws + "/sparse/joint_opencv" +
-        " --cam_from_lidar " + ws + "/sparse/joint/cam_from_lidar.txt --dataset_path " +
-        dataset + " --depth_path " + ws + "/stereo --output_path " + ws + "/dense_opencv");
+    const auto run =
+        RunCommand(kCli + " densifier --input_path " + ws +
+                   "/sparse/joint_opencv" + " --cam_from_lidar " + ws +
+                   "/sparse/joint/cam_from_lidar.txt --dataset_path " +
+                   dataset + " --depth_path " + ws + "/stereo --output_path " +
+                   ws + "/dense_opencv");
     ASSERT_EQ(run.exit_code, 0) << run.output;
     EXPECT_NE(run.output.find("is undistorted to PINHOLE"), std::string::npos);
-    const nlohmann::json opencv = EvaluateCloud(
-        ws + "/dense_opencv/fused.ply", dataset, truth_from_joint,
-        ws + "/evaluation/model_opencv");
+    const nlohmann::json opencv =
+        EvaluateCloud(ws + "/dense_opencv/fused.ply",
+                      dataset,
+                      truth_from_joint,
+                      ws + "/evaluation/model_opencv");
     PrintCloudMetrics("same, camera given as OPENCV", opencv);
     // COLMAP's undistorted camera is 1027x750, not 1028x752: the maps are resampled (measured
     // 1.99 vs 1.96 mm).
-    EXPECT_NEAR(opencv["mean_m"].get<double>(), refined["mean_m"].get<double>(), 2e-4);
+    EXPECT_NEAR(
+        opencv["mean_m"].get<double>(), refined["mean_m"].get<double>(), 2e-4);
     EXPECT_NEAR(opencv["completeness_2mm"].get<double>(),
-                refined["completeness_2mm"].get<double>(), 0.01);
+                refined["completeness_2mm"].get<double>(),
+                0.01);
   }
 
   // A missing depth map: one error naming the file, nothing written.
   fs::create_directories(ws + "/empty_stereo");
-  const auto missing = RunCommand(
-      kCli + " densifier --input_path " + ws + "/sparse/joint --dataset_path " +
-      dataset + " --depth_path " + ws + "/empty_stereo --output_path " + ws +
-      "/dense_missing");
+  const auto missing =
+      RunCommand(kCli + " densifier --input_path " + ws +
+                 "/sparse/joint --dataset_path " + dataset + " --depth_path " +
+                 ws + "/empty_stereo --output_path " + ws + "/dense_missing");
   EXPECT_NE(missing.exit_code, 0);
-  EXPECT_NE(missing.output.find("empty_stereo/depth_maps/000.png.geometric.bin"),
-            std::string::npos)
+  EXPECT_NE(
+      missing.output.find("empty_stereo/depth_maps/000.png.geometric.bin"),
+      std::string::npos)
       << missing.output;
   EXPECT_FALSE(fs::exists(ws + "/dense_missing"));
   EXPECT_FALSE(fs::exists(ws + "/dense_missing.partial"));
