@@ -41,6 +41,8 @@ int RunDensifier(int argc, char** argv) {
   options.AddDefaultOption("max_rel_diff", &refinement.max_rel_diff);
   options.AddDefaultOption("max_check_curvature",
                            &refinement.max_check_curvature);
+  options.AddDefaultOption("max_unreplaceable_diff_m",
+                           &refinement.max_unreplaceable_diff_m);
   options.AddDefaultOption("plane_tolerance_m", &refinement.plane_tolerance_m);
   options.AddDefaultOption("max_normal_angle_deg",
                            &refinement.max_normal_angle_deg);

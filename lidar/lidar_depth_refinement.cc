@@ -63,6 +63,44 @@ IndexImage Splat(const LidarSurface& surface,
   return index;
 }
 
+enum class FillVerdict { kFill, kNoLayer, kEdge, kSparse, kViewAngle, kCurvature };
+
+FillVerdict JudgeFill(const std::vector<int>& layer,
+                      size_t window_size,
+                      const std::vector<Eigen::Vector2d>& xy,
+                      const Eigen::Vector2d& centre,
+                      const Eigen::Vector3d& normal,
+                      const Eigen::Vector3d& unit_ray,
+                      double layer_curvature,
+                      double min_view_cos,
+                      const LidarDepthRefinementOptions& options) {
+  if (static_cast<int>(layer.size()) < options.min_fill_samples) {
+    return FillVerdict::kSparse;
+  }
+  if (std::abs(normal.dot(unit_ray)) < min_view_cos) {
+    return FillVerdict::kViewAngle;
+  }
+  int quadrants = 0;
+  for (int s : layer) {
+    const Eigen::Vector2d d = xy[s] - centre;
+    if (d.squaredNorm() < 0.25) {
+      quadrants = 0xF;
+    } else {
+      quadrants |= 1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3) : (d.y() >= 0 ? 1 : 2));
+    }
+  }
+  int num_quadrants = 0;
+  for (int q = 0; q < 4; ++q) num_quadrants += (quadrants >> q) & 1;
+  if (layer.size() != window_size && num_quadrants < 4) {
+    return FillVerdict::kEdge;
+  }
+  if (num_quadrants < options.min_fill_quadrants) return FillVerdict::kSparse;
+  if (layer_curvature > options.max_fill_curvature) {
+    return FillVerdict::kCurvature;
+  }
+  return FillVerdict::kFill;
+}
+
 int AutomaticWindowRadius(const LidarSurface& surface,
                           const std::vector<Eigen::Vector2d>& xy,
                           const PinholeIntrinsics& intrinsics) {
@@ -93,8 +131,11 @@ bool LidarDepthRefinementOptions::Check() const {
   if (window_radius_px < 0)
     fail("window_radius_px must be >= 0 (0: automatic)");
   if (!(max_abs_diff_m >= 0) || !(max_rel_diff >= 0) ||
-      !(max_check_curvature >= 0)) {
-    fail("max_abs_diff_m, max_rel_diff and max_check_curvature must be >= 0");
+      !(max_check_curvature >= 0) ||
+      !(max_unreplaceable_diff_m >= max_abs_diff_m)) {
+    fail(
+        "need max_abs_diff_m, max_rel_diff, max_check_curvature >= 0 and "
+        "max_unreplaceable_diff_m >= max_abs_diff_m");
   }
   if (!(plane_tolerance_m > 0)) fail("plane_tolerance_m must be > 0");
   if (!(max_normal_angle_deg > 0 && max_normal_angle_deg < 90)) {
@@ -189,6 +230,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
         bool has_plane = false;
         double lidar_z = 0;
         double layer_curvature = 0;
+        double plane_offset = 0;  // n . x on the layer's plane
         Eigen::Vector3d normal = Eigen::Vector3d::Zero();
         layer.clear();
         if (!window.empty()) {
@@ -220,79 +262,73 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
           normal = normal_sum.normalized();
           centroid /= double(layer.size());
           const double denominator = normal.dot(ray);
+          plane_offset = normal.dot(centroid);
           if (std::abs(normal.dot(unit_ray)) > kMinRayCos) {
-            lidar_z = normal.dot(centroid) / denominator;
+            lidar_z = plane_offset / denominator;
             has_plane = lidar_z > 0;
           }
         }
 
-        float depth = 0;
+        // Fold 2's verdict (paper, mapping step (2)): only inside one flat, well-observed LiDAR
+        // layer that surrounds the pixel. With a second surface in the window (a depth edge or a
+        // crease) the layer must surround the pixel on all four sides: a pixel beyond the layer's
+        // border, on the other surface, never has layer samples on the other surface's side.
+        const FillVerdict verdict =
+            has_plane && options.fill_holes
+                ? JudgeFill(layer, window.size(), xy, centre, normal, unit_ray,
+                            layer_curvature, min_view_cos, options)
+                : FillVerdict::kNoLayer;
+
         if (has_stereo) {
-          if (!has_plane || layer_curvature > options.max_check_curvature) {
-            ++local.stereo_without_lidar;
-            depth = stereo_z;
-          } else if (std::abs(stereo_z - lidar_z) <=
-                     options.max_abs_diff_m + options.max_rel_diff * lidar_z) {
-            ++local.stereo_confirmed;
-            depth = stereo_z;
-            result.normals.normals[pixel] = normal.cast<float>();
-          } else if (!options.remove_inconsistent) {
-            depth =
-                stereo_z;  // disagrees, kept on request; normal from the depth map
+          // Fold 1 (paper, mapping step (1)). Disagreement is the stereo point's distance to the
+          // LiDAR plane (what the model's accuracy is measured by), not the depth difference along
+          // the ray, which an obliquely seen plane magnifies by 1 / cos(view angle).
+          const double distance =
+              std::abs(normal.dot(ray * double(stereo_z)) - plane_offset);
+          const bool flat_layer =
+              has_plane && layer_curvature <= options.max_check_curvature;
+          const bool replaceable = verdict == FillVerdict::kFill;
+          const double tolerance =
+              replaceable ? options.max_abs_diff_m + options.max_rel_diff * lidar_z
+                          : options.max_unreplaceable_diff_m;
+          if (!flat_layer || !options.remove_inconsistent) {
+            ++local.stereo_without_lidar;  // kept, not judged
+          } else if (distance <= tolerance) {
+            if (distance <= options.max_abs_diff_m + options.max_rel_diff * lidar_z) {
+              ++local.stereo_confirmed;
+              result.normals.normals[pixel] = normal.cast<float>();
+            } else {
+              ++local.stereo_without_lidar;  // off, but nothing better to put there
+            }
           } else {
-            ++local.stereo_removed;  // fold 1 (paper, mapping step (1))
+            ++local.stereo_removed;
             result.source[pixel] = DepthSource::kRemoved;
+            if (replaceable) {
+              ++local.filled;
+              result.depth(row, col) = float(lidar_z);
+              result.normals.normals[pixel] = normal.cast<float>();
+              result.source[pixel] = DepthSource::kLidar;
+            }
+            continue;
           }
-        }
-        if (depth > 0) {
-          result.depth(row, col) = depth;
+          result.depth(row, col) = stereo_z;
           result.source[pixel] = DepthSource::kStereo;
           continue;
         }
 
-        // Fold 2 (paper, mapping step (2)): only inside one flat, well-observed LiDAR layer that
-        // surrounds the pixel. With a second surface in the window (a depth edge or a crease) the
-        // layer must surround the pixel on all four sides: a pixel beyond the layer's border, on
-        // the other surface, never has layer samples on the other surface's side.
-        if (!options.fill_holes || !has_plane) continue;
-        const bool single_layer = layer.size() == window.size();
-        if (static_cast<int>(layer.size()) < options.min_fill_samples) {
-          ++local.fill_refused_sparse;
-          continue;
+        switch (verdict) {
+          case FillVerdict::kFill:
+            result.depth(row, col) = float(lidar_z);
+            result.normals.normals[pixel] = normal.cast<float>();
+            result.source[pixel] = DepthSource::kLidar;
+            ++local.filled;
+            break;
+          case FillVerdict::kEdge: ++local.fill_refused_edge; break;
+          case FillVerdict::kSparse: ++local.fill_refused_sparse; break;
+          case FillVerdict::kViewAngle: ++local.fill_refused_view_angle; break;
+          case FillVerdict::kCurvature: ++local.fill_refused_curvature; break;
+          case FillVerdict::kNoLayer: break;
         }
-        if (std::abs(normal.dot(unit_ray)) < min_view_cos) {
-          ++local.fill_refused_view_angle;
-          continue;
-        }
-        const bool flat = layer_curvature <= options.max_fill_curvature;
-        int quadrants = 0;
-        for (int s : layer) {
-          const Eigen::Vector2d d = xy[s] - centre;
-          if (d.squaredNorm() < 0.25) {
-            quadrants = 0xF;
-          } else {
-            quadrants |=
-                1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3) : (d.y() >= 0 ? 1 : 2));
-          }
-        }
-        int num_quadrants = 0;
-        for (int q = 0; q < 4; ++q) num_quadrants += (quadrants >> q) & 1;
-        if (!single_layer && num_quadrants < 4) {
-          ++local.fill_refused_edge;
-          continue;
-        }
-        if (num_quadrants < options.min_fill_quadrants) {
-          ++local.fill_refused_sparse;
-          continue;
-        }
-        if (!flat) {
-          ++local.fill_refused_curvature;
-          continue;
-        }
-        result.depth(row, col) = float(lidar_z);
-        result.normals.normals[pixel] = normal.cast<float>();
-        result.source[pixel] = DepthSource::kLidar;
-        ++local.filled;
       }
     }
 #pragma omp critical
