@@ -63,7 +63,14 @@ IndexImage Splat(const LidarSurface& surface,
   return index;
 }
 
-enum class FillVerdict { kFill, kNoLayer, kEdge, kSparse, kViewAngle, kCurvature };
+enum class FillVerdict {
+  kFill,
+  kNoLayer,
+  kEdge,
+  kSparse,
+  kViewAngle,
+  kCurvature
+};
 
 FillVerdict JudgeFill(const std::vector<int>& layer,
                       size_t window_size,
@@ -86,7 +93,8 @@ FillVerdict JudgeFill(const std::vector<int>& layer,
     if (d.squaredNorm() < 0.25) {
       quadrants = 0xF;
     } else {
-      quadrants |= 1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3) : (d.y() >= 0 ? 1 : 2));
+      quadrants |=
+          1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3) : (d.y() >= 0 ? 1 : 2));
     }
   }
   int num_quadrants = 0;
@@ -273,11 +281,17 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
         // layer that surrounds the pixel. With a second surface in the window (a depth edge or a
         // crease) the layer must surround the pixel on all four sides: a pixel beyond the layer's
         // border, on the other surface, never has layer samples on the other surface's side.
-        const FillVerdict verdict =
-            has_plane && options.fill_holes
-                ? JudgeFill(layer, window.size(), xy, centre, normal, unit_ray,
-                            layer_curvature, min_view_cos, options)
-                : FillVerdict::kNoLayer;
+        const FillVerdict verdict = has_plane && options.fill_holes
+                                        ? JudgeFill(layer,
+                                                    window.size(),
+                                                    xy,
+                                                    centre,
+                                                    normal,
+                                                    unit_ray,
+                                                    layer_curvature,
+                                                    min_view_cos,
+                                                    options)
+                                        : FillVerdict::kNoLayer;
 
         if (has_stereo) {
           // Fold 1 (paper, mapping step (1)). Disagreement is the stereo point's distance to the
@@ -289,16 +303,19 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
               has_plane && layer_curvature <= options.max_check_curvature;
           const bool replaceable = verdict == FillVerdict::kFill;
           const double tolerance =
-              replaceable ? options.max_abs_diff_m + options.max_rel_diff * lidar_z
-                          : options.max_unreplaceable_diff_m;
+              replaceable
+                  ? options.max_abs_diff_m + options.max_rel_diff * lidar_z
+                  : options.max_unreplaceable_diff_m;
           if (!flat_layer || !options.remove_inconsistent) {
             ++local.stereo_without_lidar;  // kept, not judged
           } else if (distance <= tolerance) {
-            if (distance <= options.max_abs_diff_m + options.max_rel_diff * lidar_z) {
+            if (distance <=
+                options.max_abs_diff_m + options.max_rel_diff * lidar_z) {
               ++local.stereo_confirmed;
               result.normals.normals[pixel] = normal.cast<float>();
             } else {
-              ++local.stereo_without_lidar;  // off, but nothing better to put there
+              ++local
+                    .stereo_without_lidar;  // off, but nothing better to put there
             }
           } else {
             ++local.stereo_removed;
@@ -323,11 +340,20 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
             result.source[pixel] = DepthSource::kLidar;
             ++local.filled;
             break;
-          case FillVerdict::kEdge: ++local.fill_refused_edge; break;
-          case FillVerdict::kSparse: ++local.fill_refused_sparse; break;
-          case FillVerdict::kViewAngle: ++local.fill_refused_view_angle; break;
-          case FillVerdict::kCurvature: ++local.fill_refused_curvature; break;
-          case FillVerdict::kNoLayer: break;
+          case FillVerdict::kEdge:
+            ++local.fill_refused_edge;
+            break;
+          case FillVerdict::kSparse:
+            ++local.fill_refused_sparse;
+            break;
+          case FillVerdict::kViewAngle:
+            ++local.fill_refused_view_angle;
+            break;
+          case FillVerdict::kCurvature:
+            ++local.fill_refused_curvature;
+            break;
+          case FillVerdict::kNoLayer:
+            break;
         }
       }
     }

@@ -1,5 +1,6 @@
 // LiDAR-guided refinement of one station's stereo depth map (the paper's mapping step):
-//   fold 1  stereo depths that disagree with the local LiDAR surface are removed;
+//   fold 1  stereo depths whose points lie off the local LiDAR surface are removed (and replaced by
+//           the LiDAR depth where fold 2 allows one);
 //   fold 2  holes are filled from the LiDAR surface where it is flat (low curvature), well observed
 //           (small angle between its normal and the viewing ray) and surrounds the pixel (on all four
 //           sides when another surface is near: never across a depth edge), by intersecting the
@@ -72,8 +73,9 @@ struct LidarDepthRefinementStats {
   size_t stereo_without_lidar =
       0;                        // kept unchecked: no flat LiDAR surface near
   size_t stereo_confirmed = 0;  // kept: agrees with the LiDAR
-  size_t stereo_removed = 0;    // fold 1 (replaced by the LiDAR depth when fold 2 allows)
-  size_t filled = 0;            // fold 2 (holes and removed stereo)
+  size_t stereo_removed =
+      0;              // fold 1 (replaced by the LiDAR depth when fold 2 allows)
+  size_t filled = 0;  // fold 2 (holes and removed stereo)
   // Pixels without depth next to a LiDAR layer that fold 2 did not fill, by the first failed test.
   size_t fill_refused_edge =
       0;  // a second surface in the window, the layer not all round
