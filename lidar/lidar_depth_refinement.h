@@ -9,7 +9,7 @@
 // The local LiDAR surface at a pixel: the LiDAR surface samples (lidar_surface.h) are splatted into a
 // z-buffer, each over its footprint (half its spacing, in pixels), so that a sample hidden behind a
 // nearer surface from the camera's viewpoint (LiDAR and camera see from different places) is not used.
-// The samples within `window_radius_px` form the window; the visible sample nearest the pixel defines
+// The visible samples projecting within `window_radius_px` of the pixel form the window; the visible sample nearest the pixel defines
 // the layer: the window samples on its plane (distance and normal agree). The layer's plane (mean normal
 // through the centroid) gives the LiDAR depth z_l along the pixel's ray.
 #pragma once
