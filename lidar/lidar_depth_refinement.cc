@@ -160,14 +160,6 @@ bool LidarDepthRefinementOptions::Check() const {
   return true;
 }
 
-IndexImage SplatLidarSurface(const LidarSurface& surface,
-                             const PinholeIntrinsics& intrinsics,
-                             int max_radius_px) {
-  intrinsics.Check();
-  return Splat(
-      surface, ProjectSamples(surface, intrinsics), intrinsics, max_radius_px);
-}
-
 RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
                                   const LidarSurface& surface,
                                   const PinholeIntrinsics& intrinsics,

@@ -93,12 +93,6 @@ struct RefinedDepth {
   LidarDepthRefinementStats stats;
 };
 
-// The z-buffer of splatted samples: per pixel the index of the nearest covering sample, -1 for none.
-Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>
-SplatLidarSurface(const LidarSurface& surface,
-                  const PinholeIntrinsics& intrinsics,
-                  int max_radius_px);
-
 // `stereo` must have the intrinsics' size (throws std::invalid_argument otherwise).
 RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
                                   const LidarSurface& surface,

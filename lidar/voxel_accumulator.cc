@@ -38,16 +38,6 @@ void VoxelAccumulator::Add(const Eigen::Vector3d& point,
   ++num_added_;
 }
 
-void VoxelAccumulator::Add(const PointCloud& cloud) {
-  cloud.CheckConsistent();
-  for (size_t i = 0; i < cloud.Size(); ++i) {
-    Add(cloud.points[i],
-        cloud.HasNormals() ? Eigen::Vector3f(cloud.normals[i].cast<float>())
-                           : Eigen::Vector3f::Zero(),
-        cloud.HasColors() ? cloud.colors[i] : Color3ub(128, 128, 128));
-  }
-}
-
 PointCloud VoxelAccumulator::Extract(int min_points) const {
   PointCloud cloud;
   cloud.Reserve(voxels_.size(), true, true, false);

@@ -21,8 +21,6 @@ class VoxelAccumulator {
   void Add(const Eigen::Vector3d& point,
            const Eigen::Vector3f& normal,
            const Color3ub& color);
-  // Adds a whole cloud (normals and colours if it has them).
-  void Add(const PointCloud& cloud);
 
   size_t NumVoxels() const { return voxels_.size(); }
   size_t NumPointsAdded() const { return num_added_; }
