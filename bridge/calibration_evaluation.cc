@@ -26,8 +26,7 @@ CalibrationEvaluation EvaluateCalibration(
   result.cam_from_lidar_rotation_error_deg =
       RotationErrorDeg(true_cam_from_lidar, estimated_cam_from_lidar);
   result.cam_from_lidar_translation_error_in_cam_mm =
-      1000 *
-      (estimated_cam_from_lidar.translation - true_cam_from_lidar.translation);
+      1000 * (estimated_cam_from_lidar.translation - true_cam_from_lidar.translation);
   result.cam_from_lidar_translation_error_mm =
       result.cam_from_lidar_translation_error_in_cam_mm.norm();
 
@@ -50,12 +49,10 @@ CalibrationEvaluation EvaluateCalibration(
   result.num_stations_evaluated = names.size();
   THROW_CHECK_GE(names.size(), 3) << "Fewer than 3 stations of the ground "
                                      "truth are registered in the model";
-  Eigen::Matrix3Xd estimated_centers(3, names.size()),
-      true_centers(3, names.size());
+  Eigen::Matrix3Xd estimated_centers(3, names.size()), true_centers(3, names.size());
   for (size_t i = 0; i < names.size(); ++i) {
     estimated_centers.col(i) = images[i]->ProjectionCenter();
-    true_centers.col(i) =
-        colmap::Inverse(true_cam_from_world.at(names[i])).translation;
+    true_centers.col(i) = colmap::Inverse(true_cam_from_world.at(names[i])).translation;
   }
   // true_world_from_model_world, by Umeyama on the camera centres.
   const Eigen::Matrix4d alignment =
@@ -65,32 +62,24 @@ CalibrationEvaluation EvaluateCalibration(
   result.alignment_scale = std::cbrt(scaled_rotation.determinant());
   const Eigen::Matrix3d rotation = scaled_rotation / result.alignment_scale;
   const Eigen::Vector3d translation = alignment.topRightCorner<3, 1>();
-  result.truth_from_model =
-      colmap::Rigid3d(Eigen::Quaterniond(rotation), translation);
+  result.truth_from_model = colmap::Rigid3d(Eigen::Quaterniond(rotation), translation);
 
   double sum_rotation = 0, sum_position = 0;
   for (size_t i = 0; i < names.size(); ++i) {
     const Eigen::Vector3d center =
-        result.alignment_scale * rotation * estimated_centers.col(i) +
-        translation;
-    const double position_error_mm =
-        1000 * (center - true_centers.col(i)).norm();
+        result.alignment_scale * rotation * estimated_centers.col(i) + translation;
+    const double position_error_mm = 1000 * (center - true_centers.col(i)).norm();
     // cam_from_true_world = cam_from_model_world * model_world_from_true_world (rotation part).
     const Eigen::Quaterniond cam_from_true_world =
-        images[i]->CamFromWorld().rotation *
-        Eigen::Quaterniond(rotation.transpose());
+        images[i]->CamFromWorld().rotation * Eigen::Quaterniond(rotation.transpose());
     const double rotation_error_deg =
-        cam_from_true_world.angularDistance(
-            true_cam_from_world.at(names[i]).rotation) *
-        180 / M_PI;
+        cam_from_true_world.angularDistance(true_cam_from_world.at(names[i]).rotation) * 180 / M_PI;
     result.rotation_error_deg[names[i]] = rotation_error_deg;
     result.position_error_mm[names[i]] = position_error_mm;
     sum_rotation += rotation_error_deg;
     sum_position += position_error_mm;
-    result.max_rotation_error_deg =
-        std::max(result.max_rotation_error_deg, rotation_error_deg);
-    result.max_position_error_mm =
-        std::max(result.max_position_error_mm, position_error_mm);
+    result.max_rotation_error_deg = std::max(result.max_rotation_error_deg, rotation_error_deg);
+    result.max_position_error_mm = std::max(result.max_position_error_mm, position_error_mm);
   }
   result.mean_rotation_error_deg = sum_rotation / names.size();
   result.mean_position_error_mm = sum_position / names.size();

@@ -17,16 +17,14 @@ namespace colmap_lidar {
 struct CalibrationEvaluation {
   double cam_from_lidar_rotation_error_deg = 0;
   double cam_from_lidar_translation_error_mm = 0;
-  Eigen::Vector3d cam_from_lidar_translation_error_in_cam_mm =
-      Eigen::Vector3d::Zero();
+  Eigen::Vector3d cam_from_lidar_translation_error_in_cam_mm = Eigen::Vector3d::Zero();
   std::string alignment;  // "rigid" or "similarity"
   double alignment_scale = 1;
   // The alignment's rotation and translation: true_world_from_model_world without the scale (the
   // transform evaluate_model applies to a dense model of this sparse model).
   colmap::Rigid3d truth_from_model;
   size_t num_stations_evaluated = 0;
-  std::vector<std::string>
-      missing_stations;  // in the truth, not registered in the model
+  std::vector<std::string> missing_stations;         // in the truth, not registered in the model
   std::map<std::string, double> rotation_error_deg;  // per station
   std::map<std::string, double> position_error_mm;   // per station
   double mean_rotation_error_deg = 0, max_rotation_error_deg = 0;

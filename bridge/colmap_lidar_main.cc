@@ -34,9 +34,7 @@ int RunVersion(int argc, char** argv);
 const std::vector<Command>& Commands() {
   static const std::vector<Command> kCommands = {
       {"help", &RunHelp, "List the commands"},
-      {"version",
-       &RunVersion,
-       "Print colmap-lidar's version and the COLMAP it links"},
+      {"version", &RunVersion, "Print colmap-lidar's version and the COLMAP it links"},
       {"database_creator",
        &RunDatabaseCreator,
        "Create a COLMAP database (or extend one) with colmap-lidar's tables"},
@@ -51,9 +49,7 @@ const std::vector<Command>& Commands() {
        &RunImportDataset,
        "Import a station dataset into a COLMAP database (camera, SIFT, "
        "matches, rig, LiDAR frames)"},
-      {"stereo_depth",
-       &RunStereoDepth,
-       "SGM stereo depth maps per station in the left image grid"},
+      {"stereo_depth", &RunStereoDepth, "SGM stereo depth maps per station in the left image grid"},
       {"depth_prior_extractor",
        &RunDepthPriorExtractor,
        "Depth priors (d, sigma_d) of the database's keypoints from stereo "
@@ -73,9 +69,7 @@ const std::vector<Command>& Commands() {
        &RunDensifier,
        "Dense model: stereo depth refined by LiDAR, fused.ply, lidar_map.ply, "
        "COLMAP dense workspace"},
-      {"pipeline",
-       &RunPipeline,
-       "Run every step on a dataset into a workspace (restartable)"},
+      {"pipeline", &RunPipeline, "Run every step on a dataset into a workspace (restartable)"},
       {"evaluate_model",
        &RunEvaluateModel,
        "Accuracy, completeness and density of a cloud against the true "
@@ -89,20 +83,17 @@ const std::vector<Command>& Commands() {
 
 std::string VersionString() {
   return "colmap-lidar " COLMAP_LIDAR_VERSION " (" + colmap::GetVersionInfo() +
-         ", Ceres " CERES_VERSION_STRING ", PCL " PCL_VERSION_PRETTY
-         ", OpenCV " CV_VERSION ")";
+         ", Ceres " CERES_VERSION_STRING ", PCL " PCL_VERSION_PRETTY ", OpenCV " CV_VERSION ")";
 }
 
 int RunHelp(int, char**) {
-  std::cout
-      << VersionString() << "\n\n"
-      << "Usage: colmap-lidar COMMAND [--option value ...]\n"
-      << "       colmap-lidar COMMAND --help   (options of a command)\n"
-      << "Options may also come from an .ini file: --project_path FILE\n\n"
-      << "Commands:\n";
+  std::cout << VersionString() << "\n\n"
+            << "Usage: colmap-lidar COMMAND [--option value ...]\n"
+            << "       colmap-lidar COMMAND --help   (options of a command)\n"
+            << "Options may also come from an .ini file: --project_path FILE\n\n"
+            << "Commands:\n";
   for (const Command& command : Commands()) {
-    std::cout << "  " << std::left << std::setw(24) << command.name
-              << command.help << "\n";
+    std::cout << "  " << std::left << std::setw(24) << command.name << command.help << "\n";
   }
   return EXIT_SUCCESS;
 }
@@ -134,7 +125,7 @@ int main(int argc, char** argv) {
       }
     }
   }
-  std::cerr << "ERROR: unknown command '" << name
-            << "'. Run `colmap-lidar help` for the list." << std::endl;
+  std::cerr << "ERROR: unknown command '" << name << "'. Run `colmap-lidar help` for the list."
+            << std::endl;
   return EXIT_FAILURE;
 }

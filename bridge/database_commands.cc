@@ -15,8 +15,7 @@ int RunDatabaseCreator(int argc, char** argv) {
   options.AddDatabaseOptions();
   options.Parse(argc, argv);
   {
-    colmap::Database database(
-        *options.database_path);  // creates COLMAP's tables if absent
+    colmap::Database database(*options.database_path);  // creates COLMAP's tables if absent
   }
   ExtensionDatabase extension(*options.database_path);
   std::cout << "Database " << *options.database_path
@@ -31,8 +30,7 @@ int RunDatabaseInfo(int argc, char** argv) {
   options.AddDatabaseOptions();
   options.Parse(argc, argv);
   const std::string& path = *options.database_path;
-  THROW_CHECK(std::filesystem::is_regular_file(path))
-      << "Database file does not exist: " << path;
+  THROW_CHECK(std::filesystem::is_regular_file(path)) << "Database file does not exist: " << path;
   // Our read-only connection first: it rejects a non-COLMAP file without creating anything.
   const ExtensionDatabase extension(path, ExtensionDatabase::Mode::kReadOnly);
   const colmap::Database database(path);
@@ -44,10 +42,9 @@ int RunDatabaseInfo(int argc, char** argv) {
             << "lidar frames:  " << extension.ReadLidarFrames().size() << "\n";
   const std::optional<StereoRig> rig = extension.ReadRig();
   if (rig) {
-    std::cout << "rig:           baseline " << rig->BaselineMeters()
-              << " m, right camera " << rig->right_camera.ModelName() << " "
-              << rig->right_camera.width << "x" << rig->right_camera.height
-              << "\n";
+    std::cout << "rig:           baseline " << rig->BaselineMeters() << " m, right camera "
+              << rig->right_camera.ModelName() << " " << rig->right_camera.width << "x"
+              << rig->right_camera.height << "\n";
   } else {
     std::cout << "rig:           none\n";
   }

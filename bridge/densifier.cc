@@ -42,9 +42,8 @@ PinholeIntrinsics IntrinsicsOf(const colmap::Camera& camera) {
 }
 
 // The registered images that are stations of the dataset, in station order.
-std::vector<StationView> StationViews(
-    const colmap::Reconstruction& reconstruction,
-    const StationDataset& dataset) {
+std::vector<StationView> StationViews(const colmap::Reconstruction& reconstruction,
+                                      const StationDataset& dataset) {
   std::map<std::string, colmap::image_t> by_name;
   for (const colmap::image_t image_id : reconstruction.RegImageIds()) {
     by_name[reconstruction.Image(image_id).Name()] = image_id;
@@ -71,24 +70,20 @@ std::vector<StationView> StationViews(
 // The views that see most of this view's depth map: a coarse grid of its points is projected into
 // every other view; the views where most land inside the image, in front of the camera, are kept (at
 // most `max_views`, each seeing at least 5 % of the grid).
-std::vector<size_t> OverlappingViews(
-    const colmap::Reconstruction& reconstruction,
-    const std::vector<StationView>& views,
-    size_t view_index,
-    const cv::Mat& depth,
-    int max_views) {
+std::vector<size_t> OverlappingViews(const colmap::Reconstruction& reconstruction,
+                                     const std::vector<StationView>& views,
+                                     size_t view_index,
+                                     const cv::Mat& depth,
+                                     int max_views) {
   const colmap::Image& image = reconstruction.Image(views[view_index].image_id);
-  const PinholeIntrinsics intrinsics =
-      IntrinsicsOf(reconstruction.Camera(image.CameraId()));
+  const PinholeIntrinsics intrinsics = IntrinsicsOf(reconstruction.Camera(image.CameraId()));
   const colmap::Rigid3d world_from_cam = colmap::Inverse(image.CamFromWorld());
   std::vector<Eigen::Vector3d> grid;
   const int step = std::max(1, std::min(depth.cols, depth.rows) / 32);
   for (int row = step / 2; row < depth.rows; row += step) {
     for (int col = step / 2; col < depth.cols; col += step) {
       const float z = depth.at<float>(row, col);
-      if (z > 0)
-        grid.push_back(world_from_cam *
-                       (intrinsics.PixelRay(col, row) * double(z)));
+      if (z > 0) grid.push_back(world_from_cam * (intrinsics.PixelRay(col, row) * double(z)));
     }
   }
   std::vector<std::pair<size_t, size_t>> ranked;  // (-count, view)
@@ -126,9 +121,7 @@ cv::Mat NormalsToMat(const NormalImage& normals) {
   return mat;
 }
 
-cv::Mat SourcePreview(const std::vector<DepthSource>& source,
-                      int width,
-                      int height) {
+cv::Mat SourcePreview(const std::vector<DepthSource>& source, int width, int height) {
   cv::Mat preview(height, width, CV_8UC3, cv::Scalar(0, 0, 0));
   for (int row = 0; row < height; ++row) {
     for (int col = 0; col < width; ++col) {
@@ -152,8 +145,7 @@ cv::Mat SourcePreview(const std::vector<DepthSource>& source,
 }
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 // Fold 1 and 2 for one station; writes its maps, image and preview into the workspace and adds its
@@ -179,35 +171,29 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   cv::Mat stereo = ReadColmapDepthMap(stereo_path);
   if (stereo.cols != static_cast<int>(original_camera.width) ||
       stereo.rows != static_cast<int>(original_camera.height)) {
-    throw std::runtime_error(
-        "station " + station + ": the depth map " + stereo_path + " is " +
-        std::to_string(stereo.cols) + "x" + std::to_string(stereo.rows) +
-        " but the camera is " + std::to_string(original_camera.width) + "x" +
-        std::to_string(original_camera.height));
+    throw std::runtime_error("station " + station + ": the depth map " + stereo_path + " is " +
+                             std::to_string(stereo.cols) + "x" + std::to_string(stereo.rows) +
+                             " but the camera is " + std::to_string(original_camera.width) + "x" +
+                             std::to_string(original_camera.height));
   }
   if (undistorter) stereo = undistorter->UndistortDepthMap(stereo);
-  const Eigen::Map<const DepthImage> stereo_depth(
-      stereo.ptr<float>(), stereo.rows, stereo.cols);
+  const Eigen::Map<const DepthImage> stereo_depth(stereo.ptr<float>(), stereo.rows, stereo.cols);
 
   // The station's cloud: into the LiDAR map (world frame), and cropped to the camera's view.
   const PointCloud cloud = ReadPointCloud(dataset.cloud_paths[view.station]);
-  const colmap::Rigid3d world_from_lidar =
-      colmap::Inverse(image.CamFromWorld()) * cam_from_lidar;
+  const colmap::Rigid3d world_from_lidar = colmap::Inverse(image.CamFromWorld()) * cam_from_lidar;
   std::vector<Eigen::Vector3d> in_view;
   for (const Eigen::Vector3d& point_in_lidar : cloud.points) {
-    lidar_map->Add(world_from_lidar * point_in_lidar,
-                   Eigen::Vector3f::Zero(),
-                   Color3ub(128, 128, 128));
+    lidar_map->Add(
+        world_from_lidar * point_in_lidar, Eigen::Vector3f::Zero(), Color3ub(128, 128, 128));
     const Eigen::Vector3d point_in_cam = cam_from_lidar * point_in_lidar;
     Eigen::Vector2d xy;
-    if (point_in_cam.z() < options.min_depth_m ||
-        point_in_cam.z() > options.max_depth_m ||
+    if (point_in_cam.z() < options.min_depth_m || point_in_cam.z() > options.max_depth_m ||
         !intrinsics.Project(point_in_cam, &xy)) {
       continue;
     }
     const double margin = 0.05 * intrinsics.width;
-    if (xy.x() < -margin || xy.y() < -margin ||
-        xy.x() > intrinsics.width + margin ||
+    if (xy.x() < -margin || xy.y() < -margin || xy.x() > intrinsics.width + margin ||
         xy.y() > intrinsics.height + margin) {
       continue;
     }
@@ -218,8 +204,7 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   RefinedDepth refined;
   if (options.refine_with_lidar) {
     const LidarSurface surface = BuildLidarSurface(in_view, options.surface);
-    refined = RefineDepthWithLidar(
-        stereo_depth, surface, intrinsics, options.refinement);
+    refined = RefineDepthWithLidar(stereo_depth, surface, intrinsics, options.refinement);
   } else {
     refined.depth = stereo_depth;
     refined.normals = NormalsFromDepth(refined.depth, intrinsics);
@@ -234,28 +219,23 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   }
   result.refinement = refined.stats;
 
-  const cv::Mat depth_mat(
-      intrinsics.height, intrinsics.width, CV_32F, refined.depth.data());
+  const cv::Mat depth_mat(intrinsics.height, intrinsics.width, CV_32F, refined.depth.data());
   workspace.WriteDepthMap(view.image_name, depth_mat);
   workspace.WriteNormalMap(view.image_name, NormalsToMat(refined.normals));
   if (undistorter) {
     const std::string image_path = dataset.LeftImagePath(view.station);
     const cv::Mat distorted = cv::imread(image_path, cv::IMREAD_COLOR);
     if (distorted.empty()) {
-      throw std::runtime_error("station " + station + ": cannot read " +
-                               image_path);
+      throw std::runtime_error("station " + station + ": cannot read " + image_path);
     }
-    workspace.WriteImage(view.image_name,
-                         undistorter->UndistortImage(distorted));
+    workspace.WriteImage(view.image_name, undistorter->UndistortImage(distorted));
   } else {
     workspace.CopyImage(view.image_name, dataset.LeftImagePath(view.station));
   }
-  const fs::path preview_dir =
-      fs::path(workspace.Root()) / "stereo" / "previews";
+  const fs::path preview_dir = fs::path(workspace.Root()) / "stereo" / "previews";
   fs::create_directories(preview_dir);
-  cv::imwrite(
-      (preview_dir / (station + ".png")).string(),
-      SourcePreview(refined.source, intrinsics.width, intrinsics.height));
+  cv::imwrite((preview_dir / (station + ".png")).string(),
+              SourcePreview(refined.source, intrinsics.width, intrinsics.height));
   return result;
 }
 
@@ -269,15 +249,13 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
                  VoxelAccumulator* fused) {
   const StationView& view = views[view_index];
   const colmap::Image& image = reconstruction.Image(view.image_id);
-  const PinholeIntrinsics intrinsics =
-      IntrinsicsOf(reconstruction.Camera(image.CameraId()));
+  const PinholeIntrinsics intrinsics = IntrinsicsOf(reconstruction.Camera(image.CameraId()));
   const cv::Mat depth = workspace.ReadDepthMap(view.image_name);
   const cv::Mat normals = workspace.ReadNormalMap(view.image_name);
   const std::string image_path = workspace.ImagePath(view.image_name);
   const cv::Mat bgr = cv::imread(image_path, cv::IMREAD_COLOR);
   if (bgr.empty() || bgr.cols != depth.cols || bgr.rows != depth.rows) {
-    throw std::runtime_error("densifier: cannot read " + image_path +
-                             " at the depth map's size");
+    throw std::runtime_error("densifier: cannot read " + image_path + " at the depth map's size");
   }
   struct Other {
     cv::Mat depth;
@@ -286,11 +264,8 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
   };
   std::vector<Other> others;
   if (options.min_consistent_views > 0) {
-    for (size_t k : OverlappingViews(reconstruction,
-                                     views,
-                                     view_index,
-                                     depth,
-                                     options.max_neighbor_views)) {
+    for (size_t k :
+         OverlappingViews(reconstruction, views, view_index, depth, options.max_neighbor_views)) {
       const colmap::Image& other = reconstruction.Image(views[k].image_id);
       others.push_back({workspace.ReadDepthMap(views[k].image_name),
                         IntrinsicsOf(reconstruction.Camera(other.CameraId())),
@@ -298,8 +273,7 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
     }
   }
   const colmap::Rigid3d world_from_cam = colmap::Inverse(image.CamFromWorld());
-  const Eigen::Matrix3d world_from_cam_rotation =
-      world_from_cam.rotation.toRotationMatrix();
+  const Eigen::Matrix3d world_from_cam_rotation = world_from_cam.rotation.toRotationMatrix();
 
   struct Sample {
     Eigen::Vector3d point;
@@ -318,19 +292,16 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
       if (options.min_consistent_views > 0) {
         int agreeing = 0;
         for (const Other& other : others) {
-          const Eigen::Vector3d point_in_other =
-              other.cam_from_world * point_in_world;
+          const Eigen::Vector3d point_in_other = other.cam_from_world * point_in_world;
           Eigen::Vector2d xy;
-          if (!other.intrinsics.Project(point_in_other, &xy) ||
-              !other.intrinsics.Contains(xy)) {
+          if (!other.intrinsics.Project(point_in_other, &xy) || !other.intrinsics.Contains(xy)) {
             continue;
           }
-          const float other_z = other.depth.at<float>(static_cast<int>(xy.y()),
-                                                      static_cast<int>(xy.x()));
+          const float other_z =
+              other.depth.at<float>(static_cast<int>(xy.y()), static_cast<int>(xy.x()));
           agreeing += other_z > 0 &&
                       std::abs(other_z - point_in_other.z()) <=
-                          options.consistency_abs_m +
-                              options.consistency_rel * point_in_other.z();
+                          options.consistency_abs_m + options.consistency_rel * point_in_other.z();
         }
         if (agreeing < options.min_consistent_views) {
           ++inconsistent;
@@ -341,10 +312,9 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
       Eigen::Vector3d normal_in_cam(n[0], n[1], n[2]);
       if (normal_in_cam.isZero()) normal_in_cam = -ray.normalized();
       const cv::Vec3b& color = bgr.at<cv::Vec3b>(row, col);
-      rows[row].push_back(
-          {point_in_world,
-           (world_from_cam_rotation * normal_in_cam).cast<float>(),
-           Color3ub(color[2], color[1], color[0])});
+      rows[row].push_back({point_in_world,
+                           (world_from_cam_rotation * normal_in_cam).cast<float>(),
+                           Color3ub(color[2], color[1], color[0])});
     }
   }
   for (const auto& samples : rows) {
@@ -428,17 +398,15 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
       const colmap::Camera& pinhole = reconstruction.Camera(image.CameraId());
       colmap::Image& moved = reconstruction.Image(image_id);
       for (colmap::point2D_t k = 0; k < moved.NumPoints2D(); ++k) {
-        moved.Point2D(k).xy =
-            pinhole.ImgFromCam(original.CamFromImg(image.Point2D(k).xy));
+        moved.Point2D(k).xy = pinhole.ImgFromCam(original.CamFromImg(image.Point2D(k).xy));
       }
     }
     for (const auto& [camera_id, camera] : input_model.Cameras()) {
       if (IsPinholeCamera(camera)) continue;
-      undistorters[camera_id] = std::make_unique<CameraUndistorter>(
-          camera, reconstruction.Camera(camera_id));
-      std::cout << "densifier: camera " << camera_id << " ("
-                << camera.ModelName() << ") is undistorted to PINHOLE "
-                << reconstruction.Camera(camera_id).width << "x"
+      undistorters[camera_id] =
+          std::make_unique<CameraUndistorter>(camera, reconstruction.Camera(camera_id));
+      std::cout << "densifier: camera " << camera_id << " (" << camera.ModelName()
+                << ") is undistorted to PINHOLE " << reconstruction.Camera(camera_id).width << "x"
                 << reconstruction.Camera(camera_id).height << std::endl;
     }
   }
@@ -449,55 +417,43 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
     const DenseWorkspace workspace(partial.string());
     VoxelAccumulator lidar_map(options.lidar_map_voxel_size_m);
     std::cout << "densifier: " << views.size() << " stations, "
-              << (options.refine_with_lidar ? "LiDAR-refined" : "stereo only")
-              << std::endl;
+              << (options.refine_with_lidar ? "LiDAR-refined" : "stereo only") << std::endl;
     for (size_t k = 0; k < views.size(); ++k) {
       const auto station_start = std::chrono::steady_clock::now();
-      const colmap::camera_t camera_id =
-          input_model.Image(views[k].image_id).CameraId();
+      const colmap::camera_t camera_id = input_model.Image(views[k].image_id).CameraId();
       const auto undistorter = undistorters.find(camera_id);
-      StationDensification station = RefineStation(
-          reconstruction,
-          views[k],
-          cam_from_lidar,
-          dataset,
-          depth_path,
-          workspace,
-          options,
-          input_model.Camera(camera_id),
-          undistorter == undistorters.end() ? nullptr
-                                            : undistorter->second.get(),
-          &lidar_map);
+      StationDensification station =
+          RefineStation(reconstruction,
+                        views[k],
+                        cam_from_lidar,
+                        dataset,
+                        depth_path,
+                        workspace,
+                        options,
+                        input_model.Camera(camera_id),
+                        undistorter == undistorters.end() ? nullptr : undistorter->second.get(),
+                        &lidar_map);
       station.seconds = SecondsSince(station_start);
       const LidarDepthRefinementStats& s = station.refinement;
-      std::cout << "densifier: [" << k + 1 << "/" << views.size()
-                << "] station " << station.station << ": " << s.stereo_pixels
-                << " stereo pixels (" << s.stereo_confirmed
-                << " confirmed by LiDAR, " << s.stereo_removed << " removed), "
-                << s.filled << " filled from " << station.lidar_points_in_view
-                << " LiDAR points in view (" << std::fixed
-                << std::setprecision(1) << station.seconds << " s)"
-                << std::endl;
+      std::cout << "densifier: [" << k + 1 << "/" << views.size() << "] station " << station.station
+                << ": " << s.stereo_pixels << " stereo pixels (" << s.stereo_confirmed
+                << " confirmed by LiDAR, " << s.stereo_removed << " removed), " << s.filled
+                << " filled from " << station.lidar_points_in_view << " LiDAR points in view ("
+                << std::fixed << std::setprecision(1) << station.seconds << " s)" << std::endl;
       summary.stations.push_back(station);
     }
 
     VoxelAccumulator fused(options.fused_voxel_size_m);
     for (size_t k = 0; k < views.size(); ++k) {
       const auto station_start = std::chrono::steady_clock::now();
-      FuseStation(reconstruction,
-                  views,
-                  k,
-                  workspace,
-                  options,
-                  &summary.stations[k],
-                  &fused);
+      FuseStation(reconstruction, views, k, workspace, options, &summary.stations[k], &fused);
       summary.stations[k].seconds += SecondsSince(station_start);
     }
     const PointCloud fused_cloud = fused.Extract();
     summary.fused_points = fused_cloud.Size();
-    std::cout << "densifier: fused " << fused.NumPointsAdded()
-              << " points into " << fused_cloud.Size() << " voxels of "
-              << options.fused_voxel_size_m * 1000 << " mm" << std::endl;
+    std::cout << "densifier: fused " << fused.NumPointsAdded() << " points into "
+              << fused_cloud.Size() << " voxels of " << options.fused_voxel_size_m * 1000 << " mm"
+              << std::endl;
     WritePointCloud((partial / "fused.ply").string(), fused_cloud);
     PointCloud lidar_cloud = lidar_map.Extract();
     lidar_cloud.normals.clear();
@@ -518,19 +474,17 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
     report["lidar_map_points"] = summary.lidar_map_points;
     report["seconds"] = summary.seconds;
     const LidarDepthRefinementOptions& r = options.refinement;
-    report["refinement"] = {
-        {"window_radius_px", r.window_radius_px},
-        {"max_abs_diff_m", r.max_abs_diff_m},
-        {"max_rel_diff", r.max_rel_diff},
-        {"plane_tolerance_m", r.plane_tolerance_m},
-        {"max_normal_angle_deg", r.max_normal_angle_deg},
-        {"max_fill_curvature", r.max_fill_curvature},
-        {"max_fill_view_angle_deg", r.max_fill_view_angle_deg}};
+    report["refinement"] = {{"window_radius_px", r.window_radius_px},
+                            {"max_abs_diff_m", r.max_abs_diff_m},
+                            {"max_rel_diff", r.max_rel_diff},
+                            {"plane_tolerance_m", r.plane_tolerance_m},
+                            {"max_normal_angle_deg", r.max_normal_angle_deg},
+                            {"max_fill_curvature", r.max_fill_curvature},
+                            {"max_fill_view_angle_deg", r.max_fill_view_angle_deg}};
     for (const StationDensification& station : summary.stations) {
       report["stations"].push_back(StationReport(station));
     }
-    WriteFileAtomically((partial / "densifier.json").string(),
-                        report.dump(2) + "\n");
+    WriteFileAtomically((partial / "densifier.json").string(), report.dump(2) + "\n");
   } catch (...) {
     fs::remove_all(partial);
     throw;

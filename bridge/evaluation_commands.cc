@@ -47,47 +47,38 @@ std::vector<double> ParseThresholds(const std::string& csv) {
 }  // namespace
 
 int RunEvaluateModel(int argc, char** argv) {
-  std::string model_path, ground_truth_path, output_path,
-      thresholds = "0.002,0.005,0.01";
+  std::string model_path, ground_truth_path, output_path, thresholds = "0.002,0.005,0.01";
   ModelEvaluationOptions options;
   colmap::OptionManager manager;
-  manager.AddRequiredOption(
-      "model_path", &model_path, "reconstructed cloud (.ply/.pcd)");
-  manager.AddRequiredOption(
-      "ground_truth_path", &ground_truth_path, "surface.ply with normals");
-  manager.AddRequiredOption(
-      "output_path", &output_path, "directory for metrics.json and plots");
+  manager.AddRequiredOption("model_path", &model_path, "reconstructed cloud (.ply/.pcd)");
+  manager.AddRequiredOption("ground_truth_path", &ground_truth_path, "surface.ply with normals");
+  manager.AddRequiredOption("output_path", &output_path, "directory for metrics.json and plots");
   std::string truth_from_model_path;
   manager.AddDefaultOption("truth_from_model",
                            &truth_from_model_path,
                            "pose file moving the model into the truth's "
                            "frame first (evaluate_calibration writes one)");
-  manager.AddDefaultOption(
-      "align_icp", &options.align_icp, "rigid point-to-plane ICP first");
+  manager.AddDefaultOption("align_icp", &options.align_icp, "rigid point-to-plane ICP first");
   manager.AddDefaultOption("crop_distance_m", &options.crop_distance_m);
-  manager.AddDefaultOption(
-      "thresholds_m", &thresholds, "comma-separated, metres");
+  manager.AddDefaultOption("thresholds_m", &thresholds, "comma-separated, metres");
   manager.Parse(argc, argv);
   options.thresholds_m = ParseThresholds(thresholds);
   THROW_CHECK(!options.thresholds_m.empty())
-      << "--thresholds_m must be comma-separated numbers in metres, not '"
-      << thresholds << "'";
+      << "--thresholds_m must be comma-separated numbers in metres, not '" << thresholds << "'";
 
   // Inputs first: a missing or bad cloud must not leave an output folder behind.
   PointCloud model = ReadPointCloud(model_path);
   if (!truth_from_model_path.empty()) {
-    const colmap::Rigid3d truth_from_model =
-        ReadPoseFile(truth_from_model_path);
-    for (Eigen::Vector3d& point : model.points)
-      point = truth_from_model * point;
+    const colmap::Rigid3d truth_from_model = ReadPoseFile(truth_from_model_path);
+    for (Eigen::Vector3d& point : model.points) point = truth_from_model * point;
     for (Eigen::Vector3d& normal : model.normals) {
       normal = truth_from_model.rotation * normal;
     }
   }
   const PointCloud truth = ReadPointCloud(ground_truth_path);
   THROW_CHECK(truth.HasNormals()) << ground_truth_path << " has no normals";
-  std::cout << "evaluate_model: " << model.Size() << " model points against "
-            << truth.Size() << " surface samples" << std::endl;
+  std::cout << "evaluate_model: " << model.Size() << " model points against " << truth.Size()
+            << " surface samples" << std::endl;
   const ModelEvaluation result = EvaluateModel(model, truth, options);
 
   fs::create_directories(output_path);
@@ -114,91 +105,73 @@ int RunEvaluateModel(int argc, char** argv) {
     metrics["f_score_" + label] = at.f_score;
   }
   metrics["density_points_per_cm2"] = result.density_points_per_cm2;
-  WriteFileAtomically((fs::path(output_path) / "metrics.json").string(),
-                      metrics.dump(2) + "\n");
+  WriteFileAtomically((fs::path(output_path) / "metrics.json").string(), metrics.dump(2) + "\n");
 
   HistogramPlotOptions plot;
   plot.title = "Distance to the true surface";
   plot.x_label = "distance [mm]";
   plot.value_scale = 1000;
-  WriteHistogramPng((fs::path(output_path) / "error_histogram.png").string(),
-                    result.distances,
-                    plot);
+  WriteHistogramPng(
+      (fs::path(output_path) / "error_histogram.png").string(), result.distances, plot);
 
   // The evaluated points, aligned, coloured by error (blue 0 -> red at the 95th percentile).
   PointCloud coloured;
   coloured.Reserve(result.num_evaluated, false, true, false);
   for (size_t k = 0; k < result.num_evaluated; ++k) {
-    coloured.points.push_back(result.truth_from_model *
-                              model.points[result.evaluated_indices[k]]);
+    coloured.points.push_back(result.truth_from_model * model.points[result.evaluated_indices[k]]);
     coloured.colors.push_back(ErrorColor(result.distances[k], result.p95));
   }
-  WritePointCloud((fs::path(output_path) / "error_colored.ply").string(),
-                  coloured);
+  WritePointCloud((fs::path(output_path) / "error_colored.ply").string(), coloured);
 
-  std::cout << std::fixed << std::setprecision(2) << "evaluate_model: mean "
-            << result.mean * 1000 << " mm, median " << result.median * 1000
-            << " mm, RMSE " << result.rmse * 1000 << " mm, p95 "
-            << result.p95 * 1000 << " mm over " << result.num_evaluated
-            << " points; density " << result.density_points_per_cm2
-            << " points/cm^2" << std::endl;
+  std::cout << std::fixed << std::setprecision(2) << "evaluate_model: mean " << result.mean * 1000
+            << " mm, median " << result.median * 1000 << " mm, RMSE " << result.rmse * 1000
+            << " mm, p95 " << result.p95 * 1000 << " mm over " << result.num_evaluated
+            << " points; density " << result.density_points_per_cm2 << " points/cm^2" << std::endl;
   for (const auto& at : result.at_thresholds) {
-    std::cout << "  at " << MillimetreLabel(at.threshold) << ": completeness "
-              << at.completeness << ", precision " << at.precision << ", F "
-              << at.f_score << std::endl;
+    std::cout << "  at " << MillimetreLabel(at.threshold) << ": completeness " << at.completeness
+              << ", precision " << at.precision << ", F " << at.f_score << std::endl;
   }
   std::cout << "evaluate_model: wrote " << output_path
-            << "/{metrics.json, error_histogram.png, error_colored.ply}"
-            << std::endl;
+            << "/{metrics.json, error_histogram.png, error_colored.ply}" << std::endl;
   return EXIT_SUCCESS;
 }
 
 int RunEvaluateCalibration(int argc, char** argv) {
-  std::string dataset_path, input_path, cam_from_lidar_path, output_path,
-      alignment = "rigid";
+  std::string dataset_path, input_path, cam_from_lidar_path, output_path, alignment = "rigid";
   colmap::OptionManager manager;
-  manager.AddRequiredOption(
-      "dataset_path", &dataset_path, "dataset with ground_truth/");
+  manager.AddRequiredOption("dataset_path", &dataset_path, "dataset with ground_truth/");
   manager.AddRequiredOption("input_path", &input_path, "sparse COLMAP model");
-  manager.AddDefaultOption(
-      "cam_from_lidar",
-      &cam_from_lidar_path,
-      "estimate (qw qx qy qz tx ty tz); default INPUT/cam_from_lidar.txt");
-  manager.AddDefaultOption(
-      "output_path", &output_path, "directory for metrics.json (optional)");
+  manager.AddDefaultOption("cam_from_lidar",
+                           &cam_from_lidar_path,
+                           "estimate (qw qx qy qz tx ty tz); default INPUT/cam_from_lidar.txt");
+  manager.AddDefaultOption("output_path", &output_path, "directory for metrics.json (optional)");
   manager.AddDefaultOption("alignment", &alignment, "rigid | similarity");
   manager.Parse(argc, argv);
   THROW_CHECK(alignment == "rigid" || alignment == "similarity")
       << "--alignment must be rigid or similarity, not " << alignment;
   if (cam_from_lidar_path.empty()) {
-    cam_from_lidar_path =
-        (fs::path(input_path) / "cam_from_lidar.txt").string();
+    cam_from_lidar_path = (fs::path(input_path) / "cam_from_lidar.txt").string();
   }
   const fs::path truth_dir = fs::path(dataset_path) / "ground_truth";
-  const auto true_cam_from_world =
-      ReadNamedPoses((truth_dir / "cam_from_world.txt").string());
+  const auto true_cam_from_world = ReadNamedPoses((truth_dir / "cam_from_world.txt").string());
   const colmap::Rigid3d true_cam_from_lidar =
       ReadPoseFile((truth_dir / "cam_from_lidar.txt").string());
   const colmap::Rigid3d cam_from_lidar = ReadPoseFile(cam_from_lidar_path);
-  THROW_CHECK(fs::is_directory(input_path))
-      << "No sparse model at " << input_path;
+  THROW_CHECK(fs::is_directory(input_path)) << "No sparse model at " << input_path;
   colmap::Reconstruction reconstruction;
   reconstruction.Read(input_path);
-  const CalibrationEvaluation result =
-      EvaluateCalibration(true_cam_from_lidar,
-                          cam_from_lidar,
-                          true_cam_from_world,
-                          reconstruction,
-                          alignment == "similarity");
+  const CalibrationEvaluation result = EvaluateCalibration(true_cam_from_lidar,
+                                                           cam_from_lidar,
+                                                           true_cam_from_world,
+                                                           reconstruction,
+                                                           alignment == "similarity");
 
   nlohmann::json metrics;
-  metrics["cam_from_lidar_rotation_error_deg"] =
-      result.cam_from_lidar_rotation_error_deg;
-  metrics["cam_from_lidar_translation_error_mm"] =
-      result.cam_from_lidar_translation_error_mm;
+  metrics["cam_from_lidar_rotation_error_deg"] = result.cam_from_lidar_rotation_error_deg;
+  metrics["cam_from_lidar_translation_error_mm"] = result.cam_from_lidar_translation_error_mm;
   for (int k = 0; k < 3; ++k) {
-    metrics[std::string("cam_from_lidar_translation_error_") + "xyz"[k] +
-            "_mm"] = result.cam_from_lidar_translation_error_in_cam_mm[k];
+    metrics[std::string("cam_from_lidar_translation_error_") + "xyz"[k] + "_mm"] =
+        result.cam_from_lidar_translation_error_in_cam_mm[k];
   }
   metrics["pose_alignment"] = result.alignment;
   metrics["pose_alignment_scale"] = result.alignment_scale;
@@ -210,28 +183,22 @@ int RunEvaluateCalibration(int argc, char** argv) {
   metrics["pose_position_error_max_mm"] = result.max_position_error_mm;
   for (const auto& [name, error] : result.position_error_mm) {
     metrics["station_" + name + "_position_error_mm"] = error;
-    metrics["station_" + name + "_rotation_error_deg"] =
-        result.rotation_error_deg.at(name);
+    metrics["station_" + name + "_rotation_error_deg"] = result.rotation_error_deg.at(name);
   }
-  std::cout << std::fixed << std::setprecision(4)
-            << "evaluate_calibration: cam_from_lidar error "
-            << result.cam_from_lidar_rotation_error_deg << " deg, "
-            << std::setprecision(2)
-            << result.cam_from_lidar_translation_error_mm
-            << " mm; station poses (" << result.alignment << " alignment, "
-            << result.num_stations_evaluated << " stations): mean "
-            << result.mean_position_error_mm << " mm / " << std::setprecision(4)
-            << result.mean_rotation_error_deg << " deg, max "
-            << std::setprecision(2) << result.max_position_error_mm << " mm"
-            << std::endl;
+  std::cout << std::fixed << std::setprecision(4) << "evaluate_calibration: cam_from_lidar error "
+            << result.cam_from_lidar_rotation_error_deg << " deg, " << std::setprecision(2)
+            << result.cam_from_lidar_translation_error_mm << " mm; station poses ("
+            << result.alignment << " alignment, " << result.num_stations_evaluated
+            << " stations): mean " << result.mean_position_error_mm << " mm / "
+            << std::setprecision(4) << result.mean_rotation_error_deg << " deg, max "
+            << std::setprecision(2) << result.max_position_error_mm << " mm" << std::endl;
   if (!result.missing_stations.empty()) {
     std::cout << "evaluate_calibration: " << result.missing_stations.size()
               << " stations of the truth are not in the model" << std::endl;
   }
   if (!output_path.empty()) {
     fs::create_directories(output_path);
-    WriteFileAtomically((fs::path(output_path) / "metrics.json").string(),
-                        metrics.dump(2) + "\n");
+    WriteFileAtomically((fs::path(output_path) / "metrics.json").string(), metrics.dump(2) + "\n");
     WritePoseFile((fs::path(output_path) / "truth_from_model.txt").string(),
                   "true_world_from_model_world by " + result.alignment +
                       " alignment of the camera centres (scale " +

@@ -22,12 +22,11 @@ std::string DescribeAxis(const Eigen::Vector3d& axis) {
   const Eigen::Vector3d a = axis.normalized();
   static const char* kNames[3] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
-    if (std::abs(a[i]) > 0.9)
-      return std::string("the camera ") + kNames[i] + " axis";
+    if (std::abs(a[i]) > 0.9) return std::string("the camera ") + kNames[i] + " axis";
   }
   std::ostringstream out;
-  out << std::fixed << std::setprecision(2) << "the camera-frame direction ("
-      << a.x() << ", " << a.y() << ", " << a.z() << ")";
+  out << std::fixed << std::setprecision(2) << "the camera-frame direction (" << a.x() << ", "
+      << a.y() << ", " << a.z() << ")";
   return out.str();
 }
 
@@ -37,8 +36,7 @@ std::string Advice(const MotionAnalysis& motion) {
            "rotated about two different axes";
   }
   if (!motion.unique && motion.num_stations >= 3) {
-    return "all stations rotate about one axis (" +
-           DescribeAxis(motion.common_axis_in_cam) +
+    return "all stations rotate about one axis (" + DescribeAxis(motion.common_axis_in_cam) +
            "); add stations tilted about a second axis";
   }
   if (motion.num_stations < 3) return "fewer than 3 stations; add stations";
@@ -86,8 +84,8 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
           std::max(analysis.max_axis_angle_deg, std::acos(cosine) * kRadToDeg);
     }
   }
-  analysis.unique = analysis.num_stations >= 3 &&
-                    analysis.max_axis_angle_deg > options.max_parallel_axes_deg;
+  analysis.unique =
+      analysis.num_stations >= 3 && analysis.max_axis_angle_deg > options.max_parallel_axes_deg;
   std::ostringstream verdict;
   verdict << std::fixed << std::setprecision(1);
   if (analysis.num_stations < 3) {
@@ -104,9 +102,8 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
             << " deg): T_e's translation along it is unobservable; add "
                "stations tilted about a second axis";
   } else {
-    verdict << "relative rotation axes of " << analysis.num_rotating_pairs
-            << " station pairs span " << analysis.max_axis_angle_deg
-            << " deg: T_e is unique (the seed's condition holds)";
+    verdict << "relative rotation axes of " << analysis.num_rotating_pairs << " station pairs span "
+            << analysis.max_axis_angle_deg << " deg: T_e is unique (the seed's condition holds)";
   }
   analysis.verdict = verdict.str();
   return analysis;
@@ -118,17 +115,14 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     double* cam_from_lidar_translation,
     const std::array<bool, 3>& held_translation,
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
-    const std::unordered_map<ceres::ResidualBlockId, double>&
-        depth_scale_derivative,
+    const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
     const MotionAnalysis& motion,
     const ObservabilityOptions& options) {
   ExtrinsicUncertainty result;
-  const bool rotation_free =
-      problem->HasParameterBlock(cam_from_lidar_rotation) &&
-      !problem->IsParameterBlockConstant(cam_from_lidar_rotation);
-  const bool translation_free =
-      problem->HasParameterBlock(cam_from_lidar_translation) &&
-      !problem->IsParameterBlockConstant(cam_from_lidar_translation);
+  const bool rotation_free = problem->HasParameterBlock(cam_from_lidar_rotation) &&
+                             !problem->IsParameterBlockConstant(cam_from_lidar_rotation);
+  const bool translation_free = problem->HasParameterBlock(cam_from_lidar_translation) &&
+                                !problem->IsParameterBlockConstant(cam_from_lidar_translation);
   if (!rotation_free && !translation_free) {
     result.message = "cam_from_lidar is held constant in this mode";
     return result;
@@ -139,8 +133,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
   std::vector<double*> ordered;
   int num_other = 0;
   for (double* block : blocks) {
-    if (block == cam_from_lidar_rotation ||
-        block == cam_from_lidar_translation ||
+    if (block == cam_from_lidar_rotation || block == cam_from_lidar_translation ||
         problem->IsParameterBlockConstant(block)) {
       continue;
     }
@@ -168,15 +161,13 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
   for (size_t c = 0; c < clusters.size(); ++c) {
     for (const ceres::ResidualBlockId id : clusters[c]) {
       residual_blocks.push_back(id);
-      const int num_residuals =
-          problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+      const int num_residuals = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
       row_cluster.insert(row_cluster.end(), num_residuals, static_cast<int>(c));
       const auto derivative = depth_scale_derivative.find(id);
-      row_scale_derivative.insert(row_scale_derivative.end(),
-                                  num_residuals,
-                                  derivative == depth_scale_derivative.end()
-                                      ? 0.0
-                                      : derivative->second);
+      row_scale_derivative.insert(
+          row_scale_derivative.end(),
+          num_residuals,
+          derivative == depth_scale_derivative.end() ? 0.0 : derivative->second);
     }
   }
   ceres::Problem::EvaluateOptions evaluate_options;
@@ -198,17 +189,15 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
   }
   Eigen::SparseMatrix<double> jacobian(crs.num_rows, crs.num_cols);
   jacobian.setFromTriplets(triplets.begin(), triplets.end());
-  const Eigen::SparseMatrix<double> information =
-      (jacobian.transpose() * jacobian).pruned();
+  const Eigen::SparseMatrix<double> information = (jacobian.transpose() * jacobian).pruned();
 
   // Schur complement: information of T_e with every other block marginalised.
-  Eigen::SparseMatrix<double> other =
-      information.topLeftCorner(num_other, num_other);
+  Eigen::SparseMatrix<double> other = information.topLeftCorner(num_other, num_other);
   for (int i = 0; i < num_other; ++i) other.coeffRef(i, i) += 1e-12;
   const Eigen::MatrixXd coupling =
       Eigen::MatrixXd(information.bottomLeftCorner(num_extrinsic, num_other));
-  const Eigen::MatrixXd extrinsic = Eigen::MatrixXd(
-      information.bottomRightCorner(num_extrinsic, num_extrinsic));
+  const Eigen::MatrixXd extrinsic =
+      Eigen::MatrixXd(information.bottomRightCorner(num_extrinsic, num_extrinsic));
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(other);
   if (ldlt.info() != Eigen::Success) {
     result.message =
@@ -226,43 +215,36 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
   for (int a = 0; a < num_extrinsic; ++a) {
     for (int b = 0; b < num_extrinsic; ++b) {
       info(extrinsic_index[a], extrinsic_index[b]) =
-          marginal(a, b) /
-          (unit(extrinsic_index[a]) * unit(extrinsic_index[b]));
+          marginal(a, b) / (unit(extrinsic_index[a]) * unit(extrinsic_index[b]));
     }
   }
   const int redundancy = crs.num_rows - crs.num_cols;
   result.variance_factor = redundancy > 0 ? 2 * cost / redundancy : 1.0;
   // Formal covariance: the pseudo-inverse of the marginal information (unobservable -> huge).
-  const auto covariance_from_information =
-      [](const Eigen::Matrix<double, 6, 6>& information, double factor) {
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(
-            information);
-        Eigen::Matrix<double, 6, 6> covariance =
-            Eigen::Matrix<double, 6, 6>::Zero();
-        for (int k = 0; k < 6; ++k) {
-          const double lambda = std::max(eigen.eigenvalues()[k], 1e-30);
-          covariance += factor / lambda * eigen.eigenvectors().col(k) *
-                        eigen.eigenvectors().col(k).transpose();
-        }
-        return covariance;
-      };
-  result.formal_covariance =
-      covariance_from_information(info, result.variance_factor);
+  const auto covariance_from_information = [](const Eigen::Matrix<double, 6, 6>& information,
+                                              double factor) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(information);
+    Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+    for (int k = 0; k < 6; ++k) {
+      const double lambda = std::max(eigen.eigenvalues()[k], 1e-30);
+      covariance +=
+          factor / lambda * eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose();
+    }
+    return covariance;
+  };
+  result.formal_covariance = covariance_from_information(info, result.variance_factor);
   result.covariance = result.formal_covariance;
 
   // Cluster-robust (sandwich) covariance: X = H^-1 E (E selects T_e), v_c = (J_c X)^T r_c.
   Eigen::SparseMatrix<double> regularised = information;
-  for (int i = 0; i < regularised.rows(); ++i)
-    regularised.coeffRef(i, i) += 1e-12;
+  for (int i = 0; i < regularised.rows(); ++i) regularised.coeffRef(i, i) += 1e-12;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> full(regularised);
   if (full.info() == Eigen::Success && clusters.size() > 1) {
-    Eigen::MatrixXd selector =
-        Eigen::MatrixXd::Zero(crs.num_cols, num_extrinsic);
+    Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(crs.num_cols, num_extrinsic);
     for (int a = 0; a < num_extrinsic; ++a) selector(num_other + a, a) = 1;
     const Eigen::MatrixXd x = full.solve(selector);
     const Eigen::MatrixXd y = jacobian * x;
-    std::vector<Eigen::VectorXd> scores(clusters.size(),
-                                        Eigen::VectorXd::Zero(num_extrinsic));
+    std::vector<Eigen::VectorXd> scores(clusters.size(), Eigen::VectorXd::Zero(num_extrinsic));
     Eigen::VectorXd scale_sensitivity = Eigen::VectorXd::Zero(num_extrinsic);
     for (int row = 0; row < crs.num_rows; ++row) {
       scores[row_cluster[row]] += y.row(row).transpose() * residuals[row];
@@ -274,42 +256,35 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
           scale_sensitivity[a] * unit(extrinsic_index[a]);
     }
     const double num_clusters = static_cast<double>(clusters.size());
-    Eigen::MatrixXd sandwich =
-        Eigen::MatrixXd::Zero(num_extrinsic, num_extrinsic);
-    for (const Eigen::VectorXd& score : scores)
-      sandwich += score * score.transpose();
+    Eigen::MatrixXd sandwich = Eigen::MatrixXd::Zero(num_extrinsic, num_extrinsic);
+    for (const Eigen::VectorXd& score : scores) sandwich += score * score.transpose();
     sandwich *= num_clusters / (num_clusters - 1);
     if (sandwich.allFinite()) {
       Eigen::Matrix<double, 6, 6> robust = Eigen::Matrix<double, 6, 6>::Zero();
       for (int a = 0; a < num_extrinsic; ++a) {
         for (int b = 0; b < num_extrinsic; ++b) {
           robust(extrinsic_index[a], extrinsic_index[b]) =
-              sandwich(a, b) * unit(extrinsic_index[a]) *
-              unit(extrinsic_index[b]);
+              sandwich(a, b) * unit(extrinsic_index[a]) * unit(extrinsic_index[b]);
         }
       }
       // Directions the formal information calls unobservable stay unobservable.
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> formal(
-          result.formal_covariance);
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> formal(result.formal_covariance);
       for (int k = 0; k < 6; ++k) {
         if (formal.eigenvalues()[k] > 1e6) {
           robust += formal.eigenvalues()[k] * formal.eigenvectors().col(k) *
                     formal.eigenvectors().col(k).transpose();
         }
       }
-      result.covariance =
-          robust + options.stereo_scale_sigma * options.stereo_scale_sigma *
-                       result.stereo_scale_sensitivity *
-                       result.stereo_scale_sensitivity.transpose();
+      result.covariance = robust + options.stereo_scale_sigma * options.stereo_scale_sigma *
+                                       result.stereo_scale_sensitivity *
+                                       result.stereo_scale_sensitivity.transpose();
       result.cluster_robust = true;
       result.num_clusters = static_cast<int>(clusters.size());
     }
   }
 
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(
-      result.covariance);
-  for (int k = 0; k < 6;
-       ++k) {  // eigen values ascending: store std devs ascending
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(result.covariance);
+  for (int k = 0; k < 6; ++k) {  // eigen values ascending: store std devs ascending
     result.eigenvalues[k] = std::sqrt(std::max(eigen.eigenvalues()[k], 0.0));
     result.eigenvectors.col(k) = eigen.eigenvectors().col(k);
   }
@@ -320,18 +295,18 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     const Eigen::Matrix<double, 6, 1> v = result.eigenvectors.col(k);
     const double sigma = result.eigenvalues[k];
     const bool translation = v.tail<3>().squaredNorm() >= 0.5;
-    const double threshold = translation ? options.unobservable_translation_mm
-                                         : options.unobservable_rotation_deg;
+    const double threshold =
+        translation ? options.unobservable_translation_mm : options.unobservable_rotation_deg;
     if (!(sigma > threshold)) continue;
     std::ostringstream sentence;
     sentence << std::setprecision(3);
     if (translation) {
       ++num_unobservable_translation;
-      sentence << "translation along " << DescribeAxis(v.tail<3>())
-               << " is unobservable (sigma " << sigma << " mm): ";
+      sentence << "translation along " << DescribeAxis(v.tail<3>()) << " is unobservable (sigma "
+               << sigma << " mm): ";
     } else {
-      sentence << "rotation about " << DescribeAxis(v.head<3>())
-               << " is unobservable (sigma " << sigma << " deg): ";
+      sentence << "rotation about " << DescribeAxis(v.head<3>()) << " is unobservable (sigma "
+               << sigma << " deg): ";
     }
     sentence << Advice(motion);
     result.unobservable.push_back(sentence.str());

@@ -32,8 +32,7 @@ struct ObservabilityOptions {
   // a "consider" parameter: its effect on T_e, sigma^2 * s s^T with s = dT_e/dscale, is added to the
   // covariance (random residual scatter cannot reveal an error common to every depth prior).
   double stereo_scale_sigma = 0.001;
-  double min_rotation_deg =
-      2.0;  // relative rotations below this do not count as rotating
+  double min_rotation_deg = 2.0;       // relative rotations below this do not count as rotating
   double max_parallel_axes_deg = 5.0;  // axes closer than this are parallel
 
   bool Check() const;
@@ -45,30 +44,24 @@ struct ExtrinsicUncertainty {
   // 6x6 covariance of (rotation vector [deg] about the camera axes, translation [mm]) of cam_from_lidar:
   // cluster-robust if it could be computed (see cluster_robust), else the formal one.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 6> formal_covariance =
-      Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> formal_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool cluster_robust = false;
   // Rotation [deg] and translation [mm] of T_e per unit of relative stereo scale error (the consider
   // parameter); its contribution stereo_scale_sigma^2 s s^T is included in `covariance`.
-  Eigen::Matrix<double, 6, 1> stereo_scale_sensitivity =
-      Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> stereo_scale_sensitivity = Eigen::Matrix<double, 6, 1>::Zero();
   int num_clusters = 0;
   double variance_factor = 1;  // 2 cost / (residuals - parameters)
   Eigen::Matrix<double, 6, 1> eigenvalues =
       Eigen::Matrix<double, 6, 1>::Zero();  // std devs, ascending
-  Eigen::Matrix<double, 6, 6> eigenvectors =
-      Eigen::Matrix<double, 6, 6>::Zero();  // columns
-  std::vector<std::string>
-      unobservable;  // one sentence per unobservable direction
+  Eigen::Matrix<double, 6, 6> eigenvectors = Eigen::Matrix<double, 6, 6>::Zero();  // columns
+  std::vector<std::string> unobservable;  // one sentence per unobservable direction
 };
 
 struct MotionAnalysis {
   int num_stations = 0;
-  int num_rotating_pairs = 0;  // relative rotation above 2 deg
-  double max_axis_angle_deg =
-      0;  // largest angle between two relative rotation axes
-  Eigen::Vector3d common_axis_in_cam =
-      Eigen::Vector3d::Zero();  // if all axes are parallel
+  int num_rotating_pairs = 0;     // relative rotation above 2 deg
+  double max_axis_angle_deg = 0;  // largest angle between two relative rotation axes
+  Eigen::Vector3d common_axis_in_cam = Eigen::Vector3d::Zero();  // if all axes are parallel
   bool unique = false;  // the seed's test: >= 3 stations, axes not all parallel
   std::string verdict;
 };
@@ -89,8 +82,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     double* cam_from_lidar_translation,
     const std::array<bool, 3>& held_translation,
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
-    const std::unordered_map<ceres::ResidualBlockId, double>&
-        depth_scale_derivative,
+    const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
     const MotionAnalysis& motion,
     const ObservabilityOptions& options);
 

@@ -13,23 +13,18 @@ namespace colmap_lidar {
 
 class ExtrinsicTranslationPriorCostFunctor {
  public:
-  ExtrinsicTranslationPriorCostFunctor(const Eigen::Vector3d& translation,
-                                       double sigma)
+  ExtrinsicTranslationPriorCostFunctor(const Eigen::Vector3d& translation, double sigma)
       : translation_(translation), inverse_sigma_(1.0 / sigma) {}
 
-  static ceres::CostFunction* Create(const Eigen::Vector3d& translation,
-                                     double sigma) {
-    return new ceres::
-        AutoDiffCostFunction<ExtrinsicTranslationPriorCostFunctor, 3, 3>(
-            new ExtrinsicTranslationPriorCostFunctor(translation, sigma));
+  static ceres::CostFunction* Create(const Eigen::Vector3d& translation, double sigma) {
+    return new ceres::AutoDiffCostFunction<ExtrinsicTranslationPriorCostFunctor, 3, 3>(
+        new ExtrinsicTranslationPriorCostFunctor(translation, sigma));
   }
 
   template <typename T>
-  bool operator()(const T* const cam_from_lidar_translation,
-                  T* residuals) const {
+  bool operator()(const T* const cam_from_lidar_translation, T* residuals) const {
     for (int i = 0; i < 3; ++i) {
-      residuals[i] = (cam_from_lidar_translation[i] - T(translation_[i])) *
-                     T(inverse_sigma_);
+      residuals[i] = (cam_from_lidar_translation[i] - T(translation_[i])) * T(inverse_sigma_);
     }
     return true;
   }

@@ -36,14 +36,11 @@ int RunImportDataset(int argc, char** argv) {
   import_options.exhaustive_matching = *options.exhaustive_matching;
   const DatasetImportSummary summary =
       ImportDataset(dataset, *options.database_path, import_options);
-  std::cout << "Imported " << dataset.root << " into " << *options.database_path
-            << ": " << summary.num_images << " station images ("
-            << summary.num_new_images << " new), camera " << summary.camera_id
-            << ", " << summary.num_verified_pairs << " verified image pairs ("
-            << std::fixed << std::setprecision(0)
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                             start)
-                   .count()
+  std::cout << "Imported " << dataset.root << " into " << *options.database_path << ": "
+            << summary.num_images << " station images (" << summary.num_new_images
+            << " new), camera " << summary.camera_id << ", " << summary.num_verified_pairs
+            << " verified image pairs (" << std::fixed << std::setprecision(0)
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
             << " s)" << std::endl;
   return EXIT_SUCCESS;
 }
@@ -65,20 +62,16 @@ int RunStereoDepth(int argc, char** argv) {
   options.AddDefaultOption("pre_filter_cap", &stereo.pre_filter_cap);
   options.AddDefaultOption("speckle_window_size", &stereo.speckle_window_size);
   options.AddDefaultOption("speckle_range_px", &stereo.speckle_range_px);
-  options.AddDefaultOption("max_left_right_diff_px",
-                           &stereo.max_left_right_diff_px);
+  options.AddDefaultOption("max_left_right_diff_px", &stereo.max_left_right_diff_px);
   options.AddDefaultOption("num_threads", &stereo.num_threads);
   options.Parse(argc, argv);
   THROW_CHECK(stereo.Check());
   const StationDataset dataset = ReadStationDataset(dataset_path);
   const auto start = std::chrono::steady_clock::now();
   ComputeDatasetStereoDepth(dataset, output_path, stereo);
-  std::cout << "Depth maps of " << dataset.stations.size()
-            << " stations written to " << output_path << " (" << std::fixed
-            << std::setprecision(0)
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                             start)
-                   .count()
+  std::cout << "Depth maps of " << dataset.stations.size() << " stations written to " << output_path
+            << " (" << std::fixed << std::setprecision(0)
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
             << " s)" << std::endl;
   return EXIT_SUCCESS;
 }
@@ -90,25 +83,23 @@ int RunDepthPriorExtractor(int argc, char** argv) {
   options.AddDatabaseOptions();
   options.AddRequiredOption("depth_path", &depth_path);
   options.AddDefaultOption("max_radius_px", &prior_options.max_radius_px);
-  options.AddDefaultOption("sigma_pixels",
-                           &prior_options.sigma_pixels,
-                           "sigma_p of sigma_d = d^2/(b f) sigma_p");
-  options.AddDefaultOption("max_relative_jump",
-                           &prior_options.max_relative_jump);
+  options.AddDefaultOption(
+      "sigma_pixels", &prior_options.sigma_pixels, "sigma_p of sigma_d = d^2/(b f) sigma_p");
+  options.AddDefaultOption("max_relative_jump", &prior_options.max_relative_jump);
   options.Parse(argc, argv);
   THROW_CHECK(prior_options.Check());
-  const std::vector<ImageDepthPriorCount> counts = ExtractDatabaseDepthPriors(
-      *options.database_path, depth_path, prior_options);
+  const std::vector<ImageDepthPriorCount> counts =
+      ExtractDatabaseDepthPriors(*options.database_path, depth_path, prior_options);
   size_t num_keypoints = 0, num_priors = 0, num_without_map = 0;
   for (const ImageDepthPriorCount& count : counts) {
     num_keypoints += count.num_keypoints;
     num_priors += count.num_priors;
     if (!count.has_depth_map) ++num_without_map;
   }
-  std::cout << "Depth priors: " << num_priors << " of " << num_keypoints
-            << " keypoints (" << std::fixed << std::setprecision(1)
-            << 100.0 * num_priors / std::max<size_t>(1, num_keypoints)
-            << " %) in " << counts.size() << " images";
+  std::cout << "Depth priors: " << num_priors << " of " << num_keypoints << " keypoints ("
+            << std::fixed << std::setprecision(1)
+            << 100.0 * num_priors / std::max<size_t>(1, num_keypoints) << " %) in " << counts.size()
+            << " images";
   if (num_without_map > 0) {
     std::cout << "; " << num_without_map << " images had no depth map";
   }

@@ -21,9 +21,8 @@ struct HandEyeMotion {
 };
 
 struct HandEyeOptions {
-  double min_rotation_deg = 5.0;  // motions rotating less carry no axis
-  double min_axis_angle_deg =
-      10.0;  // two axes closer than this count as parallel
+  double min_rotation_deg = 5.0;       // motions rotating less carry no axis
+  double min_axis_angle_deg = 10.0;    // two axes closer than this count as parallel
   double max_axis_residual_deg = 2.0;  // consistency of A and B rotation angles
 
   bool Check() const;

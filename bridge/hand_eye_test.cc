@@ -10,17 +10,15 @@ namespace {
 colmap::Rigid3d Motion(double angle_deg,
                        const Eigen::Vector3d& axis,
                        const Eigen::Vector3d& translation) {
-  return colmap::Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(
-                             angle_deg * M_PI / 180, axis.normalized())),
-                         translation);
+  return colmap::Rigid3d(
+      Eigen::Quaterniond(Eigen::AngleAxisd(angle_deg * M_PI / 180, axis.normalized())),
+      translation);
 }
 
-const colmap::Rigid3d kCamFromLidar =
-    Motion(97, {0.3, -0.7, 0.6}, {0.19, -0.25, -0.05});
+const colmap::Rigid3d kCamFromLidar = Motion(97, {0.3, -0.7, 0.6}, {0.19, -0.25, -0.05});
 
 // B = X^-1 A X for each camera motion A.
-std::vector<HandEyeMotion> Conjugate(
-    const std::vector<colmap::Rigid3d>& camera_motions) {
+std::vector<HandEyeMotion> Conjugate(const std::vector<colmap::Rigid3d>& camera_motions) {
   std::vector<HandEyeMotion> motions;
   for (const colmap::Rigid3d& a : camera_motions) {
     motions.push_back({a, colmap::Inverse(kCamFromLidar) * a * kCamFromLidar});
@@ -36,12 +34,8 @@ TEST(HandEye, RecoversTheExtrinsicFromMotionsAboutTwoAxes) {
                    HandEyeOptions());
   ASSERT_TRUE(result.unique) << result.message;
   EXPECT_EQ(result.num_motions, 3);
-  EXPECT_LT(
-      result.cam_from_lidar.rotation.angularDistance(kCamFromLidar.rotation),
-      1e-9);
-  EXPECT_LT(
-      (result.cam_from_lidar.translation - kCamFromLidar.translation).norm(),
-      1e-9);
+  EXPECT_LT(result.cam_from_lidar.rotation.angularDistance(kCamFromLidar.rotation), 1e-9);
+  EXPECT_LT((result.cam_from_lidar.translation - kCamFromLidar.translation).norm(), 1e-9);
 }
 
 TEST(HandEye, SaysWhyMotionAboutOneAxisOrNoneIsDegenerate) {
@@ -50,16 +44,13 @@ TEST(HandEye, SaysWhyMotionAboutOneAxisOrNoneIsDegenerate) {
                               Motion(-70, {0, 1, 0}, {-0.8, 0.05, 1.1})}),
                    HandEyeOptions());
   EXPECT_FALSE(one_axis.unique);
-  EXPECT_NE(one_axis.message.find("rotation axes within 0.0 deg"),
-            std::string::npos)
+  EXPECT_NE(one_axis.message.find("rotation axes within 0.0 deg"), std::string::npos)
       << one_axis.message;
-  const HandEyeResult translations =
-      SolveHandEye(Conjugate({Motion(0, {0, 1, 0}, {1.2, 0.1, 0.4}),
-                              Motion(0, {0, 1, 0}, {-0.8, 0.05, 1.1})}),
-                   HandEyeOptions());
+  const HandEyeResult translations = SolveHandEye(
+      Conjugate({Motion(0, {0, 1, 0}, {1.2, 0.1, 0.4}), Motion(0, {0, 1, 0}, {-0.8, 0.05, 1.1})}),
+      HandEyeOptions());
   EXPECT_FALSE(translations.unique);
-  EXPECT_NE(translations.message.find("0 rotating motion pairs"),
-            std::string::npos)
+  EXPECT_NE(translations.message.find("0 rotating motion pairs"), std::string::npos)
       << translations.message;
 }
 

@@ -9,12 +9,9 @@
 namespace colmap_lidar {
 namespace {
 
-colmap::Rigid3d Umeyama(const Eigen::Matrix3Xd& target,
-                        const Eigen::Matrix3Xd& source) {
-  const Eigen::Matrix4d t =
-      Eigen::umeyama(source, target, /*with_scaling=*/false);
-  return colmap::Rigid3d(Eigen::Quaterniond(t.topLeftCorner<3, 3>()),
-                         t.topRightCorner<3, 1>());
+colmap::Rigid3d Umeyama(const Eigen::Matrix3Xd& target, const Eigen::Matrix3Xd& source) {
+  const Eigen::Matrix4d t = Eigen::umeyama(source, target, /*with_scaling=*/false);
+  return colmap::Rigid3d(Eigen::Quaterniond(t.topLeftCorner<3, 3>()), t.topRightCorner<3, 1>());
 }
 
 }  // namespace
@@ -26,15 +23,13 @@ bool ImagePairPoseOptions::Check() const {
   return true;
 }
 
-std::vector<ImagePairPose> EstimateImagePairPoses(
-    const colmap::Database& database,
-    const DepthPriorsByImage& depth_priors,
-    const ImagePairPoseOptions& options) {
+std::vector<ImagePairPose> EstimateImagePairPoses(const colmap::Database& database,
+                                                  const DepthPriorsByImage& depth_priors,
+                                                  const ImagePairPoseOptions& options) {
   THROW_CHECK(options.Check());
   std::unordered_map<colmap::image_t, colmap::Image> images;
   std::unordered_map<colmap::camera_t, colmap::Camera> cameras;
-  for (const colmap::Image& image : database.ReadAllImages())
-    images[image.ImageId()] = image;
+  for (const colmap::Image& image : database.ReadAllImages()) images[image.ImageId()] = image;
   for (const colmap::Camera& camera : database.ReadAllCameras()) {
     cameras[camera.camera_id] = camera;
   }
@@ -43,8 +38,7 @@ std::vector<ImagePairPose> EstimateImagePairPoses(
   database.ReadTwoViewGeometries(&pair_ids, &geometries);
   // Each image's keypoints are read once, not once per pair.
   std::unordered_map<colmap::image_t, colmap::FeatureKeypoints> keypoints;
-  const auto keypoints_of =
-      [&](colmap::image_t image_id) -> const colmap::FeatureKeypoints& {
+  const auto keypoints_of = [&](colmap::image_t image_id) -> const colmap::FeatureKeypoints& {
     auto it = keypoints.find(image_id);
     if (it == keypoints.end()) {
       it = keypoints.emplace(image_id, database.ReadKeypoints(image_id)).first;
@@ -54,12 +48,10 @@ std::vector<ImagePairPose> EstimateImagePairPoses(
   std::mt19937_64 rng(options.seed);
   std::vector<ImagePairPose> poses;
   for (size_t p = 0; p < pair_ids.size(); ++p) {
-    const auto [image_i, image_j] =
-        colmap::Database::PairIdToImagePair(pair_ids[p]);
+    const auto [image_i, image_j] = colmap::Database::PairIdToImagePair(pair_ids[p]);
     const auto priors_i = depth_priors.find(image_i);
     const auto priors_j = depth_priors.find(image_j);
-    if (priors_i == depth_priors.end() || priors_j == depth_priors.end())
-      continue;
+    if (priors_i == depth_priors.end() || priors_j == depth_priors.end()) continue;
     const colmap::FeatureKeypoints& keypoints_i = keypoints_of(image_i);
     const colmap::FeatureKeypoints& keypoints_j = keypoints_of(image_j);
     const colmap::Camera& camera_i = cameras.at(images.at(image_i).CameraId());
@@ -68,18 +60,15 @@ std::vector<ImagePairPose> EstimateImagePairPoses(
     for (const colmap::FeatureMatch& match : geometries[p].inlier_matches) {
       const auto prior_i = priors_i->second.find(match.point2D_idx1);
       const auto prior_j = priors_j->second.find(match.point2D_idx2);
-      if (prior_i == priors_i->second.end() ||
-          prior_j == priors_j->second.end()) {
+      if (prior_i == priors_i->second.end() || prior_j == priors_j->second.end()) {
         continue;
       }
       const colmap::FeatureKeypoint& ki = keypoints_i.at(match.point2D_idx1);
       const colmap::FeatureKeypoint& kj = keypoints_j.at(match.point2D_idx2);
-      points_i.push_back(
-          prior_i->second.depth *
-          camera_i.CamFromImg(Eigen::Vector2d(ki.x, ki.y)).homogeneous());
-      points_j.push_back(
-          prior_j->second.depth *
-          camera_j.CamFromImg(Eigen::Vector2d(kj.x, kj.y)).homogeneous());
+      points_i.push_back(prior_i->second.depth *
+                         camera_i.CamFromImg(Eigen::Vector2d(ki.x, ki.y)).homogeneous());
+      points_j.push_back(prior_j->second.depth *
+                         camera_j.CamFromImg(Eigen::Vector2d(kj.x, kj.y)).homogeneous());
     }
     const int n = static_cast<int>(points_i.size());
     if (n < options.min_inliers) continue;
@@ -103,8 +92,7 @@ std::vector<ImagePairPose> EstimateImagePairPoses(
     };
     std::uniform_int_distribution<int> pick(0, n - 1);
     std::vector<int> best;
-    for (int iteration = 0; iteration < options.num_ransac_iterations;
-         ++iteration) {
+    for (int iteration = 0; iteration < options.num_ransac_iterations; ++iteration) {
       const int a = pick(rng), b = pick(rng), c = pick(rng);
       if (a == b || b == c || a == c) continue;
       std::vector<int> inliers = inliers_of(fit({a, b, c}));
@@ -124,8 +112,7 @@ std::vector<ImagePairPose> EstimateImagePairPoses(
     pose.num_inliers = static_cast<int>(best.size());
     double squared = 0;
     for (const int k : best) {
-      squared +=
-          (points_i[k] - pose.cam_i_from_cam_j * points_j[k]).squaredNorm();
+      squared += (points_i[k] - pose.cam_i_from_cam_j * points_j[k]).squaredNorm();
     }
     pose.rms_m = std::sqrt(squared / best.size());
     poses.push_back(pose);

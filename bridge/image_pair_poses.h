@@ -35,12 +35,10 @@ struct ImagePairPose {
 };
 
 using DepthPriorsByImage =
-    std::unordered_map<colmap::image_t,
-                       std::unordered_map<colmap::point2D_t, DepthPrior>>;
+    std::unordered_map<colmap::image_t, std::unordered_map<colmap::point2D_t, DepthPrior>>;
 
-std::vector<ImagePairPose> EstimateImagePairPoses(
-    const colmap::Database& database,
-    const DepthPriorsByImage& depth_priors,
-    const ImagePairPoseOptions& options);
+std::vector<ImagePairPose> EstimateImagePairPoses(const colmap::Database& database,
+                                                  const DepthPriorsByImage& depth_priors,
+                                                  const ImagePairPoseOptions& options);
 
 }  // namespace colmap_lidar

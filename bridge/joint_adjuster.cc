@@ -24,8 +24,7 @@ namespace {
 
 using ImagePoint = std::pair<colmap::image_t, colmap::point2D_t>;
 
-double TermCost(ceres::Problem* problem,
-                const std::vector<ceres::ResidualBlockId>& ids) {
+double TermCost(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& ids) {
   if (ids.empty()) return 0;
   ceres::Problem::EvaluateOptions options;
   options.residual_blocks = ids;
@@ -46,12 +45,11 @@ Eigen::Isometry3d ToIsometry(const colmap::Rigid3d& transform) {
 colmap::Rigid3d LidarIFromLidarJ(const colmap::Rigid3d& cam_i_from_world,
                                  const colmap::Rigid3d& cam_j_from_world,
                                  const colmap::Rigid3d& cam_from_lidar) {
-  return colmap::Inverse(cam_from_lidar) * cam_i_from_world *
-         colmap::Inverse(cam_j_from_world) * cam_from_lidar;
+  return colmap::Inverse(cam_from_lidar) * cam_i_from_world * colmap::Inverse(cam_j_from_world) *
+         cam_from_lidar;
 }
 
-std::unique_ptr<ceres::LossFunction> MakeLoss(const std::string& name,
-                                              double scale) {
+std::unique_ptr<ceres::LossFunction> MakeLoss(const std::string& name, double scale) {
   if (name == "huber") return std::make_unique<ceres::HuberLoss>(scale);
   if (name == "cauchy") return std::make_unique<ceres::CauchyLoss>(scale);
   return nullptr;
@@ -64,12 +62,10 @@ struct JointProblem {
   std::vector<ceres::ResidualBlockId> reprojection_ids;
   std::vector<ceres::ResidualBlockId> depth_ids;
   std::vector<ceres::ResidualBlockId> lidar_ids;
-  std::vector<colmap::image_t> depth_images;  // parallel to depth_ids
-  std::vector<double>
-      depth_scale_derivatives;  // -d / sigma, parallel to depth_ids
+  std::vector<colmap::image_t> depth_images;    // parallel to depth_ids
+  std::vector<double> depth_scale_derivatives;  // -d / sigma, parallel to depth_ids
   std::vector<ceres::ResidualBlockId> prior_ids;
-  std::vector<std::pair<colmap::image_t, colmap::image_t>>
-      lidar_pairs;  // parallel to lidar_ids
+  std::vector<std::pair<colmap::image_t, colmap::image_t>> lidar_pairs;  // parallel to lidar_ids
   colmap::BundleAdjustmentOptions ba_options;
 };
 
@@ -93,8 +89,7 @@ JointMode JointModeFromName(const std::string& name) {
   if (name == "joint") return JointMode::kJoint;
   if (name == "precalibrated") return JointMode::kPrecalibrated;
   if (name == "stereo_only") return JointMode::kStereoOnly;
-  throw std::invalid_argument("unknown mode '" + name +
-                              "' (joint, precalibrated, stereo_only)");
+  throw std::invalid_argument("unknown mode '" + name + "' (joint, precalibrated, stereo_only)");
 }
 
 std::string JointModeName(JointMode mode) {
@@ -128,8 +123,7 @@ bool JointAdjusterOptions::Check() const {
   return true;
 }
 
-JointAdjuster::JointAdjuster(const JointAdjusterOptions& options,
-                             const JointProblemData& data)
+JointAdjuster::JointAdjuster(const JointAdjusterOptions& options, const JointProblemData& data)
     : options_(options), data_(data) {
   THROW_CHECK(options_.Check());
 }
@@ -141,9 +135,8 @@ std::vector<JointAdjuster::Observation> JointAdjuster::Associate(
   std::vector<std::pair<colmap::image_t, colmap::image_t>> directed;
   for (const auto& [a, b] : data_.pairs) {
     if (!reconstruction.ExistsImage(a) || !reconstruction.ExistsImage(b) ||
-        !reconstruction.Image(a).IsRegistered() ||
-        !reconstruction.Image(b).IsRegistered() || !data_.clouds.count(a) ||
-        !data_.clouds.count(b)) {
+        !reconstruction.Image(a).IsRegistered() || !reconstruction.Image(b).IsRegistered() ||
+        !data_.clouds.count(a) || !data_.clouds.count(b)) {
       continue;
     }
     directed.emplace_back(a, b);
@@ -179,24 +172,22 @@ std::vector<JointAdjuster::Observation> JointAdjuster::Associate(
   return observations;
 }
 
-JointAdjustmentSummary JointAdjuster::Run(
-    colmap::Reconstruction* reconstruction, colmap::Rigid3d* cam_from_lidar) {
+JointAdjustmentSummary JointAdjuster::Run(colmap::Reconstruction* reconstruction,
+                                          colmap::Rigid3d* cam_from_lidar) {
   THROW_CHECK_NOTNULL(reconstruction);
   THROW_CHECK_NOTNULL(cam_from_lidar);
   std::vector<colmap::image_t> image_ids = reconstruction->RegImageIds();
   THROW_CHECK_GE(image_ids.size(), 2) << "the joint problem needs at least 2 "
                                          "registered images";
   std::sort(image_ids.begin(), image_ids.end());
-  const bool use_lidar =
-      options_.mode != JointMode::kStereoOnly && options_.lidar_weight > 0;
+  const bool use_lidar = options_.mode != JointMode::kStereoOnly && options_.lidar_weight > 0;
   const bool refine_extrinsic = options_.mode == JointMode::kJoint;
   double* extrinsic_rotation = cam_from_lidar->rotation.coeffs().data();
   double* extrinsic_translation = cam_from_lidar->translation.data();
   const Eigen::Vector3d initial_translation = cam_from_lidar->translation;
 
   // Losses are owned here (COLMAP's problem does not take ownership).
-  const std::unique_ptr<ceres::LossFunction> loss =
-      MakeLoss(options_.loss, options_.loss_scale);
+  const std::unique_ptr<ceres::LossFunction> loss = MakeLoss(options_.loss, options_.loss_scale);
 
   colmap::BundleAdjustmentConfig config;
   for (const colmap::image_t image_id : image_ids) config.AddImage(image_id);
@@ -243,14 +234,12 @@ JointAdjustmentSummary JointAdjuster::Run(
     };
 
     // E_d: the seed's depth-prior residual, for every observation of every landmark with a prior.
-    const double depth_scale =
-        1.0 / std::sqrt(std::max(options_.depth_weight, 1e-300));
+    const double depth_scale = 1.0 / std::sqrt(std::max(options_.depth_weight, 1e-300));
     if (options_.depth_weight > 0) {
       for (const auto& [point3D_id, point3D] : reconstruction->Points3D()) {
         double* xyz = reconstruction->Point3D(point3D_id).xyz.data();
         for (const colmap::TrackElement& element : point3D.track.Elements()) {
-          const DepthPrior* prior =
-              FindDepthPrior(data_, depth_outliers, element);
+          const DepthPrior* prior = FindDepthPrior(data_, depth_outliers, element);
           if (prior == nullptr) continue;
           const double sigma = prior->sigma * depth_scale;
           if (config.HasConstantCamPose(element.image_id)) {
@@ -258,21 +247,19 @@ JointAdjustmentSummary JointAdjuster::Run(
             joint->depth_scale_derivatives.push_back(-prior->depth / sigma);
             joint->depth_ids.push_back(problem->AddResidualBlock(
                 DepthPriorConstantPoseCostFunctor::Create(
-                    reconstruction->Image(element.image_id).CamFromWorld(),
-                    prior->depth,
-                    sigma),
+                    reconstruction->Image(element.image_id).CamFromWorld(), prior->depth, sigma),
                 loss.get(),
                 xyz));
           } else {
             const auto [rotation, translation] = pose_blocks(element.image_id);
             joint->depth_images.push_back(element.image_id);
             joint->depth_scale_derivatives.push_back(-prior->depth / sigma);
-            joint->depth_ids.push_back(problem->AddResidualBlock(
-                DepthPriorCostFunctor::Create(prior->depth, sigma),
-                loss.get(),
-                rotation,
-                translation,
-                xyz));
+            joint->depth_ids.push_back(
+                problem->AddResidualBlock(DepthPriorCostFunctor::Create(prior->depth, sigma),
+                                          loss.get(),
+                                          rotation,
+                                          translation,
+                                          xyz));
           }
         }
       }
@@ -295,36 +282,31 @@ JointAdjustmentSummary JointAdjuster::Run(
       } else if (!held.empty()) {
         colmap::SetSubsetManifold(3, held, problem, extrinsic_translation);
       }
-      if (refine_extrinsic && held.size() < 3 &&
-          options_.extrinsic_prior_sigma_m > 0) {
-        joint->prior_ids.push_back(problem->AddResidualBlock(
-            ExtrinsicTranslationPriorCostFunctor::Create(
-                initial_translation, options_.extrinsic_prior_sigma_m),
-            nullptr,
-            extrinsic_translation));
+      if (refine_extrinsic && held.size() < 3 && options_.extrinsic_prior_sigma_m > 0) {
+        joint->prior_ids.push_back(
+            problem->AddResidualBlock(ExtrinsicTranslationPriorCostFunctor::Create(
+                                          initial_translation, options_.extrinsic_prior_sigma_m),
+                                      nullptr,
+                                      extrinsic_translation));
       }
-      const double sigma =
-          options_.sigma_lidar_m / std::sqrt(options_.lidar_weight);
+      const double sigma = options_.sigma_lidar_m / std::sqrt(options_.lidar_weight);
       for (const Observation& observation : observations) {
         if (observation.outlier) continue;
-        const auto [target_rotation, target_translation] =
-            pose_blocks(observation.target);
-        const auto [source_rotation, source_translation] =
-            pose_blocks(observation.source);
+        const auto [target_rotation, target_translation] = pose_blocks(observation.target);
+        const auto [source_rotation, source_translation] = pose_blocks(observation.source);
         joint->lidar_pairs.emplace_back(observation.target, observation.source);
-        joint->lidar_ids.push_back(
-            problem->AddResidualBlock(LidarPointToPlaneCostFunctor::Create(
-                                          observation.data.point_in_source,
-                                          observation.data.point_in_target,
-                                          observation.data.normal_in_target,
-                                          sigma),
-                                      loss.get(),
-                                      target_rotation,
-                                      target_translation,
-                                      source_rotation,
-                                      source_translation,
-                                      extrinsic_rotation,
-                                      extrinsic_translation));
+        joint->lidar_ids.push_back(problem->AddResidualBlock(
+            LidarPointToPlaneCostFunctor::Create(observation.data.point_in_source,
+                                                 observation.data.point_in_target,
+                                                 observation.data.normal_in_target,
+                                                 sigma),
+            loss.get(),
+            target_rotation,
+            target_translation,
+            source_rotation,
+            source_translation,
+            extrinsic_rotation,
+            extrinsic_translation));
       }
     }
     return joint;
@@ -334,18 +316,14 @@ JointAdjustmentSummary JointAdjuster::Run(
   for (int round = 0; round < num_rounds; ++round) {
     std::vector<Observation> observations;
     if (use_lidar) {
-      const double gate = std::max(
-          options_.association.max_distance,
-          options_.initial_association_distance_m * std::pow(0.5, round));
+      const double gate = std::max(options_.association.max_distance,
+                                   options_.initial_association_distance_m * std::pow(0.5, round));
       observations = Associate(*reconstruction, *cam_from_lidar, gate);
-      std::cout << "Round " << round + 1 << "/" << num_rounds << ": "
-                << observations.size()
-                << " LiDAR point-to-plane observations (gate " << gate << " m)"
-                << std::endl;
+      std::cout << "Round " << round + 1 << "/" << num_rounds << ": " << observations.size()
+                << " LiDAR point-to-plane observations (gate " << gate << " m)" << std::endl;
     }
     size_t num_lidar_outliers = 0;
-    for (int iteration = 0; iteration < options_.max_outlier_iterations;
-         ++iteration) {
+    for (int iteration = 0; iteration < options_.max_outlier_iterations; ++iteration) {
       const auto start = std::chrono::steady_clock::now();
       last = build(observations);
       ceres::Problem* problem = last->problem.get();
@@ -355,45 +333,38 @@ JointAdjustmentSummary JointAdjuster::Run(
       stats.reprojection.num_observations = last->reprojection_ids.size();
       stats.depth.num_observations = last->depth_ids.size();
       stats.lidar.num_observations = last->lidar_ids.size();
-      stats.reprojection.cost_before =
-          TermCost(problem, last->reprojection_ids);
+      stats.reprojection.cost_before = TermCost(problem, last->reprojection_ids);
       stats.depth.cost_before = TermCost(problem, last->depth_ids);
       stats.lidar.cost_before = TermCost(problem, last->lidar_ids);
       const ceres::Solver::Options solver_options =
-          last->adjuster->SetUpSolverOptions(*problem,
-                                             last->ba_options.solver_options);
+          last->adjuster->SetUpSolverOptions(*problem, last->ba_options.solver_options);
       ceres::Solver::Summary solver_summary;
       ceres::Solve(solver_options, problem, &solver_summary);
       stats.reprojection.cost_after = TermCost(problem, last->reprojection_ids);
       stats.depth.cost_after = TermCost(problem, last->depth_ids);
       stats.lidar.cost_after = TermCost(problem, last->lidar_ids);
       stats.num_iterations = static_cast<int>(solver_summary.iterations.size());
-      stats.termination =
-          ceres::TerminationTypeToString(solver_summary.termination_type);
+      stats.termination = ceres::TerminationTypeToString(solver_summary.termination_type);
 
       // Outliers get weight zero: reprojection -> the observation leaves the reconstruction (as in
       // COLMAP's filtering); depth and LiDAR -> left out of the next build.
       size_t new_outliers = 0;
       const double max_squared_reprojection =
-          options_.max_reprojection_error_px *
-          options_.max_reprojection_error_px;
+          options_.max_reprojection_error_px * options_.max_reprojection_error_px;
       std::vector<ImagePoint> bad_observations;
       for (const auto& [point3D_id, point3D] : reconstruction->Points3D()) {
         for (const colmap::TrackElement& element : point3D.track.Elements()) {
           const colmap::Image& image = reconstruction->Image(element.image_id);
           const double squared_error =
-              colmap::CalculateSquaredReprojectionError(
-                  image.Point2D(element.point2D_idx).xy,
-                  point3D.xyz,
-                  image.CamFromWorld(),
-                  reconstruction->Camera(image.CameraId()));
+              colmap::CalculateSquaredReprojectionError(image.Point2D(element.point2D_idx).xy,
+                                                        point3D.xyz,
+                                                        image.CamFromWorld(),
+                                                        reconstruction->Camera(image.CameraId()));
           if (squared_error > max_squared_reprojection) {
-            bad_observations.emplace_back(element.image_id,
-                                          element.point2D_idx);
+            bad_observations.emplace_back(element.image_id, element.point2D_idx);
             continue;
           }
-          const DepthPrior* prior =
-              FindDepthPrior(data_, depth_outliers, element);
+          const DepthPrior* prior = FindDepthPrior(data_, depth_outliers, element);
           if (prior == nullptr) continue;
           const double depth = (image.CamFromWorld() * point3D.xyz).z();
           if (std::abs(depth - prior->depth) > options_.max_depth_error_m) {
@@ -411,10 +382,10 @@ JointAdjustmentSummary JointAdjuster::Run(
       }
       for (Observation& observation : observations) {
         if (observation.outlier) continue;
-        const colmap::Rigid3d target_from_source = LidarIFromLidarJ(
-            reconstruction->Image(observation.target).CamFromWorld(),
-            reconstruction->Image(observation.source).CamFromWorld(),
-            *cam_from_lidar);
+        const colmap::Rigid3d target_from_source =
+            LidarIFromLidarJ(reconstruction->Image(observation.target).CamFromWorld(),
+                             reconstruction->Image(observation.source).CamFromWorld(),
+                             *cam_from_lidar);
         const double distance = observation.data.normal_in_target.dot(
             target_from_source * observation.data.point_in_source -
             observation.data.point_in_target);
@@ -427,17 +398,14 @@ JointAdjustmentSummary JointAdjuster::Run(
       stats.reprojection.num_outliers = num_reprojection_outliers;
       stats.depth.num_outliers = depth_outliers.size();
       stats.lidar.num_outliers = num_lidar_outliers;
-      stats.seconds = std::chrono::duration<double>(
-                          std::chrono::steady_clock::now() - start)
-                          .count();
-      std::cout << std::defaultfloat << std::setprecision(4) << "  solve "
-                << stats.round << "." << stats.outlier_iteration
-                << ": cost reprojection " << stats.reprojection.cost_before
-                << " -> " << stats.reprojection.cost_after << ", depth "
-                << stats.depth.cost_before << " -> " << stats.depth.cost_after
-                << ", lidar " << stats.lidar.cost_before << " -> "
-                << stats.lidar.cost_after << "; " << stats.num_iterations
-                << " iterations, " << new_outliers << " new outliers ("
+      stats.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::cout << std::defaultfloat << std::setprecision(4) << "  solve " << stats.round << "."
+                << stats.outlier_iteration << ": cost reprojection "
+                << stats.reprojection.cost_before << " -> " << stats.reprojection.cost_after
+                << ", depth " << stats.depth.cost_before << " -> " << stats.depth.cost_after
+                << ", lidar " << stats.lidar.cost_before << " -> " << stats.lidar.cost_after << "; "
+                << stats.num_iterations << " iterations, " << new_outliers << " new outliers ("
                 << std::setprecision(2) << stats.seconds << " s)" << std::endl;
       summary.solves.push_back(stats);
       if (new_outliers == 0) break;
@@ -472,26 +440,22 @@ JointAdjustmentSummary JointAdjuster::Run(
       for (size_t k = 0; k < last->depth_ids.size(); ++k) {
         per_image[last->depth_images[k]].push_back(last->depth_ids[k]);
       }
-      std::map<std::pair<colmap::image_t, colmap::image_t>,
-               std::vector<ceres::ResidualBlockId>>
+      std::map<std::pair<colmap::image_t, colmap::image_t>, std::vector<ceres::ResidualBlockId>>
           per_pair;
       for (size_t k = 0; k < last->lidar_ids.size(); ++k) {
         per_pair[last->lidar_pairs[k]].push_back(last->lidar_ids[k]);
       }
-      for (auto& [image_id, ids] : per_image)
-        clusters.push_back(std::move(ids));
+      for (auto& [image_id, ids] : per_image) clusters.push_back(std::move(ids));
       for (auto& [pair, ids] : per_pair) clusters.push_back(std::move(ids));
       clusters.push_back(last->prior_ids);
       clusters.erase(
-          std::remove_if(clusters.begin(),
-                         clusters.end(),
-                         [](const auto& ids) { return ids.empty(); }),
+          std::remove_if(
+              clusters.begin(), clusters.end(), [](const auto& ids) { return ids.empty(); }),
           clusters.end());
     }
     std::unordered_map<ceres::ResidualBlockId, double> depth_scale_derivative;
     for (size_t k = 0; k < last->depth_ids.size(); ++k) {
-      depth_scale_derivative[last->depth_ids[k]] =
-          last->depth_scale_derivatives[k];
+      depth_scale_derivative[last->depth_ids[k]] = last->depth_scale_derivatives[k];
     }
     summary.uncertainty = ComputeExtrinsicUncertainty(problem,
                                                       extrinsic_rotation,
@@ -512,8 +476,8 @@ JointAdjustmentSummary JointAdjuster::Run(
 
     // The seed's perturbation curves: only E_l depends on T_e, so the total is the rest (constant) plus
     // the LiDAR term at the perturbed T_e.
-    const double rest = TermCost(problem, last->reprojection_ids) +
-                        TermCost(problem, last->depth_ids);
+    const double rest =
+        TermCost(problem, last->reprojection_ids) + TermCost(problem, last->depth_ids);
     const colmap::Rigid3d optimum = *cam_from_lidar;
     static const char* kNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
     for (int dof = 0; dof < 6; ++dof) {
@@ -527,8 +491,7 @@ JointAdjustmentSummary JointAdjuster::Run(
         } else {
           const Eigen::Vector3d axis = Eigen::Vector3d::Unit(dof - 3);
           cam_from_lidar->rotation =
-              Eigen::Quaterniond(Eigen::AngleAxisd(offset * M_PI / 180, axis)) *
-              optimum.rotation;
+              Eigen::Quaterniond(Eigen::AngleAxisd(offset * M_PI / 180, axis)) * optimum.rotation;
         }
         curve.offsets.push_back(offset);
         curve.costs.push_back(rest + TermCost(problem, last->lidar_ids));

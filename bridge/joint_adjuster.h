@@ -45,8 +45,7 @@ enum class JointMode {
   kPrecalibrated,  // T_e held constant
   kStereoOnly,     // no LiDAR term (weight 0), T_e constant
 };
-JointMode JointModeFromName(
-    const std::string& name);  // joint | precalibrated | stereo_only
+JointMode JointModeFromName(const std::string& name);  // joint | precalibrated | stereo_only
 std::string JointModeName(JointMode mode);
 
 struct JointAdjusterOptions {
@@ -55,9 +54,8 @@ struct JointAdjusterOptions {
   double sigma_lidar_m = 0.02;  // seed: 0.02 - 0.1 m
   double depth_weight = 1.0;    // w_c of E_d (E_f keeps weight 1)
   double lidar_weight = 1.0;    // w_l
-  std::string loss =
-      "none";  // none | huber | cauchy (on every term; off in the seed)
-  double loss_scale = 1.0;  // in units of the whitened residual
+  std::string loss = "none";    // none | huber | cauchy (on every term; off in the seed)
+  double loss_scale = 1.0;      // in units of the whitened residual
   // Outliers (zero weight until none remain).
   double max_reprojection_error_px = 3.0;
   double max_depth_error_m = 0.01;
@@ -65,8 +63,7 @@ struct JointAdjusterOptions {
   int max_outlier_iterations = 10;
   // ICP-like re-association of the LiDAR observations.
   int num_association_rounds = 4;
-  AssociationOptions
-      association;  // num_samples per directed pair; max_distance = final gate
+  AssociationOptions association;  // num_samples per directed pair; max_distance = final gate
   double initial_association_distance_m =
       0.5;  // gate of round 0, halved per round down to max_distance
   // Extrinsic degrees of freedom held constant in joint mode (users ask for it): rotation as a whole,
@@ -85,8 +82,7 @@ struct JointAdjusterOptions {
 // What the joint problem needs besides COLMAP's reconstruction.
 struct JointProblemData {
   // Depth priors per image, keyed by point2D_idx.
-  std::unordered_map<colmap::image_t,
-                     std::unordered_map<colmap::point2D_t, DepthPrior>>
+  std::unordered_map<colmap::image_t, std::unordered_map<colmap::point2D_t, DepthPrior>>
       depth_priors;
   // Each station's cloud (lidar frame, normals, k-d tree), keyed by image_id; not owned.
   std::map<colmap::image_t, const StationCloud*> clouds;
@@ -111,8 +107,7 @@ struct SolveStats {
 };
 
 struct PerturbationCurve {
-  std::string
-      parameter;  // x y z [mm] or roll pitch yaw [deg] (about the camera x, y, z axes)
+  std::string parameter;  // x y z [mm] or roll pitch yaw [deg] (about the camera x, y, z axes)
   std::vector<double> offsets;
   std::vector<double> costs;  // total cost, everything else at the optimum
 };
@@ -126,8 +121,7 @@ struct JointAdjustmentSummary {
 
 class JointAdjuster {
  public:
-  JointAdjuster(const JointAdjusterOptions& options,
-                const JointProblemData& data);
+  JointAdjuster(const JointAdjusterOptions& options, const JointProblemData& data);
 
   // Refines `reconstruction` (poses, landmarks) and `cam_from_lidar` in place. Prints a line per solve.
   JointAdjustmentSummary Run(colmap::Reconstruction* reconstruction,
@@ -139,10 +133,9 @@ class JointAdjuster {
     PointToPlaneObservation data;
     bool outlier = false;
   };
-  std::vector<Observation> Associate(
-      const colmap::Reconstruction& reconstruction,
-      const colmap::Rigid3d& cam_from_lidar,
-      double max_distance) const;
+  std::vector<Observation> Associate(const colmap::Reconstruction& reconstruction,
+                                     const colmap::Rigid3d& cam_from_lidar,
+                                     double max_distance) const;
 
   const JointAdjusterOptions options_;
   const JointProblemData& data_;

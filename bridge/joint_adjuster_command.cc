@@ -100,22 +100,18 @@ void WriteReport(const std::string& directory,
   }
   report["solves"] = solves;
   const ExtrinsicUncertainty& u = summary.uncertainty;
-  nlohmann::json uncertainty = {{"computed", u.computed},
-                                {"message", u.message}};
+  nlohmann::json uncertainty = {{"computed", u.computed}, {"message", u.message}};
   if (u.computed) {
     uncertainty["variance_factor"] = u.variance_factor;
     uncertainty["covariance_deg_mm"] = MatrixJson(u.covariance);
     uncertainty["cluster_robust"] = u.cluster_robust;
-    uncertainty["stereo_scale_sigma"] =
-        options.observability.stereo_scale_sigma;
+    uncertainty["stereo_scale_sigma"] = options.observability.stereo_scale_sigma;
     uncertainty["stereo_scale_sensitivity_deg_mm"] =
         MatrixJson(u.stereo_scale_sensitivity.transpose());
     uncertainty["num_clusters"] = u.num_clusters;
     uncertainty["formal_covariance_deg_mm"] = MatrixJson(u.formal_covariance);
-    const Eigen::VectorXd formal_sigma =
-        u.formal_covariance.diagonal().cwiseSqrt();
-    uncertainty["formal_sigma_rotation_deg"] = {
-        formal_sigma[0], formal_sigma[1], formal_sigma[2]};
+    const Eigen::VectorXd formal_sigma = u.formal_covariance.diagonal().cwiseSqrt();
+    uncertainty["formal_sigma_rotation_deg"] = {formal_sigma[0], formal_sigma[1], formal_sigma[2]};
     uncertainty["formal_sigma_translation_mm"] = {
         formal_sigma[3], formal_sigma[4], formal_sigma[5]};
     const Eigen::VectorXd sigma = u.covariance.diagonal().cwiseSqrt();
@@ -133,33 +129,28 @@ void WriteReport(const std::string& directory,
                       {"verdict", summary.motion.verdict}};
   std::string verdict;
   if (options.mode != JointMode::kJoint) {
-    verdict =
-        "cam_from_lidar held constant (" + JointModeName(options.mode) + ")";
+    verdict = "cam_from_lidar held constant (" + JointModeName(options.mode) + ")";
   } else if (u.unobservable.empty() && summary.motion.unique) {
     verdict = "cam_from_lidar is observable";
   } else {
-    verdict = u.unobservable.empty() ? summary.motion.verdict
-                                     : u.unobservable.front();
+    verdict = u.unobservable.empty() ? summary.motion.verdict : u.unobservable.front();
   }
   report["observability_verdict"] = verdict;
   nlohmann::json curves = nlohmann::json::array();
   for (const PerturbationCurve& curve : summary.perturbation) {
-    curves.push_back({{"parameter", curve.parameter},
-                      {"offsets", curve.offsets},
-                      {"costs", curve.costs}});
+    curves.push_back(
+        {{"parameter", curve.parameter}, {"offsets", curve.offsets}, {"costs", curve.costs}});
   }
   report["perturbation"] = curves;
   WriteFileAtomically(directory + "/report.json", report.dump(2) + "\n");
 }
 
-void WritePlots(const std::string& directory,
-                const JointAdjustmentSummary& summary) {
+void WritePlots(const std::string& directory, const JointAdjustmentSummary& summary) {
   PlotSeries total{"total cost", {}, {}};
   for (size_t k = 0; k < summary.solves.size(); ++k) {
     const SolveStats& s = summary.solves[k];
     total.x.push_back(static_cast<double>(k + 1));
-    total.y.push_back(s.reprojection.cost_after + s.depth.cost_after +
-                      s.lidar.cost_after);
+    total.y.push_back(s.reprojection.cost_after + s.depth.cost_after + s.lidar.cost_after);
   }
   LinePlotOptions cost_options;
   cost_options.title = "Joint problem: cost after each solve";
@@ -178,8 +169,8 @@ void WritePlots(const std::string& directory,
     PlotSeries series{curve.parameter, curve.offsets, curve.costs};
     (curve.parameter.size() == 1 ? translation : rotation).push_back(series);
     for (size_t k = 0; k < curve.offsets.size(); ++k) {
-      csv << curve.parameter << "," << curve.offsets[k] << ","
-          << std::setprecision(10) << curve.costs[k] << "\n";
+      csv << curve.parameter << "," << curve.offsets[k] << "," << std::setprecision(10)
+          << curve.costs[k] << "\n";
     }
   }
   WriteFileAtomically(directory + "/perturbation.csv", csv.str());
@@ -187,8 +178,7 @@ void WritePlots(const std::string& directory,
   plot.title = "Cost vs cam_from_lidar translation offset";
   plot.x_label = "offset [mm]";
   plot.y_label = "total cost";
-  WriteLinePlotPng(
-      directory + "/perturbation_translation.png", translation, plot);
+  WriteLinePlotPng(directory + "/perturbation_translation.png", translation, plot);
   plot.title = "Cost vs cam_from_lidar rotation offset";
   plot.x_label = "offset [deg]";
   WriteLinePlotPng(directory + "/perturbation_rotation.png", rotation, plot);
@@ -207,8 +197,7 @@ int RunJointAdjuster(int argc, char** argv) {
   options.AddRequiredOption("input_path", &input_path);
   options.AddRequiredOption("dataset_path", &dataset_path);
   options.AddRequiredOption("output_path", &output_path);
-  options.AddDefaultOption(
-      "mode", &mode, "joint | precalibrated | stereo_only");
+  options.AddDefaultOption("mode", &mode, "joint | precalibrated | stereo_only");
   options.AddDefaultOption("cam_from_lidar",
                            &cam_from_lidar_path,
                            "qw qx qy qz tx ty tz file; default: "
@@ -220,32 +209,23 @@ int RunJointAdjuster(int argc, char** argv) {
   options.AddDefaultOption("lidar_weight", &adjuster.lidar_weight);
   options.AddDefaultOption("loss", &adjuster.loss, "none | huber | cauchy");
   options.AddDefaultOption("loss_scale", &adjuster.loss_scale);
-  options.AddDefaultOption("max_reprojection_error_px",
-                           &adjuster.max_reprojection_error_px);
+  options.AddDefaultOption("max_reprojection_error_px", &adjuster.max_reprojection_error_px);
   options.AddDefaultOption("max_depth_error_m", &adjuster.max_depth_error_m);
-  options.AddDefaultOption("max_point_to_plane_m",
-                           &adjuster.max_point_to_plane_m);
-  options.AddDefaultOption("num_association_rounds",
-                           &adjuster.num_association_rounds);
+  options.AddDefaultOption("max_point_to_plane_m", &adjuster.max_point_to_plane_m);
+  options.AddDefaultOption("num_association_rounds", &adjuster.num_association_rounds);
   int num_samples = static_cast<int>(adjuster.association.num_samples);
   options.AddDefaultOption("num_samples_per_pair", &num_samples);
-  options.AddDefaultOption("association_max_distance_m",
-                           &adjuster.association.max_distance);
+  options.AddDefaultOption("association_max_distance_m", &adjuster.association.max_distance);
   options.AddDefaultOption("initial_association_distance_m",
                            &adjuster.initial_association_distance_m);
   options.AddDefaultOption("hold_rotation", &adjuster.hold_rotation);
-  options.AddDefaultOption("hold_translation",
-                           &hold_translation,
-                           "comma-separated camera axes, e.g. y or x,z");
+  options.AddDefaultOption(
+      "hold_translation", &hold_translation, "comma-separated camera axes, e.g. y or x,z");
   options.AddDefaultOption("max_num_iterations", &adjuster.max_num_iterations);
-  options.AddDefaultOption("extrinsic_prior_sigma_m",
-                           &adjuster.extrinsic_prior_sigma_m);
-  options.AddDefaultOption("min_image_pair_inliers",
-                           &data_options.min_image_pair_inliers);
-  options.AddDefaultOption("max_lidar_neighbors",
-                           &data_options.max_lidar_neighbors);
-  options.AddDefaultOption("stereo_scale_sigma",
-                           &adjuster.observability.stereo_scale_sigma);
+  options.AddDefaultOption("extrinsic_prior_sigma_m", &adjuster.extrinsic_prior_sigma_m);
+  options.AddDefaultOption("min_image_pair_inliers", &data_options.min_image_pair_inliers);
+  options.AddDefaultOption("max_lidar_neighbors", &data_options.max_lidar_neighbors);
+  options.AddDefaultOption("stereo_scale_sigma", &adjuster.observability.stereo_scale_sigma);
   options.AddDefaultOption("unobservable_translation_mm",
                            &adjuster.observability.unobservable_translation_mm);
   options.AddDefaultOption("unobservable_rotation_deg",
@@ -259,15 +239,13 @@ int RunJointAdjuster(int argc, char** argv) {
   const auto start = std::chrono::steady_clock::now();
 
   const StationDataset dataset = ReadStationDataset(dataset_path);
-  THROW_CHECK(fs::is_directory(input_path))
-      << "no sparse model folder " << input_path;
+  THROW_CHECK(fs::is_directory(input_path)) << "no sparse model folder " << input_path;
   colmap::Reconstruction reconstruction;
   reconstruction.Read(input_path);
   THROW_CHECK_GE(reconstruction.NumRegImages(), 2)
       << input_path << " has fewer than 2 registered images";
   colmap::Rigid3d cam_from_lidar;
-  const std::string model_extrinsic =
-      (fs::path(input_path) / "cam_from_lidar.txt").string();
+  const std::string model_extrinsic = (fs::path(input_path) / "cam_from_lidar.txt").string();
   if (!cam_from_lidar_path.empty()) {
     cam_from_lidar = ReadPoseFile(cam_from_lidar_path);
   } else if (fs::exists(model_extrinsic)) {
@@ -281,8 +259,7 @@ int RunJointAdjuster(int argc, char** argv) {
         dataset.root + "/rig.json");
   }
   const colmap::Rigid3d initial = cam_from_lidar;
-  std::cout << "Joint adjuster (" << mode
-            << "): " << reconstruction.NumRegImages() << " images, "
+  std::cout << "Joint adjuster (" << mode << "): " << reconstruction.NumRegImages() << " images, "
             << reconstruction.NumPoints3D() << " landmarks" << std::endl;
   const std::unique_ptr<LoadedJointData> loaded =
       LoadJointProblemData(*options.database_path,
@@ -293,8 +270,7 @@ int RunJointAdjuster(int argc, char** argv) {
                            data_options);
 
   JointAdjuster joint_adjuster(adjuster, loaded->data);
-  const JointAdjustmentSummary summary =
-      joint_adjuster.Run(&reconstruction, &cam_from_lidar);
+  const JointAdjustmentSummary summary = joint_adjuster.Run(&reconstruction, &cam_from_lidar);
 
   // Everything into OUTPUT.partial, renamed at the end: never a half-written output folder.
   const fs::path output(output_path);
@@ -303,31 +279,27 @@ int RunJointAdjuster(int argc, char** argv) {
   fs::create_directories(partial);
   reconstruction.WriteBinary(partial.string());
   if (write_text) reconstruction.WriteText(partial.string());
-  WritePoseFile((partial / "cam_from_lidar.txt").string(),
-                "cam_from_lidar refined by colmap-lidar joint_adjuster (" +
-                    mode + "); qw qx qy qz tx ty tz",
-                cam_from_lidar);
-  WriteReport(
-      partial.string(), adjuster, *loaded, initial, cam_from_lidar, summary);
+  WritePoseFile(
+      (partial / "cam_from_lidar.txt").string(),
+      "cam_from_lidar refined by colmap-lidar joint_adjuster (" + mode + "); qw qx qy qz tx ty tz",
+      cam_from_lidar);
+  WriteReport(partial.string(), adjuster, *loaded, initial, cam_from_lidar, summary);
   WritePlots(partial.string(), summary);
   fs::remove_all(output);
   fs::rename(partial, output);
 
   std::cout << "Motion: " << summary.motion.verdict << std::endl;
   if (summary.uncertainty.computed) {
-    const Eigen::VectorXd sigma =
-        summary.uncertainty.covariance.diagonal().cwiseSqrt();
+    const Eigen::VectorXd sigma = summary.uncertainty.covariance.diagonal().cwiseSqrt();
     std::cout << std::setprecision(3) << "cam_from_lidar sigma: rotation "
-              << sigma.head<3>().transpose() << " deg, translation "
-              << sigma.tail<3>().transpose() << " mm" << std::endl;
+              << sigma.head<3>().transpose() << " deg, translation " << sigma.tail<3>().transpose()
+              << " mm" << std::endl;
   }
   for (const std::string& sentence : summary.uncertainty.unobservable) {
     std::cout << "UNOBSERVABLE: " << sentence << std::endl;
   }
   std::cout << "Wrote " << output_path << " ("
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                             start)
-                   .count()
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
             << " s)" << std::endl;
   return EXIT_SUCCESS;
 }

@@ -24,8 +24,7 @@ double Overlap(const StationCloud& target,
   const size_t num_samples = std::min<size_t>(500, n);
   size_t num_close = 0;
   for (size_t k = 0; k < num_samples; ++k) {
-    const Eigen::Vector3d point =
-        target_from_source * source.cloud.points[k * n / num_samples];
+    const Eigen::Vector3d point = target_from_source * source.cloud.points[k * n / num_samples];
     size_t index = 0;
     double squared_distance = 0;
     if (target.tree->Nearest(point, &index, &squared_distance) &&
@@ -47,13 +46,12 @@ bool JointDataOptions::Check() const {
   return true;
 }
 
-std::unique_ptr<LoadedJointData> LoadJointProblemData(
-    const std::string& database_path,
-    const StationDataset& dataset,
-    const colmap::Reconstruction& reconstruction,
-    const colmap::Rigid3d& cam_from_lidar,
-    bool load_clouds,
-    const JointDataOptions& options) {
+std::unique_ptr<LoadedJointData> LoadJointProblemData(const std::string& database_path,
+                                                      const StationDataset& dataset,
+                                                      const colmap::Reconstruction& reconstruction,
+                                                      const colmap::Rigid3d& cam_from_lidar,
+                                                      bool load_clouds,
+                                                      const JointDataOptions& options) {
   THROW_CHECK(options.Check());
   THROW_CHECK(fs::is_regular_file(database_path))
       << "Database file does not exist: " << database_path;
@@ -69,8 +67,8 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(
     const std::string& name = reconstruction.Image(image_id).Name();
     const auto it = station_index.find(fs::path(name).stem().string());
     if (it == station_index.end()) {
-      throw std::runtime_error("registered image '" + name +
-                               "' is not a station of " + dataset.root);
+      throw std::runtime_error("registered image '" + name + "' is not a station of " +
+                               dataset.root);
     }
     station_of_image[image_id] = it->second;
   }
@@ -80,20 +78,17 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(
     const colmap::Database database(database_path);
     for (const colmap::image_t image_id : image_ids) {
       const std::string& name = reconstruction.Image(image_id).Name();
-      if (!database.ExistsImage(image_id) ||
-          database.ReadImage(image_id).Name() != name) {
-        throw std::runtime_error(
-            "image " + std::to_string(image_id) + " ('" + name +
-            "') of the model is not the same image in " + database_path +
-            ": the model was not made from this database");
+      if (!database.ExistsImage(image_id) || database.ReadImage(image_id).Name() != name) {
+        throw std::runtime_error("image " + std::to_string(image_id) + " ('" + name +
+                                 "') of the model is not the same image in " + database_path +
+                                 ": the model was not made from this database");
       }
     }
   }
 
   // Depth priors.
   {
-    const ExtensionDatabase extension(database_path,
-                                      ExtensionDatabase::Mode::kReadOnly);
+    const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
     size_t num_priors = 0;
     for (const colmap::image_t image_id : image_ids) {
       auto& priors = loaded->data.depth_priors[image_id];
@@ -135,23 +130,20 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(
     const PointCloud raw = ReadPointCloud(dataset.cloud_paths[station]);
     loaded->clouds.push_back(PrepareStationCloud(raw, cloud_options));
     loaded->data.clouds[image_id] = loaded->clouds.back().get();
-    std::cout << "  cloud " << dataset.stations[station] << ": " << raw.Size()
-              << " points -> " << loaded->clouds.back()->cloud.Size()
-              << " after " << options.voxel_size_m << " m voxels" << std::endl;
+    std::cout << "  cloud " << dataset.stations[station] << ": " << raw.Size() << " points -> "
+              << loaded->clouds.back()->cloud.Size() << " after " << options.voxel_size_m
+              << " m voxels" << std::endl;
   }
 
   // A_l: overlapping clouds under the initial estimate; each station keeps its `max_lidar_neighbors`
   // most overlapping partners (all stations of a courtyard overlap; the term needs a connected graph,
   // not every pair).
-  std::vector<std::vector<std::pair<double, size_t>>> partners(
-      image_ids.size());
+  std::vector<std::vector<std::pair<double, size_t>>> partners(image_ids.size());
   for (size_t a = 0; a < image_ids.size(); ++a) {
     for (size_t b = a + 1; b < image_ids.size(); ++b) {
       const colmap::Rigid3d lidar_a_from_lidar_b =
-          colmap::Inverse(cam_from_lidar) *
-          reconstruction.Image(image_ids[a]).CamFromWorld() *
-          colmap::Inverse(reconstruction.Image(image_ids[b]).CamFromWorld()) *
-          cam_from_lidar;
+          colmap::Inverse(cam_from_lidar) * reconstruction.Image(image_ids[a]).CamFromWorld() *
+          colmap::Inverse(reconstruction.Image(image_ids[b]).CamFromWorld()) * cam_from_lidar;
       const double overlap = Overlap(*loaded->data.clouds.at(image_ids[a]),
                                      *loaded->data.clouds.at(image_ids[b]),
                                      lidar_a_from_lidar_b,
@@ -165,21 +157,19 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(
   std::set<std::pair<colmap::image_t, colmap::image_t>> lidar_pairs;
   for (size_t a = 0; a < image_ids.size(); ++a) {
     std::sort(partners[a].rbegin(), partners[a].rend());
-    for (size_t k = 0; k < partners[a].size() &&
-                       k < static_cast<size_t>(options.max_lidar_neighbors);
+    for (size_t k = 0;
+         k < partners[a].size() && k < static_cast<size_t>(options.max_lidar_neighbors);
          ++k) {
       const colmap::image_t other = image_ids[partners[a][k].second];
-      lidar_pairs.insert(
-          {std::min(image_ids[a], other), std::max(image_ids[a], other)});
+      lidar_pairs.insert({std::min(image_ids[a], other), std::max(image_ids[a], other)});
     }
   }
   const size_t num_lidar_pairs = lidar_pairs.size();
   pairs.insert(lidar_pairs.begin(), lidar_pairs.end());
   loaded->num_lidar_pairs = num_lidar_pairs;
   loaded->data.pairs.assign(pairs.begin(), pairs.end());
-  std::cout << "Pose graph: " << loaded->num_image_pairs
-            << " image pairs (A_c), " << num_lidar_pairs
-            << " overlapping LiDAR pairs (A_l), " << loaded->data.pairs.size()
+  std::cout << "Pose graph: " << loaded->num_image_pairs << " image pairs (A_c), "
+            << num_lidar_pairs << " overlapping LiDAR pairs (A_l), " << loaded->data.pairs.size()
             << " pairs in A_c v A_l" << std::endl;
   return loaded;
 }

@@ -27,8 +27,7 @@ struct JointDataOptions {
 
 struct LoadedJointData {
   JointProblemData data;
-  std::vector<std::unique_ptr<StationCloud>>
-      clouds;  // owns what data.clouds points to
+  std::vector<std::unique_ptr<StationCloud>> clouds;  // owns what data.clouds points to
   size_t num_image_pairs = 0;
   size_t num_lidar_pairs = 0;
 };
@@ -36,12 +35,11 @@ struct LoadedJointData {
 // Station of each registered image: image name "left/<station>.png" (or any name whose stem is a station).
 // Throws naming the image if a registered image is not a station of the dataset, or naming the cloud if
 // one cannot be read.
-std::unique_ptr<LoadedJointData> LoadJointProblemData(
-    const std::string& database_path,
-    const StationDataset& dataset,
-    const colmap::Reconstruction& reconstruction,
-    const colmap::Rigid3d& cam_from_lidar,
-    bool load_clouds,
-    const JointDataOptions& options);
+std::unique_ptr<LoadedJointData> LoadJointProblemData(const std::string& database_path,
+                                                      const StationDataset& dataset,
+                                                      const colmap::Reconstruction& reconstruction,
+                                                      const colmap::Rigid3d& cam_from_lidar,
+                                                      bool load_clouds,
+                                                      const JointDataOptions& options);
 
 }  // namespace colmap_lidar

@@ -19,21 +19,16 @@ namespace {
 namespace fs = std::filesystem;
 
 colmap::Rigid3d ToRigid3d(const Eigen::Isometry3d& pose) {
-  return colmap::Rigid3d(Eigen::Quaterniond(pose.linear()).normalized(),
-                         pose.translation());
+  return colmap::Rigid3d(Eigen::Quaterniond(pose.linear()).normalized(), pose.translation());
 }
 
-std::string PairLine(const std::string& target,
-                     const std::string& source,
-                     const LidarEdge& e) {
+std::string PairLine(const std::string& target, const std::string& source, const LidarEdge& e) {
   const colmap::Rigid3d pose = ToRigid3d(e.target_from_source);
   std::ostringstream line;
-  line << target << " " << source << std::setprecision(12) << " "
-       << pose.rotation.w() << " " << pose.rotation.x() << " "
-       << pose.rotation.y() << " " << pose.rotation.z() << " "
-       << pose.translation.x() << " " << pose.translation.y() << " "
-       << pose.translation.z() << " " << e.registration.num_inliers << " "
-       << std::setprecision(4) << e.registration.overlap << " "
+  line << target << " " << source << std::setprecision(12) << " " << pose.rotation.w() << " "
+       << pose.rotation.x() << " " << pose.rotation.y() << " " << pose.rotation.z() << " "
+       << pose.translation.x() << " " << pose.translation.y() << " " << pose.translation.z() << " "
+       << e.registration.num_inliers << " " << std::setprecision(4) << e.registration.overlap << " "
        << e.registration.rmse;
   return line.str();
 }
@@ -46,19 +41,13 @@ int RunLidarRegistrator(int argc, char** argv) {
   StationCloudOptions cloud_options;
   int max_neighbors = 0;
   colmap::OptionManager manager;
-  manager.AddRequiredOption(
-      "lidar_path", &lidar_path, "folder of station clouds (.pcd/.ply/.bin)");
-  manager.AddRequiredOption(
-      "output_path", &output_path, "folder for pairs.txt, lidar_poses.txt");
+  manager.AddRequiredOption("lidar_path", &lidar_path, "folder of station clouds (.pcd/.ply/.bin)");
+  manager.AddRequiredOption("output_path", &output_path, "folder for pairs.txt, lidar_poses.txt");
+  manager.AddDefaultOption("voxel_size", &cloud_options.voxel_size, "ICP/normals voxel [m]");
+  manager.AddDefaultOption("feature_voxel_size", &cloud_options.feature_voxel_size);
+  manager.AddDefaultOption("bsc_support_radius", &cloud_options.bsc.support_radius);
   manager.AddDefaultOption(
-      "voxel_size", &cloud_options.voxel_size, "ICP/normals voxel [m]");
-  manager.AddDefaultOption("feature_voxel_size",
-                           &cloud_options.feature_voxel_size);
-  manager.AddDefaultOption("bsc_support_radius",
-                           &cloud_options.bsc.support_radius);
-  manager.AddDefaultOption("max_neighbors",
-                           &max_neighbors,
-                           "0: all pairs; k: the k most similar stations each");
+      "max_neighbors", &max_neighbors, "0: all pairs; k: the k most similar stations each");
   manager.AddDefaultOption("min_overlap", &graph_options.pair.min_overlap);
   manager.AddDefaultOption("max_rmse", &graph_options.pair.max_rmse);
   manager.Parse(argc, argv);
@@ -68,16 +57,13 @@ int RunLidarRegistrator(int argc, char** argv) {
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(lidar_path)) {
     const std::string ext = entry.path().extension().string();
-    if (ext == ".pcd" || ext == ".ply" || ext == ".bin")
-      files.push_back(entry.path());
+    if (ext == ".pcd" || ext == ".ply" || ext == ".bin") files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end());
   THROW_CHECK_GE(files.size(), 2) << "Fewer than 2 clouds in " << lidar_path;
   const auto start = std::chrono::steady_clock::now();
   auto seconds = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                         start)
-        .count();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   std::vector<std::string> names;
   std::vector<std::unique_ptr<StationCloud>> stations;
@@ -86,22 +72,20 @@ int RunLidarRegistrator(int argc, char** argv) {
     const PointCloud raw = ReadPointCloud(file.string(), &stats);
     stations.push_back(PrepareStationCloud(raw, cloud_options));
     names.push_back(file.stem().string());
-    std::cout << "lidar_registrator: " << names.back() << ": " << raw.Size()
-              << " points (" << stats.num_dropped_non_finite
-              << " non-finite dropped), " << stations.back()->cloud.Size()
-              << " after voxel " << cloud_options.voxel_size << " m, "
-              << stations.back()->features.size() << " BSC features ["
-              << std::fixed << std::setprecision(1) << seconds() << " s]"
-              << std::defaultfloat << std::setprecision(6) << std::endl;
+    std::cout << "lidar_registrator: " << names.back() << ": " << raw.Size() << " points ("
+              << stats.num_dropped_non_finite << " non-finite dropped), "
+              << stations.back()->cloud.Size() << " after voxel " << cloud_options.voxel_size
+              << " m, " << stations.back()->features.size() << " BSC features [" << std::fixed
+              << std::setprecision(1) << seconds() << " s]" << std::defaultfloat
+              << std::setprecision(6) << std::endl;
   }
   std::vector<const StationCloud*> pointers;
   for (const auto& s : stations) pointers.push_back(s.get());
-  const LidarGraph graph = RegisterAllStations(
-      pointers, graph_options, [&](size_t done, size_t total) {
+  const LidarGraph graph =
+      RegisterAllStations(pointers, graph_options, [&](size_t done, size_t total) {
         if (done % 10 == 0 || done == total) {
-          std::cout << "lidar_registrator: registered " << done << "/" << total
-                    << " pairs [" << std::fixed << std::setprecision(1)
-                    << seconds() << " s]" << std::defaultfloat
+          std::cout << "lidar_registrator: registered " << done << "/" << total << " pairs ["
+                    << std::fixed << std::setprecision(1) << seconds() << " s]" << std::defaultfloat
                     << std::setprecision(6) << std::endl;
         }
       });
@@ -118,20 +102,17 @@ int RunLidarRegistrator(int argc, char** argv) {
     pairs << "# refused " << names[e.target] << " " << names[e.source] << ": "
           << e.registration.reason << "\n";
   }
-  WriteFileAtomically((fs::path(output_path) / "pairs.txt").string(),
-                      pairs.str());
+  WriteFileAtomically((fs::path(output_path) / "pairs.txt").string(), pairs.str());
   std::map<std::string, colmap::Rigid3d> poses;
-  for (size_t i = 0; i < names.size(); ++i)
-    poses[names[i]] = ToRigid3d(graph.world_from_lidar[i]);
+  for (size_t i = 0; i < names.size(); ++i) poses[names[i]] = ToRigid3d(graph.world_from_lidar[i]);
   WriteNamedPoses((fs::path(output_path) / "lidar_poses.txt").string(),
                   "LiDAR station poses world_from_lidar (world = first station "
                   "of each component)",
                   poses);
   std::ostringstream summary;
   summary << "stations " << names.size() << "\npairs_attempted "
-          << graph.edges.size() + graph.refused.size() << "\nedges_accepted "
-          << graph.edges.size() << "\ncomponents " << graph.num_components
-          << "\n";
+          << graph.edges.size() + graph.refused.size() << "\nedges_accepted " << graph.edges.size()
+          << "\ncomponents " << graph.num_components << "\n";
   for (int c = 0; c < graph.num_components; ++c) {
     summary << "component " << c << ":";
     for (size_t i = 0; i < names.size(); ++i) {
@@ -140,14 +121,12 @@ int RunLidarRegistrator(int argc, char** argv) {
     summary << "\n";
   }
   summary << "pose_graph_cost_initial " << graph.refinement_initial_cost
-          << "\npose_graph_cost_final " << graph.refinement_final_cost
-          << "\nseconds " << seconds() << "\n";
-  WriteFileAtomically((fs::path(output_path) / "summary.txt").string(),
-                      summary.str());
+          << "\npose_graph_cost_final " << graph.refinement_final_cost << "\nseconds " << seconds()
+          << "\n";
+  WriteFileAtomically((fs::path(output_path) / "summary.txt").string(), summary.str());
   std::cout << summary.str();
   if (graph.num_components > 1) {
-    std::cout << "lidar_registrator: WARNING: the stations form "
-              << graph.num_components
+    std::cout << "lidar_registrator: WARNING: the stations form " << graph.num_components
               << " disconnected components (see summary.txt)" << std::endl;
   }
   return EXIT_SUCCESS;

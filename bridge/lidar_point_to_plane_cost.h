@@ -35,10 +35,9 @@ class LidarPointToPlaneCostFunctor {
                                      const Eigen::Vector3d& point_in_lidar_i,
                                      const Eigen::Vector3d& normal_in_lidar_i,
                                      double sigma) {
-    return new ceres::
-        AutoDiffCostFunction<LidarPointToPlaneCostFunctor, 1, 4, 3, 4, 3, 4, 3>(
-            new LidarPointToPlaneCostFunctor(
-                point_in_lidar_j, point_in_lidar_i, normal_in_lidar_i, sigma));
+    return new ceres::AutoDiffCostFunction<LidarPointToPlaneCostFunctor, 1, 4, 3, 4, 3, 4, 3>(
+        new LidarPointToPlaneCostFunctor(
+            point_in_lidar_j, point_in_lidar_i, normal_in_lidar_i, sigma));
   }
 
   template <typename T>
@@ -50,28 +49,22 @@ class LidarPointToPlaneCostFunctor {
                   const T* const cam_from_lidar_translation,
                   T* residual) const {
     using Vector3 = Eigen::Matrix<T, 3, 1>;
-    const auto cam_from_lidar_q =
-        colmap::EigenQuaternionMap<T>(cam_from_lidar_rotation);
-    const auto cam_from_lidar_t =
-        colmap::EigenVector3Map<T>(cam_from_lidar_translation);
+    const auto cam_from_lidar_q = colmap::EigenQuaternionMap<T>(cam_from_lidar_rotation);
+    const auto cam_from_lidar_t = colmap::EigenVector3Map<T>(cam_from_lidar_translation);
     // p: lidar_j -> cam_j -> world -> cam_i.
     const Vector3 point_in_cam_j =
         cam_from_lidar_q * point_in_lidar_j_.cast<T>() + cam_from_lidar_t;
     const Vector3 point_in_world =
         colmap::EigenQuaternionMap<T>(cam_j_from_world_rotation).conjugate() *
-        (point_in_cam_j -
-         colmap::EigenVector3Map<T>(cam_j_from_world_translation));
+        (point_in_cam_j - colmap::EigenVector3Map<T>(cam_j_from_world_translation));
     const Vector3 point_in_cam_i =
-        colmap::EigenQuaternionMap<T>(cam_i_from_world_rotation) *
-            point_in_world +
+        colmap::EigenQuaternionMap<T>(cam_i_from_world_rotation) * point_in_world +
         colmap::EigenVector3Map<T>(cam_i_from_world_translation);
     // q and n: lidar_i -> cam_i.
     const Vector3 target_in_cam_i =
         cam_from_lidar_q * point_in_lidar_i_.cast<T>() + cam_from_lidar_t;
-    const Vector3 normal_in_cam_i =
-        cam_from_lidar_q * normal_in_lidar_i_.cast<T>();
-    residual[0] = normal_in_cam_i.dot(point_in_cam_i - target_in_cam_i) *
-                  T(inverse_sigma_);
+    const Vector3 normal_in_cam_i = cam_from_lidar_q * normal_in_lidar_i_.cast<T>();
+    residual[0] = normal_in_cam_i.dot(point_in_cam_i - target_in_cam_i) * T(inverse_sigma_);
     return true;
   }
 

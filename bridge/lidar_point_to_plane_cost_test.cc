@@ -13,23 +13,19 @@ namespace {
 colmap::Rigid3d Pose(double angle,
                      const Eigen::Vector3d& axis,
                      const Eigen::Vector3d& translation) {
-  return colmap::Rigid3d(
-      Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())),
-      translation);
+  return colmap::Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())),
+                         translation);
 }
 
 // Generic poses: no axis-aligned rotations, translations on every axis.
 struct ThreeFrames {
-  colmap::Rigid3d cam_i_from_world =
-      Pose(0.6, {0.2, -0.9, 0.4}, {0.3, -0.2, 1.9});
-  colmap::Rigid3d cam_j_from_world =
-      Pose(-1.1, {0.7, 0.3, -0.5}, {-0.8, 0.4, 2.4});
-  colmap::Rigid3d cam_from_lidar =
-      Pose(2.0, {0.4, -0.5, 0.6}, {0.19, -0.25, -0.05});
+  colmap::Rigid3d cam_i_from_world = Pose(0.6, {0.2, -0.9, 0.4}, {0.3, -0.2, 1.9});
+  colmap::Rigid3d cam_j_from_world = Pose(-1.1, {0.7, 0.3, -0.5}, {-0.8, 0.4, 2.4});
+  colmap::Rigid3d cam_from_lidar = Pose(2.0, {0.4, -0.5, 0.6}, {0.19, -0.25, -0.05});
 
   colmap::Rigid3d LidarIFromLidarJ() const {
-    return colmap::Inverse(cam_from_lidar) * cam_i_from_world *
-           colmap::Inverse(cam_j_from_world) * cam_from_lidar;
+    return colmap::Inverse(cam_from_lidar) * cam_i_from_world * colmap::Inverse(cam_j_from_world) *
+           cam_from_lidar;
   }
   std::vector<double*> Blocks() {
     return {cam_i_from_world.rotation.coeffs().data(),
@@ -44,26 +40,20 @@ struct ThreeFrames {
 TEST(LidarPointToPlaneCost, ZeroOnThePlaneAndTheSignedDistanceOffIt) {
   ThreeFrames setup;
   const Eigen::Vector3d point_in_lidar_j(1.3, -0.4, 0.7);
-  const Eigen::Vector3d normal_in_lidar_i =
-      Eigen::Vector3d(0.3, 0.5, -0.8).normalized();
+  const Eigen::Vector3d normal_in_lidar_i = Eigen::Vector3d(0.3, 0.5, -0.8).normalized();
   // q on the plane through the transformed point, offset along the plane: exact data.
   const Eigen::Vector3d on_plane = setup.LidarIFromLidarJ() * point_in_lidar_j;
-  const Eigen::Vector3d tangent =
-      normal_in_lidar_i.cross(Eigen::Vector3d(1, 0, 0)).normalized();
+  const Eigen::Vector3d tangent = normal_in_lidar_i.cross(Eigen::Vector3d(1, 0, 0)).normalized();
   const Eigen::Vector3d point_in_lidar_i = on_plane + 0.2 * tangent;
   double residual = 1;
-  std::unique_ptr<ceres::CostFunction> exact(
-      LidarPointToPlaneCostFunctor::Create(
-          point_in_lidar_j, point_in_lidar_i, normal_in_lidar_i, 0.02));
+  std::unique_ptr<ceres::CostFunction> exact(LidarPointToPlaneCostFunctor::Create(
+      point_in_lidar_j, point_in_lidar_i, normal_in_lidar_i, 0.02));
   std::vector<double*> blocks = setup.Blocks();
   ASSERT_TRUE(exact->Evaluate(blocks.data(), &residual, nullptr));
   EXPECT_NEAR(residual, 0, 1e-12);
   // 1 cm behind the plane (along -n) with sigma 2 cm: E_l = -0.5.
   std::unique_ptr<ceres::CostFunction> off(LidarPointToPlaneCostFunctor::Create(
-      point_in_lidar_j,
-      point_in_lidar_i + 0.01 * normal_in_lidar_i,
-      normal_in_lidar_i,
-      0.02));
+      point_in_lidar_j, point_in_lidar_i + 0.01 * normal_in_lidar_i, normal_in_lidar_i, 0.02));
   ASSERT_TRUE(off->Evaluate(blocks.data(), &residual, nullptr));
   EXPECT_NEAR(residual, -0.5, 1e-9);
 }
@@ -71,19 +61,17 @@ TEST(LidarPointToPlaneCost, ZeroOnThePlaneAndTheSignedDistanceOffIt) {
 TEST(LidarPointToPlaneCost, AnalyticGradientsMatchNumericAtGenericPoses) {
   ThreeFrames setup;
   std::unique_ptr<ceres::CostFunction> cost(
-      LidarPointToPlaneCostFunctor::Create(
-          Eigen::Vector3d(1.3, -0.4, 0.7),
-          Eigen::Vector3d(-0.2, 0.9, 1.4),
-          Eigen::Vector3d(0.3, 0.5, -0.8).normalized(),
-          0.02));
+      LidarPointToPlaneCostFunctor::Create(Eigen::Vector3d(1.3, -0.4, 0.7),
+                                           Eigen::Vector3d(-0.2, 0.9, 1.4),
+                                           Eigen::Vector3d(0.3, 0.5, -0.8).normalized(),
+                                           0.02));
   // Ambient quaternion coordinates: checks the autodiff derivative of the whole function.
   const std::vector<const ceres::Manifold*> manifolds(6, nullptr);
   ceres::NumericDiffOptions numeric_options;
   ceres::GradientChecker checker(cost.get(), &manifolds, numeric_options);
   ceres::GradientChecker::ProbeResults results;
   std::vector<double*> blocks = setup.Blocks();
-  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-7, &results))
-      << results.error_log;
+  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-7, &results)) << results.error_log;
 }
 
 }  // namespace

@@ -20,8 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int RunWithArguments(int (*command)(int, char**),
-                     const std::vector<std::string>& arguments) {
+int RunWithArguments(int (*command)(int, char**), const std::vector<std::string>& arguments) {
   std::vector<std::string> storage = arguments;
   std::vector<char*> argv;
   for (std::string& argument : storage) argv.push_back(argument.data());
@@ -42,18 +41,16 @@ int RunPoseInitializer(int argc, char** argv) {
                            "lidar_registrator's output (pairs.txt); empty: no "
                            "LiDAR edges");
   options.AddRequiredOption("output_path", &output_path);
-  options.AddDefaultOption(
-      "input_path",
-      &input_path,
-      "an existing COLMAP model of the same database (e.g. "
-      "colmap mapper's): rescaled to metres instead of "
-      "initialising poses");
+  options.AddDefaultOption("input_path",
+                           &input_path,
+                           "an existing COLMAP model of the same database (e.g. "
+                           "colmap mapper's): rescaled to metres instead of "
+                           "initialising poses");
   options.AddDefaultOption("use_guess",
                            &initializer.use_guess,
                            "use rig.json's cam_from_lidar_guess if present "
                            "(0: hand-eye)");
-  options.AddDefaultOption("min_pair_inliers",
-                           &initializer.image_pairs.min_inliers);
+  options.AddDefaultOption("min_pair_inliers", &initializer.image_pairs.min_inliers);
   options.Parse(argc, argv);
   const auto start = std::chrono::steady_clock::now();
   const StationDataset dataset = ReadStationDataset(dataset_path);
@@ -62,30 +59,23 @@ int RunPoseInitializer(int argc, char** argv) {
   PoseInitialization init;
   double scale = 1;
   if (input_path.empty()) {
-    init = InitializePoses(
-        *options.database_path, dataset, registration_path, initializer);
-    std::cout << "Pose graph: " << init.num_image_edges
-              << " image edges (A_c), " << init.num_lidar_edges
-              << " LiDAR edges (A_l); " << init.cam_from_world.size()
+    init = InitializePoses(*options.database_path, dataset, registration_path, initializer);
+    std::cout << "Pose graph: " << init.num_image_edges << " image edges (A_c), "
+              << init.num_lidar_edges << " LiDAR edges (A_l); " << init.cam_from_world.size()
               << " stations reachable" << std::endl;
     TriangulateInitialModel(*options.database_path,
                             (fs::path(dataset.root) / "images").string(),
                             init,
                             partial.string());
   } else {
-    THROW_CHECK(fs::is_directory(input_path))
-        << "no sparse model folder " << input_path;
+    THROW_CHECK(fs::is_directory(input_path)) << "no sparse model folder " << input_path;
     colmap::Reconstruction model;
     model.Read(input_path);
-    init = InitializeFromModel(*options.database_path,
-                               dataset,
-                               registration_path,
-                               initializer,
-                               &model,
-                               &scale);
+    init = InitializeFromModel(
+        *options.database_path, dataset, registration_path, initializer, &model, &scale);
     std::cout << "Rescaled " << input_path << " to metres by " << scale
-              << " (median of depth prior / model depth); "
-              << model.NumRegImages() << " registered images" << std::endl;
+              << " (median of depth prior / model depth); " << model.NumRegImages()
+              << " registered images" << std::endl;
     fs::create_directories(partial);
     model.WriteBinary(partial.string());
   }
@@ -93,35 +83,29 @@ int RunPoseInitializer(int argc, char** argv) {
             << "; hand-eye: " << init.hand_eye.message << std::endl;
   for (const std::string& name : init.unreachable) {
     std::cout << "WARNING: station image " << name
-              << " is not in the model (no image or LiDAR edge reaches it)"
-              << std::endl;
+              << " is not in the model (no image or LiDAR edge reaches it)" << std::endl;
   }
   WritePoseFile((partial / "cam_from_lidar.txt").string(),
-                "initial cam_from_lidar (" + init.extrinsic_source +
-                    "); qw qx qy qz tx ty tz",
+                "initial cam_from_lidar (" + init.extrinsic_source + "); qw qx qy qz tx ty tz",
                 init.cam_from_lidar);
   nlohmann::json report;
   report["extrinsic_source"] = init.extrinsic_source;
-  report["hand_eye"] = {
-      {"unique", init.hand_eye.unique},
-      {"message", init.hand_eye.message},
-      {"motions", init.hand_eye.num_motions},
-      {"max_axis_angle_deg", init.hand_eye.max_axis_angle_deg}};
+  report["hand_eye"] = {{"unique", init.hand_eye.unique},
+                        {"message", init.hand_eye.message},
+                        {"motions", init.hand_eye.num_motions},
+                        {"max_axis_angle_deg", init.hand_eye.max_axis_angle_deg}};
   report["image_edges"] = init.num_image_edges;
   report["lidar_edges"] = init.num_lidar_edges;
   report["stations"] = init.cam_from_world.size();
   report["unreachable"] = init.unreachable;
   report["input_model"] = input_path;
   report["scale_to_metres"] = scale;
-  WriteFileAtomically((partial / "initialization.json").string(),
-                      report.dump(2) + "\n");
+  WriteFileAtomically((partial / "initialization.json").string(), report.dump(2) + "\n");
   fs::remove_all(output_path);
   fs::rename(partial, output_path);
-  std::cout << "Wrote the initial model to " << output_path << " ("
-            << std::fixed << std::setprecision(1)
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                             start)
-                   .count()
+  std::cout << "Wrote the initial model to " << output_path << " (" << std::fixed
+            << std::setprecision(1)
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
             << " s)" << std::endl;
   return EXIT_SUCCESS;
 }
@@ -139,8 +123,7 @@ int RunPipeline(int argc, char** argv) {
                            &use_guess,
                            "0: initialise cam_from_lidar by hand-eye even if "
                            "rig.json has a guess");
-  options.AddDefaultOption(
-      "mode", &mode, "joint | precalibrated | stereo_only");
+  options.AddDefaultOption("mode", &mode, "joint | precalibrated | stereo_only");
   options.Parse(argc, argv);
   const StationDataset dataset = ReadStationDataset(dataset_path);
   const fs::path ws(workspace_path);
@@ -162,9 +145,7 @@ int RunPipeline(int argc, char** argv) {
       {"import_dataset",
        &RunImportDataset,
        {"--dataset_path", dataset.root, "--database_path", database}},
-      {"stereo_depth",
-       &RunStereoDepth,
-       {"--dataset_path", dataset.root, "--output_path", stereo}},
+      {"stereo_depth", &RunStereoDepth, {"--dataset_path", dataset.root, "--output_path", stereo}},
       {"depth_prior_extractor",
        &RunDepthPriorExtractor,
        {"--database_path", database, "--depth_path", stereo}},
@@ -215,14 +196,10 @@ int RunPipeline(int argc, char** argv) {
   };
   if (dataset.HasGroundTruth()) {
     const std::string evaluation = (ws / "evaluation").string();
-    steps.push_back({"evaluate_calibration",
-                     &RunEvaluateCalibration,
-                     {"--dataset_path",
-                      dataset.root,
-                      "--input_path",
-                      joint,
-                      "--output_path",
-                      evaluation}});
+    steps.push_back(
+        {"evaluate_calibration",
+         &RunEvaluateCalibration,
+         {"--dataset_path", dataset.root, "--input_path", joint, "--output_path", evaluation}});
     steps.push_back({"evaluate_model",
                      &RunEvaluateModel,
                      {"--model_path",
@@ -240,23 +217,19 @@ int RunPipeline(int argc, char** argv) {
     const fs::path marker = ws / "steps" / (step.name + ".done");
     if (fs::exists(marker) && !overwrite) {
       std::cout << "== [" << k + 1 << "/" << steps.size() << "] " << step.name
-                << ": done before, skipped (--overwrite 1 reruns it)"
-                << std::endl;
+                << ": done before, skipped (--overwrite 1 reruns it)" << std::endl;
       table.emplace_back(step.name, "skipped", 0.0);
       continue;
     }
-    std::cout << "== [" << k + 1 << "/" << steps.size() << "] " << step.name
-              << std::endl;
+    std::cout << "== [" << k + 1 << "/" << steps.size() << "] " << step.name << std::endl;
     fs::remove(marker);
     if (step.name == "import_dataset" && overwrite) fs::remove(database);
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::string> arguments = {step.name};
-    arguments.insert(
-        arguments.end(), step.arguments.begin(), step.arguments.end());
+    arguments.insert(arguments.end(), step.arguments.begin(), step.arguments.end());
     const int status = RunWithArguments(step.command, arguments);
     const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-            .count();
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (status != EXIT_SUCCESS) {
       throw std::runtime_error("step " + step.name + " failed");
     }
@@ -265,13 +238,11 @@ int RunPipeline(int argc, char** argv) {
   }
   std::cout << "\n== Pipeline summary (" << workspace_path << ")\n";
   for (const auto& [name, status, seconds] : table) {
-    std::cout << "  " << std::left << std::setw(24) << name << std::setw(9)
-              << status << std::right << std::fixed << std::setprecision(1)
-              << std::setw(8) << seconds << " s\n";
+    std::cout << "  " << std::left << std::setw(24) << name << std::setw(9) << status << std::right
+              << std::fixed << std::setprecision(1) << std::setw(8) << seconds << " s\n";
   }
   std::cout << "  model: " << joint << " (cam_from_lidar.txt, report.json)\n"
-            << "  dense: " << dense
-            << " (fused.ply, lidar_map.ply, COLMAP dense workspace)"
+            << "  dense: " << dense << " (fused.ply, lidar_map.ply, COLMAP dense workspace)"
             << std::endl;
   return EXIT_SUCCESS;
 }

@@ -39,13 +39,12 @@ std::vector<LidarPair> ReadLidarPairs(const std::string& path) {
     std::istringstream fields(line);
     LidarPair pair;
     double qw, qx, qy, qz, tx, ty, tz;
-    if (!(fields >> pair.target >> pair.source >> qw >> qx >> qy >> qz >> tx >>
-          ty >> tz >> pair.inliers)) {
+    if (!(fields >> pair.target >> pair.source >> qw >> qx >> qy >> qz >> tx >> ty >> tz >>
+          pair.inliers)) {
       throw std::runtime_error(path + ": malformed line '" + line + "'");
     }
-    pair.target_from_source =
-        colmap::Rigid3d(Eigen::Quaterniond(qw, qx, qy, qz).normalized(),
-                        Eigen::Vector3d(tx, ty, tz));
+    pair.target_from_source = colmap::Rigid3d(Eigen::Quaterniond(qw, qx, qy, qz).normalized(),
+                                              Eigen::Vector3d(tx, ty, tz));
     pairs.push_back(pair);
   }
   return pairs;
@@ -66,12 +65,10 @@ void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
     init->extrinsic_source = "hand-eye";
   } else if (dataset.rig.cam_from_lidar_guess) {
     init->cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
-    init->extrinsic_source =
-        "rig.json guess (hand-eye: " + init->hand_eye.message + ")";
+    init->extrinsic_source = "rig.json guess (hand-eye: " + init->hand_eye.message + ")";
   } else {
-    throw std::runtime_error(
-        "cannot initialise cam_from_lidar: " + init->hand_eye.message +
-        "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
+    throw std::runtime_error("cannot initialise cam_from_lidar: " + init->hand_eye.message +
+                             "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
   }
 }
 
@@ -93,13 +90,11 @@ PoseInitialization InitializePoses(const std::string& database_path,
   THROW_CHECK(fs::is_regular_file(database_path))
       << "Database file does not exist: " << database_path;
   PoseInitialization init;
-  const ExtensionDatabase extension(database_path,
-                                    ExtensionDatabase::Mode::kReadOnly);
+  const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
   const colmap::Database database(database_path);
   std::map<std::string, colmap::image_t> image_of_station;
   std::map<colmap::image_t, std::string> names;
-  std::set<std::string> stations(dataset.stations.begin(),
-                                 dataset.stations.end());
+  std::set<std::string> stations(dataset.stations.begin(), dataset.stations.end());
   DepthPriorsByImage priors;
   for (const colmap::Image& image : database.ReadAllImages()) {
     const std::string station = fs::path(image.Name()).stem().string();
@@ -116,8 +111,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
   // A_c.
   const std::vector<ImagePairPose> image_pairs =
       EstimateImagePairPoses(database, priors, options.image_pairs);
-  std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d>
-      image_edge;
+  std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d> image_edge;
   for (const ImagePairPose& pair : image_pairs) {
     init.edges.push_back({pair.image_i,
                           pair.image_j,
@@ -129,14 +123,11 @@ PoseInitialization InitializePoses(const std::string& database_path,
   init.num_image_edges = static_cast<int>(image_pairs.size());
 
   // A_l.
-  std::vector<
-      std::tuple<colmap::image_t, colmap::image_t, colmap::Rigid3d, double>>
-      lidar_edges;
+  std::vector<std::tuple<colmap::image_t, colmap::image_t, colmap::Rigid3d, double>> lidar_edges;
   if (!registration_path.empty()) {
     for (const LidarPair& pair :
          ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
-      if (!image_of_station.count(pair.target) ||
-          !image_of_station.count(pair.source)) {
+      if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) {
         continue;
       }
       lidar_edges.emplace_back(image_of_station.at(pair.target),
@@ -153,18 +144,17 @@ PoseInitialization InitializePoses(const std::string& database_path,
     if (image_edge.count({i, j})) {
       motions.push_back({image_edge.at({i, j}), lidar_i_from_lidar_j});
     } else if (image_edge.count({j, i})) {
-      motions.push_back(
-          {colmap::Inverse(image_edge.at({j, i})), lidar_i_from_lidar_j});
+      motions.push_back({colmap::Inverse(image_edge.at({j, i})), lidar_i_from_lidar_j});
     }
   }
   ChooseExtrinsic(motions, dataset, options, &init);
   for (const auto& [i, j, lidar_i_from_lidar_j, weight] : lidar_edges) {
-    init.edges.push_back({i,
-                          j,
-                          init.cam_from_lidar * lidar_i_from_lidar_j *
-                              colmap::Inverse(init.cam_from_lidar),
-                          weight,
-                          true});
+    init.edges.push_back(
+        {i,
+         j,
+         init.cam_from_lidar * lidar_i_from_lidar_j * colmap::Inverse(init.cam_from_lidar),
+         weight,
+         true});
   }
 
   // Maximum-weight spanning tree from the first station (Prim).
@@ -187,27 +177,23 @@ PoseInitialization InitializePoses(const std::string& database_path,
     colmap::image_t added;
     if (has_i) {  // cam_j_from_world = inverse(cam_i_from_cam_j) * cam_i_from_world
       added = edge.image_j;
-      init.cam_from_world[added] = colmap::Inverse(edge.cam_i_from_cam_j) *
-                                   init.cam_from_world.at(edge.image_i);
+      init.cam_from_world[added] =
+          colmap::Inverse(edge.cam_i_from_cam_j) * init.cam_from_world.at(edge.image_i);
     } else {
       added = edge.image_i;
-      init.cam_from_world[added] =
-          edge.cam_i_from_cam_j * init.cam_from_world.at(edge.image_j);
+      init.cam_from_world[added] = edge.cam_i_from_cam_j * init.cam_from_world.at(edge.image_j);
     }
-    for (const size_t next : incident[added])
-      queue.push({init.edges[next].weight, next});
+    for (const size_t next : incident[added]) queue.push({init.edges[next].weight, next});
   }
   for (const auto& [station, image_id] : image_of_station) {
-    if (!init.cam_from_world.count(image_id))
-      init.unreachable.push_back(names.at(image_id));
+    if (!init.cam_from_world.count(image_id)) init.unreachable.push_back(names.at(image_id));
   }
 
   // Pose graph over every edge between reachable stations.
   ceres::Problem problem;
   const double sigma_rotation = options.sigma_rotation_deg * M_PI / 180;
   for (const PoseGraphEdge& edge : init.edges) {
-    if (!init.cam_from_world.count(edge.image_i) ||
-        !init.cam_from_world.count(edge.image_j)) {
+    if (!init.cam_from_world.count(edge.image_i) || !init.cam_from_world.count(edge.image_j)) {
       continue;
     }
     colmap::Rigid3d& pose_i = init.cam_from_world.at(edge.image_i);
@@ -249,8 +235,7 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
   THROW_CHECK_NOTNULL(model);
   THROW_CHECK_GE(model->NumRegImages(), 2) << "the model has fewer than 2 "
                                               "registered images";
-  const ExtensionDatabase extension(database_path,
-                                    ExtensionDatabase::Mode::kReadOnly);
+  const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
   // Metres: the median of prior depth / model depth over every landmark observation with a prior.
   std::vector<double> ratios;
   std::map<std::string, colmap::image_t> image_of_station;
@@ -264,8 +249,7 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
       }
       const colmap::Point2D& point2D = image.Point2D(prior.point2D_idx);
       if (!point2D.HasPoint3D()) continue;
-      const double depth =
-          (image.CamFromWorld() * model->Point3D(point2D.point3D_id).xyz).z();
+      const double depth = (image.CamFromWorld() * model->Point3D(point2D.point3D_id).xyz).z();
       if (depth > 0) ratios.push_back(prior.depth / depth);
     }
   }
@@ -276,26 +260,23 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
                              "depth_prior_extractor on "
                              "the model's database)");
   }
-  std::nth_element(
-      ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
   *scale = ratios[ratios.size() / 2];
-  model->Transform(colmap::Sim3d(
-      *scale, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()));
+  model->Transform(colmap::Sim3d(*scale, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()));
 
   PoseInitialization init;
   std::vector<HandEyeMotion> motions;
   if (!registration_path.empty()) {
     for (const LidarPair& pair :
          ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
-      if (!image_of_station.count(pair.target) ||
-          !image_of_station.count(pair.source)) {
+      if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) {
         continue;
       }
       const colmap::image_t i = image_of_station.at(pair.target);
       const colmap::image_t j = image_of_station.at(pair.source);
-      motions.push_back({model->Image(i).CamFromWorld() *
-                             colmap::Inverse(model->Image(j).CamFromWorld()),
-                         pair.target_from_source});
+      motions.push_back(
+          {model->Image(i).CamFromWorld() * colmap::Inverse(model->Image(j).CamFromWorld()),
+           pair.target_from_source});
       ++init.num_lidar_edges;
     }
   }
@@ -304,8 +285,7 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
     init.cam_from_world[image_id] = model->Image(image_id).CamFromWorld();
   }
   for (const std::string& station : dataset.stations) {
-    if (!image_of_station.count(station))
-      init.unreachable.push_back("left/" + station + ".png");
+    if (!image_of_station.count(station)) init.unreachable.push_back("left/" + station + ".png");
   }
   return init;
 }
@@ -335,8 +315,7 @@ void TriangulateInitialModel(const std::string& database_path,
     for (const auto& [image_id, pose] : initialization.cam_from_world) {
       colmap::Image image = database.ReadImage(image_id);
       image.CamFromWorld() = pose;
-      image.SetPoints2D(colmap::FeatureKeypointsToPointsVector(
-          database.ReadKeypoints(image_id)));
+      image.SetPoints2D(colmap::FeatureKeypointsToPointsVector(database.ReadKeypoints(image_id)));
       if (matched.count(image_id)) {
         reconstruction->AddImage(image);
         reconstruction->RegisterImage(image_id);
@@ -353,10 +332,7 @@ void TriangulateInitialModel(const std::string& database_path,
   options->num_threads = -1;
   if (reconstruction->NumRegImages() >= 2) {
     colmap::IncrementalMapperController mapper(
-        options,
-        image_path,
-        database_path,
-        std::make_shared<colmap::ReconstructionManager>());
+        options, image_path, database_path, std::make_shared<colmap::ReconstructionManager>());
     mapper.TriangulateReconstruction(reconstruction);
   }
   for (const colmap::Image& image : without_correspondences) {

@@ -24,7 +24,7 @@ namespace colmap_lidar {
 struct PoseInitializerOptions {
   ImagePairPoseOptions image_pairs;
   HandEyeOptions hand_eye;
-  bool use_guess = true;  // false: hand-eye even when rig.json has a guess
+  bool use_guess = true;            // false: hand-eye even when rig.json has a guess
   double sigma_rotation_deg = 0.1;  // pose-graph edge weights
   double sigma_translation_m = 0.005;
 
@@ -39,9 +39,8 @@ struct PoseGraphEdge {
 };
 
 struct PoseInitialization {
-  std::map<colmap::image_t, colmap::Rigid3d>
-      cam_from_world;                    // reachable stations
-  std::vector<std::string> unreachable;  // image names
+  std::map<colmap::image_t, colmap::Rigid3d> cam_from_world;  // reachable stations
+  std::vector<std::string> unreachable;                       // image names
   colmap::Rigid3d cam_from_lidar;
   std::string extrinsic_source;  // "rig.json guess" or "hand-eye"
   HandEyeResult hand_eye;

@@ -23,10 +23,8 @@ class RelativePoseCostFunctor {
   static ceres::CostFunction* Create(const colmap::Rigid3d& cam_i_from_cam_j,
                                      double sigma_rotation_rad,
                                      double sigma_translation_m) {
-    return new ceres::
-        AutoDiffCostFunction<RelativePoseCostFunctor, 6, 4, 3, 4, 3>(
-            new RelativePoseCostFunctor(
-                cam_i_from_cam_j, sigma_rotation_rad, sigma_translation_m));
+    return new ceres::AutoDiffCostFunction<RelativePoseCostFunctor, 6, 4, 3, 4, 3>(
+        new RelativePoseCostFunctor(cam_i_from_cam_j, sigma_rotation_rad, sigma_translation_m));
   }
 
   template <typename T>
@@ -38,15 +36,13 @@ class RelativePoseCostFunctor {
     const Eigen::Quaternion<T> q_i = colmap::EigenQuaternionMap<T>(rotation_i);
     const Eigen::Quaternion<T> q_j = colmap::EigenQuaternionMap<T>(rotation_j);
     const Eigen::Quaternion<T> i_from_j = q_i * q_j.conjugate();
-    const Eigen::Quaternion<T> error =
-        measured_.rotation.cast<T>().conjugate() * i_from_j;
-    const Eigen::Matrix<T, 3, 1> t_i_from_j =
-        colmap::EigenVector3Map<T>(translation_i) -
-        i_from_j * colmap::EigenVector3Map<T>(translation_j);
+    const Eigen::Quaternion<T> error = measured_.rotation.cast<T>().conjugate() * i_from_j;
+    const Eigen::Matrix<T, 3, 1> t_i_from_j = colmap::EigenVector3Map<T>(translation_i) -
+                                              i_from_j * colmap::EigenVector3Map<T>(translation_j);
     for (int k = 0; k < 3; ++k) {
       residuals[k] = T(2) * error.vec()[k] * T(inverse_sigma_rotation_);
-      residuals[3 + k] = (t_i_from_j[k] - T(measured_.translation[k])) *
-                         T(inverse_sigma_translation_);
+      residuals[3 + k] =
+          (t_i_from_j[k] - T(measured_.translation[k])) * T(inverse_sigma_translation_);
     }
     return true;
   }

@@ -29,33 +29,20 @@ CameraUndistorter::CameraUndistorter(const colmap::Camera& distorted,
 
 cv::Mat CameraUndistorter::UndistortImage(const cv::Mat& image) const {
   cv::Mat result;
-  cv::remap(image,
-            result,
-            map_x_,
-            map_y_,
-            cv::INTER_LINEAR,
-            cv::BORDER_CONSTANT,
-            cv::Scalar::all(0));
+  cv::remap(
+      image, result, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
   return result;
 }
 
 cv::Mat CameraUndistorter::UndistortDepthMap(const cv::Mat& depth) const {
-  if (depth.type() != CV_32F || depth.cols != distorted_width_ ||
-      depth.rows != distorted_height_) {
+  if (depth.type() != CV_32F || depth.cols != distorted_width_ || depth.rows != distorted_height_) {
     throw std::invalid_argument("UndistortDepthMap: expected a CV_32F map of " +
                                 std::to_string(distorted_width_) + "x" +
                                 std::to_string(distorted_height_) + ", got " +
-                                std::to_string(depth.cols) + "x" +
-                                std::to_string(depth.rows));
+                                std::to_string(depth.cols) + "x" + std::to_string(depth.rows));
   }
   cv::Mat result;
-  cv::remap(depth,
-            result,
-            map_x_,
-            map_y_,
-            cv::INTER_NEAREST,
-            cv::BORDER_CONSTANT,
-            cv::Scalar(0));
+  cv::remap(depth, result, map_x_, map_y_, cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
   return result;
 }
 

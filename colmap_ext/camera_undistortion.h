@@ -11,8 +11,7 @@ namespace colmap_lidar {
 
 class CameraUndistorter {
  public:
-  CameraUndistorter(const colmap::Camera& distorted,
-                    const colmap::Camera& undistorted);
+  CameraUndistorter(const colmap::Camera& distorted, const colmap::Camera& undistorted);
 
   // Bilinear (8-bit images of the distorted camera's size).
   cv::Mat UndistortImage(const cv::Mat& image) const;

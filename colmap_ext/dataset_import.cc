@@ -25,15 +25,14 @@ void CheckImage(const std::string& station,
                 const colmap::Camera& camera) {
   const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty()) {
-    throw std::runtime_error("station " + station + ": cannot read the " +
-                             side + " image " + path);
+    throw std::runtime_error("station " + station + ": cannot read the " + side + " image " + path);
   }
   if (static_cast<size_t>(image.cols) != camera.width ||
       static_cast<size_t>(image.rows) != camera.height) {
     std::ostringstream message;
-    message << "station " << station << ": the " << side << " image " << path
-            << " is " << image.cols << "x" << image.rows << " but rig.json's "
-            << side << " camera is " << camera.width << "x" << camera.height;
+    message << "station " << station << ": the " << side << " image " << path << " is "
+            << image.cols << "x" << image.rows << " but rig.json's " << side << " camera is "
+            << camera.width << "x" << camera.height;
     throw std::runtime_error(message.str());
   }
 }
@@ -44,8 +43,7 @@ bool SameIntrinsics(const colmap::Camera& a, const colmap::Camera& b) {
     return false;
   }
   for (size_t i = 0; i < a.params.size(); ++i) {
-    if (std::abs(a.params[i] - b.params[i]) >
-        1e-9 * (1 + std::abs(b.params[i]))) {
+    if (std::abs(a.params[i] - b.params[i]) > 1e-9 * (1 + std::abs(b.params[i]))) {
       return false;
     }
   }
@@ -61,11 +59,11 @@ colmap::camera_t LeftCameraId(const StationDataset& dataset,
   if (rig && database->ExistsCamera(rig->left_camera_id)) {
     const colmap::Camera camera = database->ReadCamera(rig->left_camera_id);
     if (!SameIntrinsics(camera, dataset.rig.left)) {
-      throw std::runtime_error(
-          "the database already holds a rig whose left camera (camera_id " +
-          std::to_string(rig->left_camera_id) + ", " + camera.ModelName() +
-          " " + camera.ParamsToString() + ") differs from the left camera in " +
-          dataset.root + "/rig.json; import into a new database");
+      throw std::runtime_error("the database already holds a rig whose left camera (camera_id " +
+                               std::to_string(rig->left_camera_id) + ", " + camera.ModelName() +
+                               " " + camera.ParamsToString() +
+                               ") differs from the left camera in " + dataset.root +
+                               "/rig.json; import into a new database");
     }
     return rig->left_camera_id;
   }
@@ -78,14 +76,8 @@ colmap::camera_t LeftCameraId(const StationDataset& dataset,
 
 void CheckStationImages(const StationDataset& dataset) {
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
-    CheckImage(dataset.stations[i],
-               "left",
-               dataset.LeftImagePath(i),
-               dataset.rig.left);
-    CheckImage(dataset.stations[i],
-               "right",
-               dataset.RightImagePath(i),
-               dataset.rig.right);
+    CheckImage(dataset.stations[i], "left", dataset.LeftImagePath(i), dataset.rig.left);
+    CheckImage(dataset.stations[i], "right", dataset.RightImagePath(i), dataset.rig.right);
   }
 }
 
@@ -97,8 +89,8 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
   THROW_CHECK(options.two_view_geometry.Check());
   THROW_CHECK(options.exhaustive_matching.Check());
   THROW_CHECK(!dataset.stations.empty()) << "no stations in " << dataset.root;
-  std::cout << "Checking " << dataset.stations.size() << " stereo pairs of "
-            << dataset.root << std::endl;
+  std::cout << "Checking " << dataset.stations.size() << " stereo pairs of " << dataset.root
+            << std::endl;
   CheckStationImages(dataset);
 
   const std::string partial = database_path + ".import-partial";
@@ -111,10 +103,7 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
   remove_partial();
   if (fs::exists(database_path)) {
     // Rejects a non-COLMAP file before anything is written; the copy is a consistent snapshot.
-    {
-      ExtensionDatabase check(database_path,
-                              ExtensionDatabase::Mode::kReadOnly);
-    }
+    { ExtensionDatabase check(database_path, ExtensionDatabase::Mode::kReadOnly); }
     CopySqliteDatabase(database_path, partial);
   }
   try {
@@ -137,10 +126,10 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
     reader_options.image_path = (fs::path(dataset.root) / "images").string();
     reader_options.image_list = names;
     reader_options.existing_camera_id = static_cast<int>(summary.camera_id);
-    std::cout << "COLMAP SIFT extraction (" << summary.num_new_images
-              << " new images)" << std::endl;
-    auto extractor = colmap::CreateFeatureExtractorController(
-        reader_options, options.sift_extraction);
+    std::cout << "COLMAP SIFT extraction (" << summary.num_new_images << " new images)"
+              << std::endl;
+    auto extractor =
+        colmap::CreateFeatureExtractorController(reader_options, options.sift_extraction);
     extractor->Start();
     extractor->Wait();
     extractor.reset();  // closes its database connection
@@ -150,16 +139,14 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
       colmap::Database database(partial);
       for (size_t i = 0; i < names.size(); ++i) {
         if (!database.ExistsImageWithName(names[i])) {
-          throw std::runtime_error("station " + dataset.stations[i] +
-                                   ": COLMAP did not import " +
+          throw std::runtime_error("station " + dataset.stations[i] + ": COLMAP did not import " +
                                    dataset.LeftImagePath(i));
         }
         const colmap::Image image = database.ReadImageWithName(names[i]);
         if (image.CameraId() != summary.camera_id) {
-          throw std::runtime_error(
-              "station " + dataset.stations[i] + ": image " + names[i] +
-              " already exists in the database with another camera (" +
-              std::to_string(image.CameraId()) + ")");
+          throw std::runtime_error("station " + dataset.stations[i] + ": image " + names[i] +
+                                   " already exists in the database with another camera (" +
+                                   std::to_string(image.CameraId()) + ")");
         }
         if (!database.ExistsKeypoints(image.ImageId())) {
           throw std::runtime_error("station " + dataset.stations[i] +
@@ -171,11 +158,8 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
     }
 
     std::cout << "COLMAP exhaustive matching" << std::endl;
-    auto matcher =
-        colmap::CreateExhaustiveFeatureMatcher(options.exhaustive_matching,
-                                               options.sift_matching,
-                                               options.two_view_geometry,
-                                               partial);
+    auto matcher = colmap::CreateExhaustiveFeatureMatcher(
+        options.exhaustive_matching, options.sift_matching, options.two_view_geometry, partial);
     matcher->Start();
     matcher->Wait();
     matcher.reset();
@@ -190,8 +174,7 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
       for (size_t i = 0; i < names.size(); ++i) {
         LidarFrame frame;
         frame.image_id = image_ids[i];
-        frame.path =
-            fs::relative(dataset.cloud_paths[i], dataset.root).generic_string();
+        frame.path = fs::relative(dataset.cloud_paths[i], dataset.root).generic_string();
         frame.cam_from_lidar_guess = dataset.rig.cam_from_lidar_guess;
         extension.WriteLidarFrame(frame);
       }

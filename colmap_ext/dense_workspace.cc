@@ -15,9 +15,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void EnsureParent(const std::string& path) {
-  fs::create_directories(fs::path(path).parent_path());
-}
+void EnsureParent(const std::string& path) { fs::create_directories(fs::path(path).parent_path()); }
 
 }  // namespace
 
@@ -34,23 +32,18 @@ cv::Mat ReadColmapDepthMap(const std::string& path) {
   try {
     map.Read(path);
   } catch (const std::exception& error) {
-    throw std::runtime_error("Cannot read the depth map " + path + ": " +
-                             error.what());
+    throw std::runtime_error("Cannot read the depth map " + path + ": " + error.what());
   }
   if (map.GetWidth() == 0 || map.GetHeight() == 0 || map.GetDepth() != 1) {
-    throw std::runtime_error("Not a depth map (empty or several channels): " +
-                             path);
+    throw std::runtime_error("Not a depth map (empty or several channels): " + path);
   }
-  cv::Mat depth(static_cast<int>(map.GetHeight()),
-                static_cast<int>(map.GetWidth()),
-                CV_32F);
+  cv::Mat depth(static_cast<int>(map.GetHeight()), static_cast<int>(map.GetWidth()), CV_32F);
   std::copy(map.GetData().begin(), map.GetData().end(), depth.ptr<float>());
   return depth;
 }
 
 DenseWorkspace::DenseWorkspace(std::string root) : root_(std::move(root)) {
-  for (const char* folder :
-       {"images", "sparse", "stereo/depth_maps", "stereo/normal_maps"}) {
+  for (const char* folder : {"images", "sparse", "stereo/depth_maps", "stereo/normal_maps"}) {
     fs::create_directories(fs::path(root_) / folder);
   }
 }
@@ -60,26 +53,20 @@ std::string DenseWorkspace::ImagePath(const std::string& image_name) const {
 }
 
 std::string DenseWorkspace::DepthMapPath(const std::string& image_name) const {
-  return (fs::path(root_) / "stereo" / "depth_maps" /
-          (image_name + ".geometric.bin"))
-      .string();
+  return (fs::path(root_) / "stereo" / "depth_maps" / (image_name + ".geometric.bin")).string();
 }
 
 std::string DenseWorkspace::NormalMapPath(const std::string& image_name) const {
-  return (fs::path(root_) / "stereo" / "normal_maps" /
-          (image_name + ".geometric.bin"))
-      .string();
+  return (fs::path(root_) / "stereo" / "normal_maps" / (image_name + ".geometric.bin")).string();
 }
 
-void DenseWorkspace::WriteSparse(
-    const colmap::Reconstruction& reconstruction) const {
+void DenseWorkspace::WriteSparse(const colmap::Reconstruction& reconstruction) const {
   colmap::Reconstruction workspace_model = reconstruction;
   for (const auto& [camera_id, original] : reconstruction.Cameras()) {
     if (!IsPinholeCamera(original)) {
-      throw std::invalid_argument(
-          "The dense workspace needs undistorted images: camera " +
-          std::to_string(camera_id) + " is " + original.ModelName() +
-          " (only SIMPLE_PINHOLE and PINHOLE are supported)");
+      throw std::invalid_argument("The dense workspace needs undistorted images: camera " +
+                                  std::to_string(camera_id) + " is " + original.ModelName() +
+                                  " (only SIMPLE_PINHOLE and PINHOLE are supported)");
     }
     colmap::Camera& camera = workspace_model.Camera(camera_id);
     camera.model_id = colmap::PinholeCameraModel::model_id;
@@ -100,8 +87,7 @@ void DenseWorkspace::WriteConfigs(const std::vector<std::string>& image_names,
     patch_match << name << "\n__auto__, " << num_source_images << "\n";
   }
   if (!fusion || !patch_match) {
-    throw std::runtime_error("Cannot write the configuration files in " +
-                             root_ + "/stereo");
+    throw std::runtime_error("Cannot write the configuration files in " + root_ + "/stereo");
   }
 }
 
@@ -112,8 +98,7 @@ void DenseWorkspace::CopyImage(const std::string& image_name,
   fs::copy_file(source_path, path, fs::copy_options::overwrite_existing);
 }
 
-void DenseWorkspace::WriteImage(const std::string& image_name,
-                                const cv::Mat& image) const {
+void DenseWorkspace::WriteImage(const std::string& image_name, const cv::Mat& image) const {
   const std::string path = ImagePath(image_name);
   EnsureParent(path);
   if (!cv::imwrite(path, image)) {
@@ -121,13 +106,11 @@ void DenseWorkspace::WriteImage(const std::string& image_name,
   }
 }
 
-void DenseWorkspace::WriteDepthMap(const std::string& image_name,
-                                   const cv::Mat& depth) const {
+void DenseWorkspace::WriteDepthMap(const std::string& image_name, const cv::Mat& depth) const {
   if (depth.type() != CV_32F) {
     throw std::invalid_argument("WriteDepthMap: depth must be CV_32F");
   }
-  colmap::mvs::DepthMap map(
-      depth.cols, depth.rows, 0, 0);  // the range is not stored
+  colmap::mvs::DepthMap map(depth.cols, depth.rows, 0, 0);  // the range is not stored
   for (int row = 0; row < depth.rows; ++row) {
     for (int col = 0; col < depth.cols; ++col) {
       map.Set(row, col, depth.at<float>(row, col));
@@ -138,8 +121,7 @@ void DenseWorkspace::WriteDepthMap(const std::string& image_name,
   map.Write(path);
 }
 
-void DenseWorkspace::WriteNormalMap(const std::string& image_name,
-                                    const cv::Mat& normals) const {
+void DenseWorkspace::WriteNormalMap(const std::string& image_name, const cv::Mat& normals) const {
   if (normals.type() != CV_32FC3) {
     throw std::invalid_argument("WriteNormalMap: normals must be CV_32FC3");
   }
@@ -169,9 +151,7 @@ cv::Mat DenseWorkspace::ReadNormalMap(const std::string& image_name) const {
   if (map.GetDepth() != 3) {
     throw std::runtime_error("Not a normal map: " + path);
   }
-  cv::Mat normals(static_cast<int>(map.GetHeight()),
-                  static_cast<int>(map.GetWidth()),
-                  CV_32FC3);
+  cv::Mat normals(static_cast<int>(map.GetHeight()), static_cast<int>(map.GetWidth()), CV_32FC3);
   for (int row = 0; row < normals.rows; ++row) {
     for (int col = 0; col < normals.cols; ++col) {
       cv::Vec3f& n = normals.at<cv::Vec3f>(row, col);

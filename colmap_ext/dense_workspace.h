@@ -36,16 +36,13 @@ class DenseWorkspace {
   // colmap::UndistortReconstruction and camera_undistortion.h, as the densifier does).
   void WriteSparse(const colmap::Reconstruction& reconstruction) const;
   // fusion.cfg lists the images; patch-match.cfg gives each "__auto__, num_source_images".
-  void WriteConfigs(const std::vector<std::string>& image_names,
-                    int num_source_images = 20) const;
+  void WriteConfigs(const std::vector<std::string>& image_names, int num_source_images = 20) const;
 
-  void CopyImage(const std::string& image_name,
-                 const std::string& source_path) const;
+  void CopyImage(const std::string& image_name, const std::string& source_path) const;
   void WriteImage(const std::string& image_name, const cv::Mat& image) const;
   // depth: CV_32F, metres, 0 = none. normals: CV_32FC3 (x, y, z), zero = none.
   void WriteDepthMap(const std::string& image_name, const cv::Mat& depth) const;
-  void WriteNormalMap(const std::string& image_name,
-                      const cv::Mat& normals) const;
+  void WriteNormalMap(const std::string& image_name, const cv::Mat& normals) const;
   cv::Mat ReadDepthMap(const std::string& image_name) const;
   cv::Mat ReadNormalMap(const std::string& image_name) const;
 

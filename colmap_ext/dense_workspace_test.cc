@@ -14,8 +14,7 @@ namespace {
 
 colmap::Reconstruction OneImageModel(const std::string& camera_model) {
   colmap::Reconstruction reconstruction;
-  colmap::Camera camera =
-      colmap::Camera::CreateFromModelName(1, camera_model, 500, 64, 48);
+  colmap::Camera camera = colmap::Camera::CreateFromModelName(1, camera_model, 500, 64, 48);
   reconstruction.AddCamera(camera);
   colmap::Image image;
   image.SetImageId(1);

@@ -34,9 +34,7 @@ class DepthPriorCostFunctor {
   DepthPriorCostFunctor(double depth, double sigma, DepthType type)
       : depth_(depth), inverse_sigma_(1.0 / sigma), type_(type) {}
 
-  static ceres::CostFunction* Create(double depth,
-                                     double sigma,
-                                     DepthType type = DepthType::kZ) {
+  static ceres::CostFunction* Create(double depth, double sigma, DepthType type = DepthType::kZ) {
     return new ceres::AutoDiffCostFunction<DepthPriorCostFunctor, 1, 4, 3, 3>(
         new DepthPriorCostFunctor(depth, sigma, type));
   }
@@ -50,8 +48,7 @@ class DepthPriorCostFunctor {
         colmap::EigenQuaternionMap<T>(cam_from_world_rotation) *
             colmap::EigenVector3Map<T>(point_in_world) +
         colmap::EigenVector3Map<T>(cam_from_world_translation);
-    residual[0] =
-        (DepthOfPoint(point_in_cam, type_) - T(depth_)) * T(inverse_sigma_);
+    residual[0] = (DepthOfPoint(point_in_cam, type_) - T(depth_)) * T(inverse_sigma_);
     return true;
   }
 
@@ -69,29 +66,22 @@ class DepthPriorConstantPoseCostFunctor {
                                     double depth,
                                     double sigma,
                                     DepthType type)
-      : cam_from_world_(cam_from_world),
-        depth_(depth),
-        inverse_sigma_(1.0 / sigma),
-        type_(type) {}
+      : cam_from_world_(cam_from_world), depth_(depth), inverse_sigma_(1.0 / sigma), type_(type) {}
 
   static ceres::CostFunction* Create(const colmap::Rigid3d& cam_from_world,
                                      double depth,
                                      double sigma,
                                      DepthType type = DepthType::kZ) {
-    return new ceres::
-        AutoDiffCostFunction<DepthPriorConstantPoseCostFunctor, 1, 3>(
-            new DepthPriorConstantPoseCostFunctor(
-                cam_from_world, depth, sigma, type));
+    return new ceres::AutoDiffCostFunction<DepthPriorConstantPoseCostFunctor, 1, 3>(
+        new DepthPriorConstantPoseCostFunctor(cam_from_world, depth, sigma, type));
   }
 
   template <typename T>
   bool operator()(const T* const point_in_world, T* residual) const {
     const Eigen::Matrix<T, 3, 1> point_in_cam =
-        cam_from_world_.rotation.cast<T>() *
-            colmap::EigenVector3Map<T>(point_in_world) +
+        cam_from_world_.rotation.cast<T>() * colmap::EigenVector3Map<T>(point_in_world) +
         cam_from_world_.translation.cast<T>();
-    residual[0] =
-        (DepthOfPoint(point_in_cam, type_) - T(depth_)) * T(inverse_sigma_);
+    residual[0] = (DepthOfPoint(point_in_cam, type_) - T(depth_)) * T(inverse_sigma_);
     return true;
   }
 

@@ -11,8 +11,7 @@ namespace {
 // A generic pose: no axis-aligned rotation, translation on all axes.
 colmap::Rigid3d GenericCamFromWorld() {
   return colmap::Rigid3d(
-      Eigen::Quaterniond(
-          Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, -0.8, 0.5).normalized())),
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, -0.8, 0.5).normalized())),
       Eigen::Vector3d(0.4, -1.2, 2.1));
 }
 
@@ -29,10 +28,8 @@ TEST(DepthPriorCost, ZeroResidualOnExactDataForZAndRange) {
   const Eigen::Vector3d point_in_cam = cam_from_world * kPointInWorld;
   ASSERT_GT(point_in_cam.z(), 0);
   for (const DepthType type : {DepthType::kZ, DepthType::kRange}) {
-    const double depth =
-        type == DepthType::kZ ? point_in_cam.z() : point_in_cam.norm();
-    std::unique_ptr<ceres::CostFunction> cost(
-        DepthPriorCostFunctor::Create(depth, 0.01, type));
+    const double depth = type == DepthType::kZ ? point_in_cam.z() : point_in_cam.norm();
+    std::unique_ptr<ceres::CostFunction> cost(DepthPriorCostFunctor::Create(depth, 0.01, type));
     EXPECT_NEAR(Evaluate(cost.get(),
                          {cam_from_world.rotation.coeffs().data(),
                           cam_from_world.translation.data(),
@@ -40,8 +37,7 @@ TEST(DepthPriorCost, ZeroResidualOnExactDataForZAndRange) {
                 0,
                 1e-12);
     std::unique_ptr<ceres::CostFunction> constant(
-        DepthPriorConstantPoseCostFunctor::Create(
-            cam_from_world, depth, 0.01, type));
+        DepthPriorConstantPoseCostFunctor::Create(cam_from_world, depth, 0.01, type));
     EXPECT_NEAR(Evaluate(constant.get(), {kPointInWorld.data()}), 0, 1e-12);
   }
   // 1 cm too deep with sigma 1 cm: residual -1 (the measured depth is larger than the model's).
@@ -62,28 +58,21 @@ TEST(DepthPriorCost, AnalyticGradientsMatchNumericAtAGenericPose) {
   // derivatives are exactly zero by construction (z is invariant to rotation about the camera z axis, the
   // range to any rotation of the camera), which GradientChecker's relative test cannot compare.
   for (const DepthType type : {DepthType::kZ, DepthType::kRange}) {
-    std::unique_ptr<ceres::CostFunction> cost(
-        DepthPriorCostFunctor::Create(2.3, 0.02, type));
-    const std::vector<const ceres::Manifold*> manifolds = {
-        nullptr, nullptr, nullptr};
+    std::unique_ptr<ceres::CostFunction> cost(DepthPriorCostFunctor::Create(2.3, 0.02, type));
+    const std::vector<const ceres::Manifold*> manifolds = {nullptr, nullptr, nullptr};
     ceres::NumericDiffOptions numeric_options;
     ceres::GradientChecker checker(cost.get(), &manifolds, numeric_options);
     ceres::GradientChecker::ProbeResults results;
-    std::vector<double*> blocks = {cam_from_world.rotation.coeffs().data(),
-                                   cam_from_world.translation.data(),
-                                   point.data()};
-    EXPECT_TRUE(checker.Probe(blocks.data(), 1e-7, &results))
-        << results.error_log;
+    std::vector<double*> blocks = {
+        cam_from_world.rotation.coeffs().data(), cam_from_world.translation.data(), point.data()};
+    EXPECT_TRUE(checker.Probe(blocks.data(), 1e-7, &results)) << results.error_log;
 
     std::unique_ptr<ceres::CostFunction> constant(
-        DepthPriorConstantPoseCostFunctor::Create(
-            cam_from_world, 2.3, 0.02, type));
+        DepthPriorConstantPoseCostFunctor::Create(cam_from_world, 2.3, 0.02, type));
     const std::vector<const ceres::Manifold*> no_manifold = {nullptr};
-    ceres::GradientChecker constant_checker(
-        constant.get(), &no_manifold, numeric_options);
+    ceres::GradientChecker constant_checker(constant.get(), &no_manifold, numeric_options);
     double* point_block = point.data();
-    EXPECT_TRUE(constant_checker.Probe(&point_block, 1e-7, &results))
-        << results.error_log;
+    EXPECT_TRUE(constant_checker.Probe(&point_block, 1e-7, &results)) << results.error_log;
   }
 }
 

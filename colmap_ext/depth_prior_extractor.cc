@@ -35,14 +35,13 @@ std::optional<double> DepthAtKeypoint(const colmap::mvs::DepthMap& depth_map,
   const double u = x - 0.5, v = y - 0.5;
   const int c0 = static_cast<int>(std::floor(u));
   const int r0 = static_cast<int>(std::floor(v));
-  const double d00 = depth_at(c0, r0), d10 = depth_at(c0 + 1, r0),
-               d01 = depth_at(c0, r0 + 1), d11 = depth_at(c0 + 1, r0 + 1);
+  const double d00 = depth_at(c0, r0), d10 = depth_at(c0 + 1, r0), d01 = depth_at(c0, r0 + 1),
+               d11 = depth_at(c0 + 1, r0 + 1);
   const double lo = std::min(std::min(d00, d10), std::min(d01, d11));
   const double hi = std::max(std::max(d00, d10), std::max(d01, d11));
   if (lo > 0 && hi - lo <= options.max_relative_jump * lo) {
     const double fu = u - c0, fv = v - r0;
-    return (1 - fv) * ((1 - fu) * d00 + fu * d10) +
-           fv * ((1 - fu) * d01 + fu * d11);
+    return (1 - fv) * ((1 - fu) * d00 + fu * d10) + fv * ((1 - fu) * d01 + fu * d11);
   }
   const int radius = static_cast<int>(std::ceil(options.max_radius_px));
   double best_distance_sq = options.max_radius_px * options.max_radius_px;
@@ -64,20 +63,16 @@ std::optional<double> DepthAtKeypoint(const colmap::mvs::DepthMap& depth_map,
   return best;
 }
 
-double DepthSigma(double depth,
-                  double baseline_m,
-                  double focal_px,
-                  double sigma_pixels) {
+double DepthSigma(double depth, double baseline_m, double focal_px, double sigma_pixels) {
   // The seed's sigma_d = d^2 / (b f) * sigma_p.
   return depth * depth / (baseline_m * focal_px) * sigma_pixels;
 }
 
-std::vector<DepthPrior> ExtractDepthPriors(
-    const colmap::FeatureKeypoints& keypoints,
-    const colmap::mvs::DepthMap& depth_map,
-    double baseline_m,
-    double focal_px,
-    const DepthPriorOptions& options) {
+std::vector<DepthPrior> ExtractDepthPriors(const colmap::FeatureKeypoints& keypoints,
+                                           const colmap::mvs::DepthMap& depth_map,
+                                           double baseline_m,
+                                           double focal_px,
+                                           const DepthPriorOptions& options) {
   std::vector<DepthPrior> priors;
   for (size_t i = 0; i < keypoints.size(); ++i) {
     const std::optional<double> depth =
@@ -86,17 +81,15 @@ std::vector<DepthPrior> ExtractDepthPriors(
     DepthPrior prior;
     prior.point2D_idx = static_cast<colmap::point2D_t>(i);
     prior.depth = *depth;
-    prior.sigma =
-        DepthSigma(*depth, baseline_m, focal_px, options.sigma_pixels);
+    prior.sigma = DepthSigma(*depth, baseline_m, focal_px, options.sigma_pixels);
     priors.push_back(prior);
   }
   return priors;
 }
 
-std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(
-    const std::string& database_path,
-    const std::string& depth_path,
-    const DepthPriorOptions& options) {
+std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(const std::string& database_path,
+                                                             const std::string& depth_path,
+                                                             const DepthPriorOptions& options) {
   THROW_CHECK(options.Check());
   THROW_CHECK(fs::is_regular_file(database_path))
       << "Database file does not exist: " << database_path;
@@ -116,11 +109,9 @@ std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(
       cameras[camera.camera_id] = camera;
     }
   }
-  std::sort(images.begin(),
-            images.end(),
-            [](const colmap::Image& a, const colmap::Image& b) {
-              return a.Name() < b.Name();
-            });
+  std::sort(images.begin(), images.end(), [](const colmap::Image& a, const colmap::Image& b) {
+    return a.Name() < b.Name();
+  });
   std::vector<ImageDepthPriorCount> counts;
   std::map<colmap::image_t, std::vector<DepthPrior>> priors;
   for (const colmap::Image& image : images) {
@@ -136,14 +127,12 @@ std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(
       THROW_CHECK_GT(depth_map.GetWidth(), 0) << "cannot read " << map_path;
       // The map must be in this image's pixel grid, or every prior would be read at the wrong place.
       const colmap::Camera& camera = cameras.at(image.CameraId());
-      if (depth_map.GetWidth() != camera.width ||
-          depth_map.GetHeight() != camera.height) {
-        throw std::runtime_error(
-            map_path + " is " + std::to_string(depth_map.GetWidth()) + "x" +
-            std::to_string(depth_map.GetHeight()) + " but image " +
-            image.Name() + " is " + std::to_string(camera.width) + "x" +
-            std::to_string(camera.height) +
-            ": the depth maps belong to another dataset or rig");
+      if (depth_map.GetWidth() != camera.width || depth_map.GetHeight() != camera.height) {
+        throw std::runtime_error(map_path + " is " + std::to_string(depth_map.GetWidth()) + "x" +
+                                 std::to_string(depth_map.GetHeight()) + " but image " +
+                                 image.Name() + " is " + std::to_string(camera.width) + "x" +
+                                 std::to_string(camera.height) +
+                                 ": the depth maps belong to another dataset or rig");
       }
       std::vector<DepthPrior>& image_priors = priors[image.ImageId()];
       image_priors = ExtractDepthPriors(keypoints.at(image.ImageId()),
@@ -152,15 +141,13 @@ std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(
                                         info.rectified_focal_px,
                                         options);
       count.num_priors = image_priors.size();
-      std::cout << "  " << image.Name() << ": " << count.num_priors << " of "
-                << count.num_keypoints << " keypoints with a depth prior ("
-                << std::fixed << std::setprecision(1)
-                << 100.0 * count.num_priors /
-                       std::max<size_t>(1, count.num_keypoints)
-                << " %)" << std::endl;
+      std::cout << "  " << image.Name() << ": " << count.num_priors << " of " << count.num_keypoints
+                << " keypoints with a depth prior (" << std::fixed << std::setprecision(1)
+                << 100.0 * count.num_priors / std::max<size_t>(1, count.num_keypoints) << " %)"
+                << std::endl;
     } else {
-      std::cout << "  " << image.Name() << ": no depth map (" << map_path
-                << "), no priors" << std::endl;
+      std::cout << "  " << image.Name() << ": no depth map (" << map_path << "), no priors"
+                << std::endl;
     }
     counts.push_back(count);
   }

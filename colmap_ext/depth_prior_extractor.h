@@ -37,18 +37,14 @@ std::optional<double> DepthAtKeypoint(const colmap::mvs::DepthMap& depth_map,
                                       const DepthPriorOptions& options);
 
 // sigma_d = d^2 / (b f) * sigma_p.
-double DepthSigma(double depth,
-                  double baseline_m,
-                  double focal_px,
-                  double sigma_pixels);
+double DepthSigma(double depth, double baseline_m, double focal_px, double sigma_pixels);
 
 // Priors of one image's keypoints (point2D_idx = keypoint index, as in COLMAP).
-std::vector<DepthPrior> ExtractDepthPriors(
-    const colmap::FeatureKeypoints& keypoints,
-    const colmap::mvs::DepthMap& depth_map,
-    double baseline_m,
-    double focal_px,
-    const DepthPriorOptions& options);
+std::vector<DepthPrior> ExtractDepthPriors(const colmap::FeatureKeypoints& keypoints,
+                                           const colmap::mvs::DepthMap& depth_map,
+                                           double baseline_m,
+                                           double focal_px,
+                                           const DepthPriorOptions& options);
 
 struct ImageDepthPriorCount {
   std::string image_name;
@@ -60,9 +56,8 @@ struct ImageDepthPriorCount {
 // For every image of the database whose depth map DEPTH_PATH/depth_maps/<stem>.png.geometric.bin exists
 // (stem = image file name without extension: left/000.png -> 000), extracts the priors and replaces the
 // image's rows in depth_priors, all images in ONE transaction. Prints a line per image.
-std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(
-    const std::string& database_path,
-    const std::string& depth_path,
-    const DepthPriorOptions& options);
+std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(const std::string& database_path,
+                                                             const std::string& depth_path,
+                                                             const DepthPriorOptions& options);
 
 }  // namespace colmap_lidar

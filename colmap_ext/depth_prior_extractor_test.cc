@@ -45,10 +45,8 @@ TEST(DepthAtKeypoint, NeverBlendsAcrossADepthEdge) {
     for (int col = 0; col < 10; ++col) map.Set(row, col, col < 5 ? 2.f : 4.f);
   }
   DepthPriorOptions options;
-  const std::optional<double> near_side =
-      DepthAtKeypoint(map, 4.9, 3.5, options);
-  const std::optional<double> far_side =
-      DepthAtKeypoint(map, 5.1, 3.5, options);
+  const std::optional<double> near_side = DepthAtKeypoint(map, 4.9, 3.5, options);
+  const std::optional<double> far_side = DepthAtKeypoint(map, 5.1, 3.5, options);
   ASSERT_TRUE(near_side && far_side);
   EXPECT_DOUBLE_EQ(*near_side, 2.0);
   EXPECT_DOUBLE_EQ(*far_side, 4.0);
@@ -57,8 +55,7 @@ TEST(DepthAtKeypoint, NeverBlendsAcrossADepthEdge) {
 TEST(DepthSigma, IsTheSeedsFormula) {
   // sigma_d = d^2 / (b f) sigma_p: 2.5 m, 0.38 m, 1154 px, 1 px -> 14.25 mm.
   EXPECT_NEAR(DepthSigma(2.5, 0.38, 1154, 1.0), 6.25 / (0.38 * 1154), 1e-12);
-  EXPECT_NEAR(
-      DepthSigma(2.5, 0.38, 1154, 0.5), 0.5 * 6.25 / (0.38 * 1154), 1e-12);
+  EXPECT_NEAR(DepthSigma(2.5, 0.38, 1154, 0.5), 0.5 * 6.25 / (0.38 * 1154), 1e-12);
 }
 
 TEST(ExtractDepthPriors, KeepsKeypointIndicesAndSkipsKeypointsWithoutDepth) {

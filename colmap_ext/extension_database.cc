@@ -20,16 +20,14 @@ void BindRigid3d(SqliteStatement* stmt,
 
 colmap::Rigid3d ColumnRigid3d(const SqliteStatement& stmt, int first_column) {
   colmap::Rigid3d target_from_source;
-  target_from_source.rotation =
-      Eigen::Quaterniond(stmt.ColumnDouble(first_column),
-                         stmt.ColumnDouble(first_column + 1),
-                         stmt.ColumnDouble(first_column + 2),
-                         stmt.ColumnDouble(first_column + 3))
-          .normalized();
-  target_from_source.translation =
-      Eigen::Vector3d(stmt.ColumnDouble(first_column + 4),
-                      stmt.ColumnDouble(first_column + 5),
-                      stmt.ColumnDouble(first_column + 6));
+  target_from_source.rotation = Eigen::Quaterniond(stmt.ColumnDouble(first_column),
+                                                   stmt.ColumnDouble(first_column + 1),
+                                                   stmt.ColumnDouble(first_column + 2),
+                                                   stmt.ColumnDouble(first_column + 3))
+                                    .normalized();
+  target_from_source.translation = Eigen::Vector3d(stmt.ColumnDouble(first_column + 4),
+                                                   stmt.ColumnDouble(first_column + 5),
+                                                   stmt.ColumnDouble(first_column + 6));
   return target_from_source;
 }
 
@@ -43,23 +41,18 @@ std::string RigidColumns(const std::string& prefix, const std::string& type) {
 
 }  // namespace
 
-ExtensionDatabase::ExtensionDatabase(const std::string& path,
-                                     Mode mode,
-                                     int busy_timeout_ms)
+ExtensionDatabase::ExtensionDatabase(const std::string& path, Mode mode, int busy_timeout_ms)
     : connection_(path, mode, busy_timeout_ms) {
-  if (!connection_.TableExists("images") ||
-      !connection_.TableExists("cameras")) {
-    throw std::runtime_error(
-        "Not a COLMAP database (no 'images'/'cameras' tables): " + path +
-        ". Create it with `colmap database_creator` or "
-        "`colmap-lidar database_creator` first.");
+  if (!connection_.TableExists("images") || !connection_.TableExists("cameras")) {
+    throw std::runtime_error("Not a COLMAP database (no 'images'/'cameras' tables): " + path +
+                             ". Create it with `colmap database_creator` or "
+                             "`colmap-lidar database_creator` first.");
   }
   if (mode == Mode::kReadWrite && !HasOurTables()) CreateTables();
 }
 
 bool ExtensionDatabase::HasOurTables() const {
-  return connection_.TableExists("depth_priors") &&
-         connection_.TableExists("lidar_frames") &&
+  return connection_.TableExists("depth_priors") && connection_.TableExists("lidar_frames") &&
          connection_.TableExists("rig");
 }
 
@@ -95,21 +88,18 @@ void ExtensionDatabase::CreateTables() {
   transaction.Commit();
 }
 
-void ExtensionDatabase::WriteDepthPriors(
-    colmap::image_t image_id, const std::vector<DepthPrior>& priors) {
+void ExtensionDatabase::WriteDepthPriors(colmap::image_t image_id,
+                                         const std::vector<DepthPrior>& priors) {
   WriteDepthPriors({{image_id, priors}});
 }
 
 void ExtensionDatabase::WriteDepthPriors(
-    const std::map<colmap::image_t, std::vector<DepthPrior>>&
-        priors_per_image) {
+    const std::map<colmap::image_t, std::vector<DepthPrior>>& priors_per_image) {
   SqliteTransaction transaction(connection_);
-  SqliteStatement remove(connection_,
-                         "DELETE FROM depth_priors WHERE image_id=?");
-  SqliteStatement insert(
-      connection_,
-      "INSERT INTO depth_priors(image_id, point2D_idx, depth, sigma) "
-      "VALUES(?, ?, ?, ?)");
+  SqliteStatement remove(connection_, "DELETE FROM depth_priors WHERE image_id=?");
+  SqliteStatement insert(connection_,
+                         "INSERT INTO depth_priors(image_id, point2D_idx, depth, sigma) "
+                         "VALUES(?, ?, ?, ?)");
   for (const auto& [image_id, priors] : priors_per_image) {
     remove.Reset();
     remove.BindInt64(1, image_id);
@@ -126,8 +116,7 @@ void ExtensionDatabase::WriteDepthPriors(
   transaction.Commit();
 }
 
-std::vector<DepthPrior> ExtensionDatabase::ReadDepthPriors(
-    colmap::image_t image_id) const {
+std::vector<DepthPrior> ExtensionDatabase::ReadDepthPriors(colmap::image_t image_id) const {
   std::vector<DepthPrior> priors;
   if (!HasOurTables()) return priors;
   SqliteStatement select(connection_,
@@ -160,19 +149,18 @@ void ExtensionDatabase::ClearDepthPriors() {
 int64_t ExtensionDatabase::WriteLidarFrame(const LidarFrame& frame) {
   THROW_CHECK(!frame.path.empty()) << "LiDAR frame without a cloud path";
   SqliteTransaction transaction(connection_);
-  SqliteStatement upsert(
-      connection_,
-      "INSERT INTO lidar_frames(image_id, path" +
-          RigidColumns("cam_from_lidar_guess", "") +
-          ") VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?) "
-          "ON CONFLICT(image_id) DO UPDATE SET path=excluded.path, "
-          "cam_from_lidar_guess_qw=excluded.cam_from_lidar_guess_qw, "
-          "cam_from_lidar_guess_qx=excluded.cam_from_lidar_guess_qx, "
-          "cam_from_lidar_guess_qy=excluded.cam_from_lidar_guess_qy, "
-          "cam_from_lidar_guess_qz=excluded.cam_from_lidar_guess_qz, "
-          "cam_from_lidar_guess_tx=excluded.cam_from_lidar_guess_tx, "
-          "cam_from_lidar_guess_ty=excluded.cam_from_lidar_guess_ty, "
-          "cam_from_lidar_guess_tz=excluded.cam_from_lidar_guess_tz");
+  SqliteStatement upsert(connection_,
+                         "INSERT INTO lidar_frames(image_id, path" +
+                             RigidColumns("cam_from_lidar_guess", "") +
+                             ") VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?) "
+                             "ON CONFLICT(image_id) DO UPDATE SET path=excluded.path, "
+                             "cam_from_lidar_guess_qw=excluded.cam_from_lidar_guess_qw, "
+                             "cam_from_lidar_guess_qx=excluded.cam_from_lidar_guess_qx, "
+                             "cam_from_lidar_guess_qy=excluded.cam_from_lidar_guess_qy, "
+                             "cam_from_lidar_guess_qz=excluded.cam_from_lidar_guess_qz, "
+                             "cam_from_lidar_guess_tx=excluded.cam_from_lidar_guess_tx, "
+                             "cam_from_lidar_guess_ty=excluded.cam_from_lidar_guess_ty, "
+                             "cam_from_lidar_guess_tz=excluded.cam_from_lidar_guess_tz");
   upsert.BindInt64(1, frame.image_id);
   upsert.BindText(2, frame.path);
   if (frame.cam_from_lidar_guess) {
@@ -181,8 +169,7 @@ int64_t ExtensionDatabase::WriteLidarFrame(const LidarFrame& frame) {
     for (int i = 3; i < 10; ++i) upsert.BindNull(i);
   }
   upsert.Execute();
-  SqliteStatement select(connection_,
-                         "SELECT frame_id FROM lidar_frames WHERE image_id=?");
+  SqliteStatement select(connection_, "SELECT frame_id FROM lidar_frames WHERE image_id=?");
   select.BindInt64(1, frame.image_id);
   THROW_CHECK(select.Step());
   const int64_t frame_id = select.ColumnInt64(0);
@@ -210,8 +197,7 @@ std::vector<LidarFrame> ExtensionDatabase::ReadLidarFrames() const {
   return frames;
 }
 
-std::optional<LidarFrame> ExtensionDatabase::ReadLidarFrameOfImage(
-    colmap::image_t image_id) const {
+std::optional<LidarFrame> ExtensionDatabase::ReadLidarFrameOfImage(colmap::image_t image_id) const {
   for (LidarFrame& frame : ReadLidarFrames()) {
     if (frame.image_id == image_id) return std::move(frame);
   }
@@ -224,19 +210,16 @@ void ExtensionDatabase::WriteRig(const StereoRig& rig) {
       << "Right camera parameters do not fit model " << right.ModelName();
   THROW_CHECK_GT(rig.BaselineMeters(), 0) << "Stereo rig with zero baseline";
   SqliteTransaction transaction(connection_);
-  SqliteStatement upsert(
-      connection_,
-      "INSERT OR REPLACE INTO rig(rig_id, left_camera_id, right_model, "
-      "right_width, right_height, right_params" +
-          RigidColumns("right_from_left", "") +
-          ") VALUES(1, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  SqliteStatement upsert(connection_,
+                         "INSERT OR REPLACE INTO rig(rig_id, left_camera_id, right_model, "
+                         "right_width, right_height, right_params" +
+                             RigidColumns("right_from_left", "") +
+                             ") VALUES(1, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   upsert.BindInt64(1, rig.left_camera_id);
   upsert.BindText(2, right.ModelName());
   upsert.BindInt64(3, static_cast<int64_t>(right.width));
   upsert.BindInt64(4, static_cast<int64_t>(right.height));
-  upsert.BindBlob(5,
-                  right.params.data(),
-                  static_cast<int>(right.params.size() * sizeof(double)));
+  upsert.BindBlob(5, right.params.data(), static_cast<int>(right.params.size() * sizeof(double)));
   BindRigid3d(&upsert, 6, rig.right_from_left);
   upsert.Execute();
   transaction.Commit();
@@ -247,15 +230,13 @@ std::optional<StereoRig> ExtensionDatabase::ReadRig() const {
   SqliteStatement select(connection_,
                          "SELECT left_camera_id, right_model, right_width, "
                          "right_height, right_params" +
-                             RigidColumns("right_from_left", "") +
-                             " FROM rig WHERE rig_id=1");
+                             RigidColumns("right_from_left", "") + " FROM rig WHERE rig_id=1");
   if (!select.Step()) return std::nullopt;
   StereoRig rig;
   rig.left_camera_id = static_cast<colmap::camera_t>(select.ColumnInt64(0));
   const std::string model = select.ColumnText(1);
   if (!colmap::ExistsCameraModelWithName(model)) {
-    throw std::runtime_error("Unknown camera model '" + model +
-                             "' in table rig of " + Path());
+    throw std::runtime_error("Unknown camera model '" + model + "' in table rig of " + Path());
   }
   rig.right_camera.model_id = colmap::CameraModelNameToId(model);
   rig.right_camera.width = static_cast<size_t>(select.ColumnInt64(2));

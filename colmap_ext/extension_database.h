@@ -64,12 +64,9 @@ class ExtensionDatabase {
   const std::string& Path() const { return connection_.Path(); }
 
   // Depth priors. Write replaces all rows of the given image in one transaction.
-  void WriteDepthPriors(colmap::image_t image_id,
-                        const std::vector<DepthPrior>& priors);
+  void WriteDepthPriors(colmap::image_t image_id, const std::vector<DepthPrior>& priors);
   // Several images in one transaction (all or nothing).
-  void WriteDepthPriors(
-      const std::map<colmap::image_t, std::vector<DepthPrior>>&
-          priors_per_image);
+  void WriteDepthPriors(const std::map<colmap::image_t, std::vector<DepthPrior>>& priors_per_image);
   std::vector<DepthPrior> ReadDepthPriors(colmap::image_t image_id) const;
   size_t NumDepthPriors() const;
   void ClearDepthPriors();
@@ -77,8 +74,7 @@ class ExtensionDatabase {
   // LiDAR frames. Write inserts or replaces the frame of frame.image_id; returns its frame_id.
   int64_t WriteLidarFrame(const LidarFrame& frame);
   std::vector<LidarFrame> ReadLidarFrames() const;
-  std::optional<LidarFrame> ReadLidarFrameOfImage(
-      colmap::image_t image_id) const;
+  std::optional<LidarFrame> ReadLidarFrameOfImage(colmap::image_t image_id) const;
 
   // The station rig (one per database).
   void WriteRig(const StereoRig& rig);

@@ -23,8 +23,8 @@ class ExtensionDatabaseTest : public ::testing::Test {
   void SetUp() override {
     path_ = dir_.File("database.db");
     colmap::Database database(path_);
-    const colmap::Camera camera = colmap::Camera::CreateFromModelName(
-        colmap::kInvalidCameraId, "PINHOLE", 800, 1028, 752);
+    const colmap::Camera camera =
+        colmap::Camera::CreateFromModelName(colmap::kInvalidCameraId, "PINHOLE", 800, 1028, 752);
     camera_id_ = database.WriteCamera(camera);
     for (int i = 0; i < 3; ++i) {
       colmap::Image image;
@@ -37,9 +37,7 @@ class ExtensionDatabaseTest : public ::testing::Test {
   static std::vector<DepthPrior> MakePriors(int n, double depth0) {
     std::vector<DepthPrior> priors;
     for (int i = 0; i < n; ++i) {
-      priors.push_back({static_cast<colmap::point2D_t>(2 * i),
-                        depth0 + 0.01 * i,
-                        0.001 * (i + 1)});
+      priors.push_back({static_cast<colmap::point2D_t>(2 * i), depth0 + 0.01 * i, 0.001 * (i + 1)});
     }
     return priors;
   }
@@ -59,10 +57,9 @@ TEST_F(ExtensionDatabaseTest, RoundTripsAllTables) {
     LidarFrame frame;
     frame.image_id = image_ids_[0];
     frame.path = "lidar/000.pcd";
-    frame.cam_from_lidar_guess =
-        colmap::Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(
-                            0.3, Eigen::Vector3d(1, 2, 3).normalized())),
-                        Eigen::Vector3d(0.1, -0.2, 0.05));
+    frame.cam_from_lidar_guess = colmap::Rigid3d(
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())),
+        Eigen::Vector3d(0.1, -0.2, 0.05));
     EXPECT_GT(db.WriteLidarFrame(frame), 0);
     LidarFrame frame_without_guess;
     frame_without_guess.image_id = image_ids_[1];
@@ -71,8 +68,8 @@ TEST_F(ExtensionDatabaseTest, RoundTripsAllTables) {
 
     StereoRig rig;
     rig.left_camera_id = camera_id_;
-    rig.right_camera = colmap::Camera::CreateFromModelName(
-        colmap::kInvalidCameraId, "OPENCV", 805, 1028, 752);
+    rig.right_camera =
+        colmap::Camera::CreateFromModelName(colmap::kInvalidCameraId, "OPENCV", 805, 1028, 752);
     rig.right_camera.params[4] = -0.05;
     rig.right_from_left.translation = Eigen::Vector3d(-0.38, 0.001, 0.002);
     db.WriteRig(rig);
@@ -91,9 +88,8 @@ TEST_F(ExtensionDatabaseTest, RoundTripsAllTables) {
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(frames[0].path, "lidar/000.pcd");
   ASSERT_TRUE(frames[0].cam_from_lidar_guess.has_value());
-  EXPECT_NEAR(frames[0].cam_from_lidar_guess->rotation.angularDistance(
-                  Eigen::Quaterniond(Eigen::AngleAxisd(
-                      0.3, Eigen::Vector3d(1, 2, 3).normalized()))),
+  EXPECT_NEAR(frames[0].cam_from_lidar_guess->rotation.angularDistance(Eigen::Quaterniond(
+                  Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()))),
               0,
               1e-12);
   EXPECT_NEAR(frames[0].cam_from_lidar_guess->translation.y(), -0.2, 1e-15);
@@ -138,16 +134,15 @@ TEST_F(ExtensionDatabaseTest, FailedWriteRollsBackWholeTransaction) {
 
 TEST_F(ExtensionDatabaseTest, ForeignKeysRejectUnknownImagesAndCameras) {
   ExtensionDatabase db(path_);
-  EXPECT_THROW(db.WriteDepthPriors(9999, MakePriors(3, 1.0)),
-               std::runtime_error);
+  EXPECT_THROW(db.WriteDepthPriors(9999, MakePriors(3, 1.0)), std::runtime_error);
   LidarFrame frame;
   frame.image_id = 9999;
   frame.path = "lidar/x.pcd";
   EXPECT_THROW(db.WriteLidarFrame(frame), std::runtime_error);
   StereoRig rig;
   rig.left_camera_id = 4242;
-  rig.right_camera = colmap::Camera::CreateFromModelName(
-      colmap::kInvalidCameraId, "PINHOLE", 800, 10, 10);
+  rig.right_camera =
+      colmap::Camera::CreateFromModelName(colmap::kInvalidCameraId, "PINHOLE", 800, 10, 10);
   rig.right_from_left.translation.x() = -0.38;
   EXPECT_THROW(db.WriteRig(rig), std::runtime_error);
   EXPECT_EQ(db.NumDepthPriors(), 0u);
@@ -176,14 +171,12 @@ TEST_F(ExtensionDatabaseTest, LockedDatabaseGivesClearErrorAndNoChange) {
   db.WriteDepthPriors(image_ids_[0], MakePriors(3, 2.0));
   sqlite3* other = nullptr;
   ASSERT_EQ(sqlite3_open(path_.c_str(), &other), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(other, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr),
-            SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(other, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
   try {
     db.WriteDepthPriors(image_ids_[0], MakePriors(8, 5.0));
     ADD_FAILURE() << "write to a locked database succeeded";
   } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find("lock"), std::string::npos)
-        << error.what();
+    EXPECT_NE(std::string(error.what()).find("lock"), std::string::npos) << error.what();
     EXPECT_NE(std::string(error.what()).find(path_), std::string::npos);
   }
   sqlite3_exec(other, "ROLLBACK", nullptr, nullptr, nullptr);
@@ -198,8 +191,7 @@ TEST_F(ExtensionDatabaseTest, ReadOnlyDatabaseRefusesWrites) {
     db.WriteDepthPriors(image_ids_[0], MakePriors(3, 2.0));
     ADD_FAILURE() << "write to a read-only database succeeded";
   } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find("read-only"), std::string::npos)
-        << error.what();
+    EXPECT_NE(std::string(error.what()).find("read-only"), std::string::npos) << error.what();
   }
   EXPECT_EQ(db.NumDepthPriors(), 0u);
 }
@@ -227,8 +219,7 @@ TEST_F(ExtensionDatabaseTest, RejectsMissingAndNonColmapFiles) {
     ExtensionDatabase db(empty_sqlite);
     ADD_FAILURE();
   } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find("Not a COLMAP database"),
-              std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("Not a COLMAP database"), std::string::npos);
   }
 }
 

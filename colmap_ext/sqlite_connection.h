@@ -89,8 +89,6 @@ class SqliteTransaction {
 // `from` (its write-ahead log included, which a file copy would lose: COLMAP databases are in WAL mode),
 // written into `to` as one transaction (created if absent). Retries while either is locked, up to
 // `busy_timeout_ms`, then throws naming the locked file.
-void CopySqliteDatabase(const std::string& from,
-                        const std::string& to,
-                        int busy_timeout_ms = 5000);
+void CopySqliteDatabase(const std::string& from, const std::string& to, int busy_timeout_ms = 5000);
 
 }  // namespace colmap_lidar

@@ -37,9 +37,7 @@ std::vector<double> NumberArray(const json& value,
                                 const std::string& path,
                                 const std::string& key) {
   if (!value.is_array() || (expected_size && value.size() != expected_size)) {
-    Fail(path,
-         "'" + key + "' must be an array of " + std::to_string(expected_size) +
-             " numbers");
+    Fail(path, "'" + key + "' must be an array of " + std::to_string(expected_size) + " numbers");
   }
   std::vector<double> numbers;
   for (const json& v : value) {
@@ -51,16 +49,11 @@ std::vector<double> NumberArray(const json& value,
   return numbers;
 }
 
-colmap::Camera ParseCamera(const json& value,
-                           const std::string& path,
-                           const std::string& key) {
+colmap::Camera ParseCamera(const json& value, const std::string& path, const std::string& key) {
   const std::string where = key + ".";
   const json& model = Require(value, "model", path, where);
-  if (!model.is_string() ||
-      !colmap::ExistsCameraModelWithName(model.get<std::string>())) {
-    Fail(path,
-         "'" + where +
-             "model' is not a COLMAP camera model name: " + model.dump());
+  if (!model.is_string() || !colmap::ExistsCameraModelWithName(model.get<std::string>())) {
+    Fail(path, "'" + where + "model' is not a COLMAP camera model name: " + model.dump());
   }
   colmap::Camera camera;
   camera.model_id = colmap::CameraModelNameToId(model.get<std::string>());
@@ -76,9 +69,8 @@ colmap::Camera ParseCamera(const json& value,
   const json& params = Require(value, "params", path, where);
   if (!params.is_array() || params.size() != num_params) {
     Fail(path,
-         "'" + where + "params' must hold " + std::to_string(num_params) +
-             " values for model " + camera.ModelName() + " (" +
-             camera.ParamsInfo() + "), got " +
+         "'" + where + "params' must hold " + std::to_string(num_params) + " values for model " +
+             camera.ModelName() + " (" + camera.ParamsInfo() + "), got " +
              std::to_string(params.is_array() ? params.size() : 0));
   }
   camera.params = NumberArray(params, num_params, path, where + "params");
@@ -88,22 +80,16 @@ colmap::Camera ParseCamera(const json& value,
   return camera;
 }
 
-colmap::Rigid3d ParseRigid(const json& value,
-                           const std::string& path,
-                           const std::string& key) {
-  const std::vector<double> q = NumberArray(
-      Require(value, "rotation", path, key + "."), 4, path, key + ".rotation");
+colmap::Rigid3d ParseRigid(const json& value, const std::string& path, const std::string& key) {
+  const std::vector<double> q =
+      NumberArray(Require(value, "rotation", path, key + "."), 4, path, key + ".rotation");
   const std::vector<double> t =
-      NumberArray(Require(value, "translation", path, key + "."),
-                  3,
-                  path,
-                  key + ".translation");
+      NumberArray(Require(value, "translation", path, key + "."), 3, path, key + ".translation");
   const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);  // w first
   if (std::abs(rotation.norm() - 1) > 1e-3) {
     Fail(path, "'" + key + ".rotation' is not a unit quaternion [qw,qx,qy,qz]");
   }
-  return colmap::Rigid3d(rotation.normalized(),
-                         Eigen::Vector3d(t[0], t[1], t[2]));
+  return colmap::Rigid3d(rotation.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
 }
 
 json CameraToJson(const colmap::Camera& camera) {
@@ -116,36 +102,29 @@ json CameraToJson(const colmap::Camera& camera) {
 json RigidToJson(const colmap::Rigid3d& pose) {
   const Eigen::Quaterniond& q = pose.rotation;
   return {{"rotation", {q.w(), q.x(), q.y(), q.z()}},
-          {"translation",
-           {pose.translation.x(), pose.translation.y(), pose.translation.z()}}};
+          {"translation", {pose.translation.x(), pose.translation.y(), pose.translation.z()}}};
 }
 
 std::string PoseLine(const colmap::Rigid3d& pose) {
   std::ostringstream line;
   line << std::setprecision(17);
   const Eigen::Quaterniond& q = pose.rotation;
-  line << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " "
-       << pose.translation.x() << " " << pose.translation.y() << " "
-       << pose.translation.z();
+  line << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " " << pose.translation.x()
+       << " " << pose.translation.y() << " " << pose.translation.z();
   return line.str();
 }
 
-colmap::Rigid3d ParsePose(std::istream& tokens,
-                          const std::string& path,
-                          size_t line_number) {
+colmap::Rigid3d ParsePose(std::istream& tokens, const std::string& path, size_t line_number) {
   double v[7];
   for (double& x : v) {
     if (!(tokens >> x) || !std::isfinite(x)) {
-      Fail(path,
-           "line " + std::to_string(line_number) +
-               ": expected qw qx qy qz tx ty tz");
+      Fail(path, "line " + std::to_string(line_number) + ": expected qw qx qy qz tx ty tz");
     }
   }
   const Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
   if (std::abs(q.norm() - 1) > 1e-3) {
     Fail(path,
-         "line " + std::to_string(line_number) +
-             ": rotation is not a unit quaternion (qw first)");
+         "line " + std::to_string(line_number) + ": rotation is not a unit quaternion (qw first)");
   }
   return colmap::Rigid3d(q.normalized(), Eigen::Vector3d(v[4], v[5], v[6]));
 }
@@ -179,20 +158,18 @@ StationRig ReadRigJson(const std::string& path) {
   StationRig rig;
   rig.left = ParseCamera(Require(root, "left", path, ""), path, "left");
   rig.right = ParseCamera(Require(root, "right", path, ""), path, "right");
-  rig.right_from_left = ParseRigid(
-      Require(root, "right_from_left", path, ""), path, "right_from_left");
+  rig.right_from_left =
+      ParseRigid(Require(root, "right_from_left", path, ""), path, "right_from_left");
   if (rig.BaselineMeters() < 1e-3) {
     Fail(path, "'right_from_left.translation' gives a baseline below 1 mm");
   }
-  if (root.contains("cam_from_lidar_guess") &&
-      !root["cam_from_lidar_guess"].is_null()) {
+  if (root.contains("cam_from_lidar_guess") && !root["cam_from_lidar_guess"].is_null()) {
     rig.cam_from_lidar_guess =
         ParseRigid(root["cam_from_lidar_guess"], path, "cam_from_lidar_guess");
   }
   if (root.contains("lidar")) {
     const json& lidar = root["lidar"];
-    if (lidar.contains("model"))
-      rig.lidar_model = lidar["model"].get<std::string>();
+    if (lidar.contains("model")) rig.lidar_model = lidar["model"].get<std::string>();
     if (lidar.contains("range_noise_m")) {
       rig.lidar_range_noise_m = lidar["range_noise_m"].get<double>();
     }
@@ -214,8 +191,7 @@ void WriteRigJson(const std::string& path, const StationRig& rig) {
     root["cam_from_lidar_guess"] = RigidToJson(*rig.cam_from_lidar_guess);
   }
   if (!rig.lidar_model.empty()) {
-    root["lidar"] = {{"model", rig.lidar_model},
-                     {"range_noise_m", rig.lidar_range_noise_m}};
+    root["lidar"] = {{"model", rig.lidar_model}, {"range_noise_m", rig.lidar_range_noise_m}};
   }
   WriteFileAtomically(path, root.dump(2) + "\n");
 }
@@ -225,8 +201,7 @@ std::string StationDataset::LeftImagePath(size_t i) const {
 }
 
 std::string StationDataset::RightImagePath(size_t i) const {
-  return (fs::path(root) / "images" / "right" / (stations.at(i) + ".png"))
-      .string();
+  return (fs::path(root) / "images" / "right" / (stations.at(i) + ".png")).string();
 }
 
 std::string StationDataset::LeftImageName(size_t i) const {
@@ -259,13 +234,11 @@ StationDataset ReadStationDataset(const std::string& root) {
   if (dataset.stations.empty()) Fail(left_dir.string(), "no .png images");
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
     if (!fs::is_regular_file(dataset.RightImagePath(i))) {
-      Fail(dataset.RightImagePath(i),
-           "missing right image of station " + dataset.stations[i]);
+      Fail(dataset.RightImagePath(i), "missing right image of station " + dataset.stations[i]);
     }
     std::string cloud;
     for (const char* ext : {".pcd", ".ply", ".bin"}) {
-      const fs::path candidate =
-          fs::path(root) / "lidar" / (dataset.stations[i] + ext);
+      const fs::path candidate = fs::path(root) / "lidar" / (dataset.stations[i] + ext);
       if (fs::is_regular_file(candidate)) {
         cloud = candidate.string();
         break;
@@ -293,9 +266,7 @@ std::map<std::string, colmap::Rigid3d> ReadNamedPoses(const std::string& path) {
     std::string name;
     tokens >> name;
     if (poses.count(name)) {
-      Fail(path,
-           "line " + std::to_string(line_number) + ": station '" + name +
-               "' appears twice");
+      Fail(path, "line " + std::to_string(line_number) + ": station '" + name + "' appears twice");
     }
     poses[name] = ParsePose(tokens, path, line_number);
   }
@@ -309,8 +280,7 @@ void WriteNamedPoses(const std::string& path,
   out << "# " << header_comment << "\n"
       << "# <station> qw qx qy qz tx ty tz   (target_from_source, quaternion w "
          "first, metres)\n";
-  for (const auto& [name, pose] : poses)
-    out << name << " " << PoseLine(pose) << "\n";
+  for (const auto& [name, pose] : poses) out << name << " " << PoseLine(pose) << "\n";
   WriteFileAtomically(path, out.str());
 }
 

@@ -38,9 +38,7 @@ class StationDatasetTest : public ::testing::Test {
       std::ofstream(dir_.File("lidar/") + s + ".pcd") << "x";
     }
   }
-  void WriteRig(const json& rig) {
-    std::ofstream(dir_.File("rig.json")) << rig.dump();
-  }
+  void WriteRig(const json& rig) { std::ofstream(dir_.File("rig.json")) << rig.dump(); }
 
   // Expects ReadStationDataset to fail with a message naming `file` and containing `problem`.
   void ExpectError(const std::string& file, const std::string& problem) {
@@ -77,10 +75,10 @@ TEST_F(StationDatasetTest, RigJsonRoundTrips) {
   const StationRig copy = ReadRigJson(dir_.File("copy.json"));
   EXPECT_EQ(copy.right.params, rig.right.params);
   EXPECT_EQ(copy.lidar_model, "VLP-16");
-  EXPECT_NEAR(copy.cam_from_lidar_guess->rotation.angularDistance(
-                  rig.cam_from_lidar_guess->rotation),
-              0,
-              1e-12);
+  EXPECT_NEAR(
+      copy.cam_from_lidar_guess->rotation.angularDistance(rig.cam_from_lidar_guess->rotation),
+      0,
+      1e-12);
 }
 
 TEST_F(StationDatasetTest, BadRigJsonNamesTheFileAndTheKey) {
@@ -124,16 +122,13 @@ TEST_F(StationDatasetTest, MissingImageOrCloudNamesTheFile) {
   std::ofstream(dir_.File("images/right/001.png")) << "x";
   fs::remove(dir_.File("lidar/000.pcd"));
   ExpectError("lidar/000.pcd", "missing LiDAR cloud of station 000");
-  std::ofstream(dir_.File("lidar/000.bin"))
-      << "x";  // any supported format will do
-  EXPECT_EQ(ReadStationDataset(dir_.Path().string()).cloud_paths[0],
-            dir_.File("lidar/000.bin"));
+  std::ofstream(dir_.File("lidar/000.bin")) << "x";  // any supported format will do
+  EXPECT_EQ(ReadStationDataset(dir_.Path().string()).cloud_paths[0], dir_.File("lidar/000.bin"));
 }
 
 TEST_F(StationDatasetTest, PoseFilesRoundTripWithWFirst) {
   const colmap::Rigid3d pose(
-      Eigen::Quaterniond(
-          Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized())),
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized())),
       Eigen::Vector3d(1.5, -0.25, 3));
   WritePoseFile(dir_.File("p.txt"), "test", pose);
   const colmap::Rigid3d read = ReadPoseFile(dir_.File("p.txt"));
@@ -145,17 +140,14 @@ TEST_F(StationDatasetTest, PoseFilesRoundTripWithWFirst) {
   }
   EXPECT_DOUBLE_EQ(std::stod(line), pose.rotation.w());
 
-  WriteNamedPoses(
-      dir_.File("n.txt"), "test", {{"000", pose}, {"001", colmap::Rigid3d()}});
+  WriteNamedPoses(dir_.File("n.txt"), "test", {{"000", pose}, {"001", colmap::Rigid3d()}});
   const auto poses = ReadNamedPoses(dir_.File("n.txt"));
   ASSERT_EQ(poses.size(), 2u);
-  EXPECT_NEAR(
-      (poses.at("000").translation - pose.translation).norm(), 0, 1e-15);
+  EXPECT_NEAR((poses.at("000").translation - pose.translation).norm(), 0, 1e-15);
 
   std::ofstream(dir_.File("bad.txt")) << "000 1 0 0\n";
   EXPECT_THROW(ReadNamedPoses(dir_.File("bad.txt")), std::runtime_error);
-  std::ofstream(dir_.File("twice.txt"))
-      << "000 1 0 0 0 0 0 0\n000 1 0 0 0 1 1 1\n";
+  std::ofstream(dir_.File("twice.txt")) << "000 1 0 0 0 0 0 0\n000 1 0 0 0 1 1 1\n";
   EXPECT_THROW(ReadNamedPoses(dir_.File("twice.txt")), std::runtime_error);
 }
 

@@ -32,8 +32,7 @@ int SgbmMode(const std::string& mode) {
   if (mode == "hh") return cv::StereoSGBM::MODE_HH;
   if (mode == "3way") return cv::StereoSGBM::MODE_SGBM_3WAY;
   if (mode == "hh4") return cv::StereoSGBM::MODE_HH4;
-  throw std::invalid_argument("unknown SGBM mode '" + mode +
-                              "' (sgbm, hh, 3way, hh4)");
+  throw std::invalid_argument("unknown SGBM mode '" + mode + "' (sgbm, hh, 3way, hh4)");
 }
 
 // Disparity search range [min, min + num) from the depth range: num is a multiple of 16 (OpenCV).
@@ -41,13 +40,10 @@ void DisparityRange(const StereoRectifier& rectifier,
                     const StereoDepthOptions& options,
                     int* min_disparity,
                     int* num_disparities) {
-  const double fb =
-      rectifier.RectifiedFocalLength() * rectifier.BaselineMeters();
+  const double fb = rectifier.RectifiedFocalLength() * rectifier.BaselineMeters();
   *min_disparity = static_cast<int>(std::floor(fb / options.max_depth_m));
-  const int max_disparity =
-      static_cast<int>(std::ceil(fb / options.min_depth_m));
-  *num_disparities =
-      std::max(16, (max_disparity - *min_disparity + 15) / 16 * 16);
+  const int max_disparity = static_cast<int>(std::ceil(fb / options.min_depth_m));
+  *num_disparities = std::max(16, (max_disparity - *min_disparity + 15) / 16 * 16);
 }
 
 // CV_16S fixed-point (x16) SGBM output to float pixels; invalid -> 0.
@@ -99,39 +95,34 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
                                const cv::Mat& right_image,
                                const StereoRectifier& rectifier,
                                const StereoDepthOptions& options) {
-  if (left_image.size() != rectifier.ImageSize() ||
-      right_image.size() != rectifier.ImageSize()) {
+  if (left_image.size() != rectifier.ImageSize() || right_image.size() != rectifier.ImageSize()) {
     std::ostringstream message;
-    message << "stereo pair sizes (left " << left_image.cols << "x"
-            << left_image.rows << ", right " << right_image.cols << "x"
-            << right_image.rows << ") differ from the rig's "
-            << rectifier.ImageSize().width << "x"
-            << rectifier.ImageSize().height;
+    message << "stereo pair sizes (left " << left_image.cols << "x" << left_image.rows << ", right "
+            << right_image.cols << "x" << right_image.rows << ") differ from the rig's "
+            << rectifier.ImageSize().width << "x" << rectifier.ImageSize().height;
     throw std::invalid_argument(message.str());
   }
   cv::Mat left_grey = left_image, right_grey = right_image;
-  if (left_grey.channels() == 3)
-    cv::cvtColor(left_image, left_grey, cv::COLOR_BGR2GRAY);
-  if (right_grey.channels() == 3)
-    cv::cvtColor(right_image, right_grey, cv::COLOR_BGR2GRAY);
+  if (left_grey.channels() == 3) cv::cvtColor(left_image, left_grey, cv::COLOR_BGR2GRAY);
+  if (right_grey.channels() == 3) cv::cvtColor(right_image, right_grey, cv::COLOR_BGR2GRAY);
   cv::Mat left_rectified, right_rectified;
   rectifier.Rectify(left_grey, right_grey, &left_rectified, &right_rectified);
 
   int min_disparity = 0, num_disparities = 0;
   DisparityRange(rectifier, options, &min_disparity, &num_disparities);
   const int area = options.block_size * options.block_size;
-  cv::Ptr<cv::StereoSGBM> matcher = cv::StereoSGBM::create(
-      min_disparity,
-      num_disparities,
-      options.block_size,
-      options.p1_factor * area,
-      options.p2_factor * area,
-      /*disp12MaxDiff=*/-1,
-      options.pre_filter_cap,
-      options.uniqueness_ratio,
-      options.speckle_window_size,
-      static_cast<int>(std::ceil(options.speckle_range_px)),
-      SgbmMode(options.mode));
+  cv::Ptr<cv::StereoSGBM> matcher =
+      cv::StereoSGBM::create(min_disparity,
+                             num_disparities,
+                             options.block_size,
+                             options.p1_factor * area,
+                             options.p2_factor * area,
+                             /*disp12MaxDiff=*/-1,
+                             options.pre_filter_cap,
+                             options.uniqueness_ratio,
+                             options.speckle_window_size,
+                             static_cast<int>(std::ceil(options.speckle_range_px)),
+                             SgbmMode(options.mode));
 
   // Left disparity, and the right image's disparity by matching the mirrored pair (the right image
   // becomes the reference): d_right(x) = d such that right x matches left x + d.
@@ -140,10 +131,8 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
   const int pad = min_disparity + num_disparities;
   const auto match = [&](const cv::Mat& reference, const cv::Mat& other) {
     cv::Mat reference_padded, other_padded, fixed;
-    cv::copyMakeBorder(
-        reference, reference_padded, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
-    cv::copyMakeBorder(
-        other, other_padded, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
+    cv::copyMakeBorder(reference, reference_padded, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
+    cv::copyMakeBorder(other, other_padded, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
     matcher->compute(reference_padded, other_padded, fixed);
     return fixed(cv::Rect(pad, 0, reference.cols, reference.rows)).clone();
   };
@@ -163,8 +152,7 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
       float& d = left_disparity.at<float>(row, col);
       if (d <= 0.f) continue;
       const int right_col = static_cast<int>(std::lround(col - d));
-      const float d_right =
-          right_col >= 0 ? right_disparity.at<float>(row, right_col) : 0.f;
+      const float d_right = right_col >= 0 ? right_disparity.at<float>(row, right_col) : 0.f;
       const float diff = std::abs(d - d_right);
       if (mask.at<uchar>(row, col) == 0 || d_right <= 0.f ||
           diff > options.max_left_right_diff_px) {
@@ -183,8 +171,8 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
     for (int col = 0; col < lr_diff.cols; ++col) {
       const float diff = lr_diff.at<float>(row, col);
       if (diff < 0.f) continue;
-      confidence_rectified.at<uchar>(row, col) = static_cast<uchar>(std::lround(
-          1 + 254 * (1.0 - diff / (options.max_left_right_diff_px + 1e-9))));
+      confidence_rectified.at<uchar>(row, col) = static_cast<uchar>(
+          std::lround(1 + 254 * (1.0 - diff / (options.max_left_right_diff_px + 1e-9))));
     }
   }
   result.confidence = rectifier.ToLeftImage(confidence_rectified);
@@ -200,16 +188,13 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
       }
     }
   }
-  result.valid_fraction = static_cast<double>(num_valid) /
-                          static_cast<double>(result.depth.total());
+  result.valid_fraction =
+      static_cast<double>(num_valid) / static_cast<double>(result.depth.total());
   return result;
 }
 
-std::string StereoDepthMapPath(const std::string& depth_path,
-                               const std::string& station) {
-  return (fs::path(depth_path) / "depth_maps" /
-          (station + ".png.geometric.bin"))
-      .string();
+std::string StereoDepthMapPath(const std::string& depth_path, const std::string& station) {
+  return (fs::path(depth_path) / "depth_maps" / (station + ".png.geometric.bin")).string();
 }
 
 void WriteStationStereoDepth(const std::string& output_path,
@@ -225,8 +210,7 @@ void WriteStationStereoDepth(const std::string& output_path,
       max_depth = std::max(max_depth, depth.depth.at<float>(row, col));
     }
   }
-  colmap::mvs::DepthMap depth_map(
-      depth.depth.cols, depth.depth.rows, 0.f, max_depth);
+  colmap::mvs::DepthMap depth_map(depth.depth.cols, depth.depth.rows, 0.f, max_depth);
   for (int row = 0; row < depth.depth.rows; ++row) {
     for (int col = 0; col < depth.depth.cols; ++col) {
       depth_map.Set(row, col, depth.depth.at<float>(row, col));
@@ -273,8 +257,7 @@ void WriteStationStereoDepth(const std::string& output_path,
   cv::Mat preview;
   cv::applyColorMap(grey, preview, cv::COLORMAP_TURBO);
   preview.setTo(cv::Scalar(0, 0, 0), grey == 0);
-  WriteAtomically((root / "previews" / (station + ".png")).string(),
-                  write_png(preview));
+  WriteAtomically((root / "previews" / (station + ".png")).string(), write_png(preview));
 }
 
 StereoDepthInfo ReadStereoDepthInfo(const std::string& depth_path) {
@@ -282,8 +265,8 @@ StereoDepthInfo ReadStereoDepthInfo(const std::string& depth_path) {
   std::ifstream file(path);
   if (!file) {
     throw std::runtime_error("no stereo.json in " + depth_path +
-                             ": run `colmap-lidar stereo_depth --output_path " +
-                             depth_path + "` first");
+                             ": run `colmap-lidar stereo_depth --output_path " + depth_path +
+                             "` first");
   }
   try {
     const nlohmann::json json = nlohmann::json::parse(file);
@@ -302,29 +285,25 @@ void ComputeDatasetStereoDepth(const StationDataset& dataset,
                                const std::string& output_path,
                                const StereoDepthOptions& options) {
   THROW_CHECK(options.Check());
-  const StereoRectifier rectifier(
-      dataset.rig.left, dataset.rig.right, dataset.rig.right_from_left);
+  const StereoRectifier rectifier(dataset.rig.left, dataset.rig.right, dataset.rig.right_from_left);
   int min_disparity = 0, num_disparities = 0;
   DisparityRange(rectifier, options, &min_disparity, &num_disparities);
   std::cout << "Stereo depth: " << dataset.stations.size() << " stations, "
-            << rectifier.ImageSize().width << "x"
-            << rectifier.ImageSize().height << ", rectified f " << std::fixed
-            << std::setprecision(1) << rectifier.RectifiedFocalLength()
-            << " px, baseline " << std::setprecision(3)
-            << rectifier.BaselineMeters() << " m, disparities " << min_disparity
-            << ".." << min_disparity + num_disparities - 1 << " px, SGBM mode "
-            << options.mode << std::endl;
+            << rectifier.ImageSize().width << "x" << rectifier.ImageSize().height
+            << ", rectified f " << std::fixed << std::setprecision(1)
+            << rectifier.RectifiedFocalLength() << " px, baseline " << std::setprecision(3)
+            << rectifier.BaselineMeters() << " m, disparities " << min_disparity << ".."
+            << min_disparity + num_disparities - 1 << " px, SGBM mode " << options.mode
+            << std::endl;
   fs::create_directories(output_path);
-  fs::remove(fs::path(output_path) /
-             "stereo.json");  // not complete until rewritten
+  fs::remove(fs::path(output_path) / "stereo.json");  // not complete until rewritten
 
   const int num_stations = static_cast<int>(dataset.stations.size());
   std::vector<double> valid_fraction(dataset.stations.size(), 0);
   std::vector<std::string> errors(dataset.stations.size());
   std::atomic<int> num_done{0};
   std::mutex print_mutex;
-  const int num_threads =
-      options.num_threads > 0 ? options.num_threads : omp_get_max_threads();
+  const int num_threads = options.num_threads > 0 ? options.num_threads : omp_get_max_threads();
   // One station per thread; OpenCV's own threads off meanwhile (no oversubscription).
   const int opencv_threads = cv::getNumThreads();
   cv::setNumThreads(num_threads > 1 ? 1 : opencv_threads);
@@ -335,18 +314,15 @@ void ComputeDatasetStereoDepth(const StationDataset& dataset,
     try {
       const cv::Mat left = ReadImageOrThrow(dataset.LeftImagePath(i));
       const cv::Mat right = ReadImageOrThrow(dataset.RightImagePath(i));
-      const StereoDepth depth =
-          ComputeStereoDepth(left, right, rectifier, options);
+      const StereoDepth depth = ComputeStereoDepth(left, right, rectifier, options);
       WriteStationStereoDepth(output_path, station, depth);
       valid_fraction[i] = depth.valid_fraction;
       const int done = ++num_done;
-      const double seconds = std::chrono::duration<double>(
-                                 std::chrono::steady_clock::now() - start)
-                                 .count();
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       std::lock_guard<std::mutex> lock(print_mutex);
-      std::cout << "  [" << done << "/" << num_stations << "] station "
-                << station << ": " << std::setprecision(1)
-                << 100 * depth.valid_fraction << " % of pixels with depth ("
+      std::cout << "  [" << done << "/" << num_stations << "] station " << station << ": "
+                << std::setprecision(1) << 100 * depth.valid_fraction << " % of pixels with depth ("
                 << std::setprecision(0) << seconds << " s)" << std::endl;
     } catch (const std::exception& error) {
       errors[i] = "station " + station + ": " + error.what();
@@ -363,22 +339,20 @@ void ComputeDatasetStereoDepth(const StationDataset& dataset,
   json["depth"] = "z in the original left camera, metres; 0 = no depth";
   json["min_disparity_px"] = min_disparity;
   json["num_disparities"] = num_disparities;
-  json["options"] = {
-      {"mode", options.mode},
-      {"min_depth_m", options.min_depth_m},
-      {"max_depth_m", options.max_depth_m},
-      {"block_size", options.block_size},
-      {"p1_factor", options.p1_factor},
-      {"p2_factor", options.p2_factor},
-      {"uniqueness_ratio", options.uniqueness_ratio},
-      {"speckle_window_size", options.speckle_window_size},
-      {"speckle_range_px", options.speckle_range_px},
-      {"max_left_right_diff_px", options.max_left_right_diff_px}};
+  json["options"] = {{"mode", options.mode},
+                     {"min_depth_m", options.min_depth_m},
+                     {"max_depth_m", options.max_depth_m},
+                     {"block_size", options.block_size},
+                     {"p1_factor", options.p1_factor},
+                     {"p2_factor", options.p2_factor},
+                     {"uniqueness_ratio", options.uniqueness_ratio},
+                     {"speckle_window_size", options.speckle_window_size},
+                     {"speckle_range_px", options.speckle_range_px},
+                     {"max_left_right_diff_px", options.max_left_right_diff_px}};
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
     json["valid_fraction"][dataset.stations[i]] = valid_fraction[i];
   }
-  WriteFileAtomically((fs::path(output_path) / "stereo.json").string(),
-                      json.dump(2) + "\n");
+  WriteFileAtomically((fs::path(output_path) / "stereo.json").string(), json.dump(2) + "\n");
 }
 
 }  // namespace colmap_lidar

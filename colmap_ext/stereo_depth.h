@@ -60,8 +60,7 @@ void WriteStationStereoDepth(const std::string& output_path,
                              const std::string& station,
                              const StereoDepth& depth);
 
-std::string StereoDepthMapPath(const std::string& depth_path,
-                               const std::string& station);
+std::string StereoDepthMapPath(const std::string& depth_path, const std::string& station);
 
 // What stereo.json records, read back by the depth-prior extractor.
 struct StereoDepthInfo {

@@ -10,22 +10,18 @@
 
 namespace colmap_lidar {
 
-void CameraToOpenCv(const colmap::Camera& camera,
-                    cv::Mat* camera_matrix,
-                    cv::Mat* distortion) {
+void CameraToOpenCv(const colmap::Camera& camera, cv::Mat* camera_matrix, cv::Mat* distortion) {
   const std::vector<double>& p = camera.params;
   double fx = 0, fy = 0, cx = 0, cy = 0;
   std::vector<double> coefficients;
   const std::string model = camera.ModelName();
-  if (model == "SIMPLE_PINHOLE" || model == "SIMPLE_RADIAL" ||
-      model == "RADIAL") {
+  if (model == "SIMPLE_PINHOLE" || model == "SIMPLE_RADIAL" || model == "RADIAL") {
     fx = fy = p[0];
     cx = p[1];
     cy = p[2];
     if (model == "SIMPLE_RADIAL") coefficients = {p[3], 0, 0, 0};
     if (model == "RADIAL") coefficients = {p[3], p[4], 0, 0};
-  } else if (model == "PINHOLE" || model == "OPENCV" ||
-             model == "FULL_OPENCV") {
+  } else if (model == "PINHOLE" || model == "OPENCV" || model == "FULL_OPENCV") {
     fx = p[0];
     fy = p[1];
     cx = p[2];
@@ -33,15 +29,13 @@ void CameraToOpenCv(const colmap::Camera& camera,
     // COLMAP's OPENCV / FULL_OPENCV parameters follow OpenCV's own order.
     coefficients.assign(p.begin() + 4, p.end());
   } else {
-    throw std::invalid_argument(
-        "camera model " + model +
-        " is not supported for stereo rectification (use SIMPLE_PINHOLE, "
-        "PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV or FULL_OPENCV)");
+    throw std::invalid_argument("camera model " + model +
+                                " is not supported for stereo rectification (use SIMPLE_PINHOLE, "
+                                "PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV or FULL_OPENCV)");
   }
   if (coefficients.empty()) coefficients = {0, 0, 0, 0};
   // COLMAP's pixel centres are at +0.5, OpenCV's at integers.
-  *camera_matrix =
-      (cv::Mat_<double>(3, 3) << fx, 0, cx - 0.5, 0, fy, cy - 0.5, 0, 0, 1);
+  *camera_matrix = (cv::Mat_<double>(3, 3) << fx, 0, cx - 0.5, 0, fy, cy - 0.5, 0, 0, 1);
   *distortion = cv::Mat(coefficients, true).reshape(1, 1);
 }
 
@@ -49,10 +43,10 @@ StereoRectifier::StereoRectifier(const colmap::Camera& left,
                                  const colmap::Camera& right,
                                  const colmap::Rigid3d& right_from_left) {
   if (left.width != right.width || left.height != right.height) {
-    throw std::invalid_argument(
-        "left and right cameras differ in size (" + std::to_string(left.width) +
-        "x" + std::to_string(left.height) + " vs " +
-        std::to_string(right.width) + "x" + std::to_string(right.height) + ")");
+    throw std::invalid_argument("left and right cameras differ in size (" +
+                                std::to_string(left.width) + "x" + std::to_string(left.height) +
+                                " vs " + std::to_string(right.width) + "x" +
+                                std::to_string(right.height) + ")");
   }
   size_ = cv::Size(static_cast<int>(left.width), static_cast<int>(left.height));
   cv::Mat k_left, d_left, k_right, d_right;
@@ -89,8 +83,7 @@ StereoRectifier::StereoRectifier(const colmap::Camera& left,
                     cv::CALIB_ZERO_DISPARITY,
                     1.0,
                     size_);
-  THROW_CHECK_LT(std::abs(p2.at<double>(1, 3)),
-                 1e-6 * std::abs(p2.at<double>(0, 3)))
+  THROW_CHECK_LT(std::abs(p2.at<double>(1, 3)), 1e-6 * std::abs(p2.at<double>(0, 3)))
       << "only horizontal stereo rigs are supported (right camera beside the "
          "left one)";
   rectified_focal_ = p1.at<double>(0, 0);
@@ -98,11 +91,9 @@ StereoRectifier::StereoRectifier(const colmap::Camera& left,
   rectified_cy_ = p1.at<double>(1, 2);
   baseline_ = std::abs(p2.at<double>(0, 3)) / p2.at<double>(0, 0);
   for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j)
-      left_from_rectified_(i, j) = r1.at<double>(j, i);
+    for (int j = 0; j < 3; ++j) left_from_rectified_(i, j) = r1.at<double>(j, i);
   }
-  cv::initUndistortRectifyMap(
-      k_left, d_left, r1, p1, size_, CV_32FC1, left_map_x_, left_map_y_);
+  cv::initUndistortRectifyMap(k_left, d_left, r1, p1, size_, CV_32FC1, left_map_x_, left_map_y_);
   cv::remap(cv::Mat(size_, CV_8U, cv::Scalar(255)),
             left_mask_,
             left_map_x_,
@@ -162,8 +153,7 @@ cv::Mat StereoRectifier::ToLeftImage(const cv::Mat& rectified) const {
 
 cv::Mat StereoRectifier::DepthInLeftImage(const cv::Mat& left_disparity,
                                           float max_disparity_jump) const {
-  THROW_CHECK(left_disparity.type() == CV_32F &&
-              left_disparity.size() == size_);
+  THROW_CHECK(left_disparity.type() == CV_32F && left_disparity.size() == size_);
   cv::Mat depth(size_, CV_32F, cv::Scalar(0));
   const int width = size_.width;
   const int height = size_.height;
@@ -179,25 +169,22 @@ cv::Mat StereoRectifier::DepthInLeftImage(const cv::Mat& left_disparity,
       const float fx = uv.x - c0;
       const float fy = uv.y - r0;
       const float d00 = disparity_at(c0, r0), d10 = disparity_at(c0 + 1, r0),
-                  d01 = disparity_at(c0, r0 + 1),
-                  d11 = disparity_at(c0 + 1, r0 + 1);
+                  d01 = disparity_at(c0, r0 + 1), d11 = disparity_at(c0 + 1, r0 + 1);
       float disparity = 0.f;
       const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
       const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
       if (lo > 0.f && hi - lo <= max_disparity_jump) {
-        disparity = (1 - fy) * ((1 - fx) * d00 + fx * d10) +
-                    fy * ((1 - fx) * d01 + fx * d11);
+        disparity = (1 - fy) * ((1 - fx) * d00 + fx * d10) + fy * ((1 - fx) * d01 + fx * d11);
       } else {
-        disparity = disparity_at(static_cast<int>(std::lround(uv.x)),
-                                 static_cast<int>(std::lround(uv.y)));
+        disparity =
+            disparity_at(static_cast<int>(std::lround(uv.x)), static_cast<int>(std::lround(uv.y)));
       }
       if (disparity <= 0.f) continue;
       // Eq. (stereo): Z = f b / d in the rectified frame, then back to the original left camera.
       const double z = rectified_focal_ * baseline_ / disparity;
-      const cv::Vec3d point_in_rectified(
-          (uv.x - rectified_cx_) / rectified_focal_ * z,
-          (uv.y - rectified_cy_) / rectified_focal_ * z,
-          z);
+      const cv::Vec3d point_in_rectified((uv.x - rectified_cx_) / rectified_focal_ * z,
+                                         (uv.y - rectified_cy_) / rectified_focal_ * z,
+                                         z);
       const cv::Vec3d point_in_left = left_from_rectified_ * point_in_rectified;
       if (point_in_left[2] > 0) {
         depth.at<float>(row, col) = static_cast<float>(point_in_left[2]);

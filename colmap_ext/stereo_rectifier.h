@@ -16,9 +16,7 @@ namespace colmap_lidar {
 // The OpenCV form of a COLMAP camera: 3x3 K (OpenCV pixel convention) and distortion coefficients in
 // OpenCV's order (k1 k2 p1 p2 [k3 k4 k5 k6]). Supported models: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL,
 // RADIAL, OPENCV, FULL_OPENCV; any other model throws std::invalid_argument naming it.
-void CameraToOpenCv(const colmap::Camera& camera,
-                    cv::Mat* camera_matrix,
-                    cv::Mat* distortion);
+void CameraToOpenCv(const colmap::Camera& camera, cv::Mat* camera_matrix, cv::Mat* distortion);
 
 class StereoRectifier {
  public:
@@ -37,8 +35,7 @@ class StereoRectifier {
   // map (CV_32F, pixels, <= 0 invalid). A pixel's disparity is interpolated bilinearly when its four
   // rectified neighbours are valid and agree within `max_disparity_jump` px, else taken from the nearest
   // rectified pixel; it stays 0 (invalid) when that pixel is invalid.
-  cv::Mat DepthInLeftImage(const cv::Mat& left_disparity,
-                           float max_disparity_jump = 1.f) const;
+  cv::Mat DepthInLeftImage(const cv::Mat& left_disparity, float max_disparity_jump = 1.f) const;
 
   // Nearest-neighbour resampling of a rectified left-image map into the original left grid.
   cv::Mat ToLeftImage(const cv::Mat& rectified) const;
@@ -48,9 +45,7 @@ class StereoRectifier {
 
   double RectifiedFocalLength() const { return rectified_focal_; }
   // Principal point of both rectified cameras (OpenCV pixel convention).
-  cv::Point2d RectifiedPrincipalPoint() const {
-    return {rectified_cx_, rectified_cy_};
-  }
+  cv::Point2d RectifiedPrincipalPoint() const { return {rectified_cx_, rectified_cy_}; }
   // Rotation from the rectified left camera frame to the original left camera frame (R1^T).
   const cv::Matx33d& LeftFromRectified() const { return left_from_rectified_; }
   double BaselineMeters() const { return baseline_; }

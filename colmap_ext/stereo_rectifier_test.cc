@@ -8,15 +8,13 @@ namespace colmap_lidar {
 namespace {
 
 // A rig with distortion and a rotated right camera, as after a real calibration.
-void MakeRig(colmap::Camera* left,
-             colmap::Camera* right,
-             colmap::Rigid3d* right_from_left) {
+void MakeRig(colmap::Camera* left, colmap::Camera* right, colmap::Rigid3d* right_from_left) {
   *left = colmap::Camera::CreateFromModelName(1, "OPENCV", 800, 640, 480);
   left->params = {800, 805, 321.3, 238.1, -0.08, 0.02, 0.0005, -0.0003};
   *right = colmap::Camera::CreateFromModelName(2, "OPENCV", 800, 640, 480);
   right->params = {810, 812, 317.9, 242.6, -0.07, 0.015, -0.0002, 0.0004};
-  right_from_left->rotation = Eigen::Quaterniond(
-      Eigen::AngleAxisd(0.02, Eigen::Vector3d(0.3, 1, 0.2).normalized()));
+  right_from_left->rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.02, Eigen::Vector3d(0.3, 1, 0.2).normalized()));
   right_from_left->translation = Eigen::Vector3d(-0.38, 0.004, -0.002);
 }
 
@@ -32,8 +30,7 @@ TEST(StereoRectifier, DisparityOfAPlaneGivesItsDepthInTheOriginalLeftGrid) {
   colmap::Rigid3d right_from_left;
   MakeRig(&left, &right, &right_from_left);
   const StereoRectifier rectifier(left, right, right_from_left);
-  EXPECT_NEAR(
-      rectifier.BaselineMeters(), right_from_left.translation.norm(), 1e-9);
+  EXPECT_NEAR(rectifier.BaselineMeters(), right_from_left.translation.norm(), 1e-9);
 
   // A slanted plane 2-3 m in front of the left camera.
   const Eigen::Vector3d normal = Eigen::Vector3d(0.2, -0.1, 1).normalized();
@@ -45,14 +42,12 @@ TEST(StereoRectifier, DisparityOfAPlaneGivesItsDepthInTheOriginalLeftGrid) {
   cv::Mat disparity(480, 640, CV_32F);
   for (int row = 0; row < 480; ++row) {
     for (int col = 0; col < 640; ++col) {
-      const cv::Vec3d ray_rect(
-          (col - principal.x) / f, (row - principal.y) / f, 1);
+      const cv::Vec3d ray_rect((col - principal.x) / f, (row - principal.y) / f, 1);
       const cv::Vec3d ray_left = left_from_rectified * ray_rect;
       const Eigen::Vector3d ray(ray_left[0], ray_left[1], ray_left[2]);
       const double t = offset / normal.dot(ray);  // point = t * ray
       const double z_rect = t;                    // ray_rect has unit z
-      disparity.at<float>(row, col) =
-          static_cast<float>(f * rectifier.BaselineMeters() / z_rect);
+      disparity.at<float>(row, col) = static_cast<float>(f * rectifier.BaselineMeters() / z_rect);
     }
   }
   const cv::Mat depth = rectifier.DepthInLeftImage(disparity);
@@ -61,13 +56,11 @@ TEST(StereoRectifier, DisparityOfAPlaneGivesItsDepthInTheOriginalLeftGrid) {
   int num_checked = 0;
   for (int row = 20; row < 460; row += 7) {
     for (int col = 20; col < 620; col += 7) {
-      const Eigen::Vector2d uv =
-          left.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5));
+      const Eigen::Vector2d uv = left.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5));
       const double truth = PlaneDepthAlongRay(uv.homogeneous(), normal, offset);
       const double z = depth.at<float>(row, col);
       ASSERT_GT(z, 0) << row << " " << col;
-      max_relative_error =
-          std::max(max_relative_error, std::abs(z - truth) / truth);
+      max_relative_error = std::max(max_relative_error, std::abs(z - truth) / truth);
       ++num_checked;
     }
   }
@@ -80,19 +73,16 @@ TEST(StereoRectifier, RejectsUnsupportedModelsAndDifferentSizes) {
   colmap::Camera left, right;
   colmap::Rigid3d right_from_left;
   MakeRig(&left, &right, &right_from_left);
-  colmap::Camera fisheye =
-      colmap::Camera::CreateFromModelName(1, "OPENCV_FISHEYE", 800, 640, 480);
+  colmap::Camera fisheye = colmap::Camera::CreateFromModelName(1, "OPENCV_FISHEYE", 800, 640, 480);
   try {
     StereoRectifier rectifier(fisheye, right, right_from_left);
     FAIL() << "a fisheye camera was accepted";
   } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("OPENCV_FISHEYE"),
-              std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("OPENCV_FISHEYE"), std::string::npos);
   }
   colmap::Camera smaller = right;
   smaller.width = 600;
-  EXPECT_THROW(StereoRectifier(left, smaller, right_from_left),
-               std::invalid_argument);
+  EXPECT_THROW(StereoRectifier(left, smaller, right_from_left), std::invalid_argument);
 }
 
 TEST(CameraToOpenCv, ShiftsThePrincipalPointToOpenCvsPixelConvention) {

@@ -49,17 +49,14 @@ void ComparisonBits(const std::vector<double>& values,
   }
 }
 
-BscDescriptor Describe(
-    const std::vector<Eigen::Vector3d>& local,  // neighbours in the LRF, / R
-    const std::vector<CellPair>& pairs,
-    const BscOptions& options) {
+BscDescriptor Describe(const std::vector<Eigen::Vector3d>& local,  // neighbours in the LRF, / R
+                       const std::vector<CellPair>& pairs,
+                       const BscOptions& options) {
   const int n = options.grid_size;
   const int num_cells = n * n;
   BscDescriptor descriptor(options.NumWords(), 0);
-  constexpr int kPlaneAxes[3][3] = {
-      {0, 1, 2}, {0, 2, 1}, {1, 2, 0}};  // (u, v, depth): XY, XZ, YZ
-  std::vector<double> density(num_cells), depth_sum(num_cells),
-      mean_depth(num_cells);
+  constexpr int kPlaneAxes[3][3] = {{0, 1, 2}, {0, 2, 1}, {1, 2, 0}};  // (u, v, depth): XY, XZ, YZ
+  std::vector<double> density(num_cells), depth_sum(num_cells), mean_depth(num_cells);
   for (int plane = 0; plane < 3; ++plane) {
     std::fill(density.begin(), density.end(), 0.0);
     std::fill(depth_sum.begin(), depth_sum.end(), 0.0);
@@ -69,15 +66,13 @@ BscDescriptor Describe(
       const double u = (l[kPlaneAxes[plane][0]] + 1) * n / 2 - 0.5;
       const double v = (l[kPlaneAxes[plane][1]] + 1) * n / 2 - 0.5;
       const double depth = l[kPlaneAxes[plane][2]];
-      const int cu = static_cast<int>(std::lround(u)),
-                cv = static_cast<int>(std::lround(v));
+      const int cu = static_cast<int>(std::lround(u)), cv = static_cast<int>(std::lround(v));
       for (int du = -1; du <= 1; ++du) {
         for (int dv = -1; dv <= 1; ++dv) {
           const int iu = cu + du, iv = cv + dv;
           if (iu < 0 || iv < 0 || iu >= n || iv >= n) continue;
           // Gaussian with sigma = half a cell.
-          const double w =
-              std::exp(-2.0 * ((iu - u) * (iu - u) + (iv - v) * (iv - v)));
+          const double w = std::exp(-2.0 * ((iu - u) * (iu - u) + (iv - v) * (iv - v)));
           density[iv * n + iu] += w;
           depth_sum[iv * n + iu] += w * depth;
           total += w;
@@ -94,8 +89,7 @@ BscDescriptor Describe(
     mean_density /= num_cells;
     const int first = plane * 3 * num_cells;
     for (int c = 0; c < num_cells; ++c) {
-      if (density[c] > options.occupancy_ratio * mean_density)
-        SetBit(first + c, &descriptor);
+      if (density[c] > options.occupancy_ratio * mean_density) SetBit(first + c, &descriptor);
     }
     ComparisonBits(density, pairs, first + num_cells, &descriptor);
     ComparisonBits(mean_depth, pairs, first + 2 * num_cells, &descriptor);
@@ -106,10 +100,8 @@ BscDescriptor Describe(
 }  // namespace
 
 bool BscOptions::Check() const {
-  if (!(support_radius > 0) || grid_size < 2 || !(occupancy_ratio >= 0) ||
-      min_neighbors < 3) {
-    throw std::invalid_argument(
-        "BscOptions: invalid radius, grid size, ratio or neighbour count");
+  if (!(support_radius > 0) || grid_size < 2 || !(occupancy_ratio >= 0) || min_neighbors < 3) {
+    throw std::invalid_argument("BscOptions: invalid radius, grid size, ratio or neighbour count");
   }
   return true;
 }
@@ -144,8 +136,7 @@ std::vector<BscFeature> ComputeBscFeatures(const PointCloud& cloud,
         weight_sum += w;
       }
       if (weight_sum <= 0) continue;
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance /
-                                                                  weight_sum);
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance / weight_sum);
       Eigen::Vector3d z = solver.eigenvectors().col(0);
       Eigen::Vector3d x = solver.eigenvectors().col(2);
       if (z.dot(viewpoint - center) < 0) z = -z;
@@ -158,11 +149,9 @@ std::vector<BscFeature> ComputeBscFeatures(const PointCloud& cloud,
       }
       if (majority < 0) x = -x;
       std::vector<Eigen::Vector3d> x_axes = {x};
-      if (std::abs(majority) < options.sign_ambiguity * magnitude)
-        x_axes.push_back(-x);
+      if (std::abs(majority) < options.sign_ambiguity * magnitude) x_axes.push_back(-x);
       const Eigen::Vector3d ascending = solver.eigenvalues().cwiseMax(0);
-      if (ascending(2) > 0 &&
-          ascending(1) / ascending(2) > options.ambiguity_ratio) {
+      if (ascending(2) > 0 && ascending(1) / ascending(2) > options.ambiguity_ratio) {
         const Eigen::Vector3d y = z.cross(x);
         x_axes.push_back(y);
         x_axes.push_back(-y);
@@ -176,10 +165,9 @@ std::vector<BscFeature> ComputeBscFeatures(const PointCloud& cloud,
         if (v == 0) feature.cloud_from_lrf = cloud_from_lrf;
         local.clear();
         for (size_t j : neighbors) {
-          local.push_back(
-              (cloud_from_lrf.transpose() * (cloud.points[j] - center) / R)
-                  .cwiseMax(-1.0)
-                  .cwiseMin(1.0));
+          local.push_back((cloud_from_lrf.transpose() * (cloud.points[j] - center) / R)
+                              .cwiseMax(-1.0)
+                              .cwiseMin(1.0));
         }
         feature.variants.push_back(Describe(local, pairs, options));
       }
@@ -195,16 +183,14 @@ std::vector<BscFeature> ComputeBscFeatures(const PointCloud& cloud,
 
 int HammingDistance(const BscDescriptor& a, const BscDescriptor& b) {
   int distance = 0;
-  for (size_t w = 0; w < a.size(); ++w)
-    distance += __builtin_popcountll(a[w] ^ b[w]);
+  for (size_t w = 0; w < a.size(); ++w) distance += __builtin_popcountll(a[w] ^ b[w]);
   return distance;
 }
 
 int BscDistance(const BscFeature& a, const BscFeature& b) {
   int best = 1 << 30;
   for (const BscDescriptor& da : a.variants) {
-    for (const BscDescriptor& db : b.variants)
-      best = std::min(best, HammingDistance(da, db));
+    for (const BscDescriptor& db : b.variants) best = std::min(best, HammingDistance(da, db));
   }
   return best;
 }

@@ -26,14 +26,11 @@
 namespace colmap_lidar {
 
 struct BscOptions {
-  double support_radius = 1.5;  // R [m]
-  int grid_size = 7;            // N
-  double occupancy_ratio =
-      0.5;  // occupied: cell density > ratio * mean cell density of the plane
-  double ambiguity_ratio =
-      0.85;  // lambda_2 / lambda_1 above this: keep the y-axis variants too
-  double sign_ambiguity =
-      0.1;  // |weighted majority| below this fraction: keep the -x variant too
+  double support_radius = 1.5;    // R [m]
+  int grid_size = 7;              // N
+  double occupancy_ratio = 0.5;   // occupied: cell density > ratio * mean cell density of the plane
+  double ambiguity_ratio = 0.85;  // lambda_2 / lambda_1 above this: keep the y-axis variants too
+  double sign_ambiguity = 0.1;  // |weighted majority| below this fraction: keep the -x variant too
   int min_neighbors = 10;
   uint64_t pair_seed = 0x5bd1e995;
 
@@ -47,9 +44,8 @@ using BscDescriptor = std::vector<uint64_t>;
 struct BscFeature {
   size_t point_index = 0;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d cloud_from_lrf =
-      Eigen::Matrix3d::Identity();      // columns: x, y, z axes
-  std::vector<BscDescriptor> variants;  // the first is the primary frame
+  Eigen::Matrix3d cloud_from_lrf = Eigen::Matrix3d::Identity();  // columns: x, y, z axes
+  std::vector<BscDescriptor> variants;                           // the first is the primary frame
 };
 
 // Descriptors at the given keypoints of `cloud` (tree built over it); `viewpoint` is the sensor origin.

@@ -25,12 +25,9 @@ std::vector<BscFeature> Describe(const PointCloud& cloud,
   return ComputeBscFeatures(cloud, tree, keypoints, viewpoint, BscOptions());
 }
 
-double MeanDistance(const std::vector<BscFeature>& a,
-                    const std::vector<BscFeature>& b,
-                    int shift) {
+double MeanDistance(const std::vector<BscFeature>& a, const std::vector<BscFeature>& b, int shift) {
   double sum = 0;
-  for (size_t k = 0; k < a.size(); ++k)
-    sum += BscDistance(a[k], b[(k + shift) % b.size()]);
+  for (size_t k = 0; k < a.size(); ++k) sum += BscDistance(a[k], b[(k + shift) % b.size()]);
   return sum / a.size();
 }
 
@@ -56,10 +53,8 @@ TEST_F(BscDescriptorTest, HasTheSpecifiedLayout) {
   for (const BscFeature& f : features_) {
     ASSERT_FALSE(f.variants.empty());
     EXPECT_EQ(f.variants[0].size(), 7u);
-    EXPECT_EQ(f.variants[0][6] >> (441 - 384), 0u)
-        << "bits beyond 441 must stay zero";
-    EXPECT_NEAR(
-        f.cloud_from_lrf.determinant(), 1.0, 1e-9);  // right-handed frame
+    EXPECT_EQ(f.variants[0][6] >> (441 - 384), 0u) << "bits beyond 441 must stay zero";
+    EXPECT_NEAR(f.cloud_from_lrf.determinant(), 1.0, 1e-9);  // right-handed frame
   }
 }
 
@@ -74,9 +69,8 @@ TEST_F(BscDescriptorTest, InvariantToARigidTransform) {
   ASSERT_EQ(moved_features.size(), features_.size());
   const double same = MeanDistance(features_, moved_features, 0);
   const double unrelated = MeanDistance(features_, moved_features, 7);
-  std::cout << "mean Hamming distance: same keypoint after a rigid motion "
-            << same << ", unrelated keypoints " << unrelated << " (of 441 bits)"
-            << std::endl;
+  std::cout << "mean Hamming distance: same keypoint after a rigid motion " << same
+            << ", unrelated keypoints " << unrelated << " (of 441 bits)" << std::endl;
   EXPECT_LT(same,
             0.02 * 441);  // only floating-point ties at cell borders may flip
   EXPECT_GT(unrelated, 15 * std::max(same, 1.0));
@@ -84,8 +78,7 @@ TEST_F(BscDescriptorTest, InvariantToARigidTransform) {
 
 TEST_F(BscDescriptorTest, RobustToNoiseAndResampling) {
   // Another random sampling of the same room with 1 cm noise, described at the nearest points.
-  const PointCloud noisy =
-      VoxelDownsample(testing::SyntheticRoom(600, 22, 0.01), 0.1);
+  const PointCloud noisy = VoxelDownsample(testing::SyntheticRoom(600, 22, 0.01), 0.1);
   const KdTree3 tree(noisy.points);
   std::vector<size_t> nearest;
   for (size_t index : keypoints_) {
@@ -94,14 +87,12 @@ TEST_F(BscDescriptorTest, RobustToNoiseAndResampling) {
     tree.Nearest(cloud_.points[index], &k, &squared);
     nearest.push_back(k);
   }
-  const std::vector<BscFeature> noisy_features =
-      Describe(noisy, nearest, viewpoint_);
+  const std::vector<BscFeature> noisy_features = Describe(noisy, nearest, viewpoint_);
   ASSERT_EQ(noisy_features.size(), features_.size());
   const double same = MeanDistance(features_, noisy_features, 0);
   const double unrelated = MeanDistance(features_, noisy_features, 7);
-  std::cout
-      << "mean Hamming distance with 1 cm noise and resampling: corresponding "
-      << same << ", unrelated " << unrelated << std::endl;
+  std::cout << "mean Hamming distance with 1 cm noise and resampling: corresponding " << same
+            << ", unrelated " << unrelated << std::endl;
   EXPECT_LT(same, 0.6 * unrelated);
 }
 

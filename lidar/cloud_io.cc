@@ -51,8 +51,7 @@ class CloudBuilder {
   PointCloud Finish(const std::string& path, CloudReadStats* stats) {
     if (num_read_ == 0) Fail(path, "the file holds no points");
     if (cloud_.Empty()) {
-      Fail(path,
-           "all " + std::to_string(num_read_) + " points are NaN or infinite");
+      Fail(path, "all " + std::to_string(num_read_) + " points are NaN or infinite");
     }
     if (stats) {
       stats->num_read = num_read_;
@@ -158,8 +157,7 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
       std::memcpy(&rgb, p + frgb->offset, 4);
       color = Color3ub((rgb >> 16) & 0xff, (rgb >> 8) & 0xff, rgb & 0xff);
     }
-    const float intensity =
-        fi ? static_cast<float>(ReadPcdValue(*fi, p + fi->offset)) : 0.f;
+    const float intensity = fi ? static_cast<float>(ReadPcdValue(*fi, p + fi->offset)) : 0.f;
     builder.Add(point, normal, color, intensity);
   }
   return builder.Finish(path, stats);
@@ -174,13 +172,10 @@ struct PlyProperty {
 };
 
 int PlyTypeSize(const std::string& type) {
-  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8")
-    return 1;
-  if (type == "short" || type == "ushort" || type == "int16" ||
-      type == "uint16")
-    return 2;
-  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" ||
-      type == "float" || type == "float32")
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
+      type == "float32")
     return 4;
   if (type == "double" || type == "float64") return 8;
   return 0;
@@ -201,8 +196,7 @@ double DecodePly(const std::string& type, const char* data, bool swap) {
     std::memcpy(&v, buffer, 8);
     return v;
   }
-  if (type == "uchar" || type == "uint8")
-    return static_cast<uint8_t>(buffer[0]);
+  if (type == "uchar" || type == "uint8") return static_cast<uint8_t>(buffer[0]);
   if (type == "char" || type == "int8") return static_cast<int8_t>(buffer[0]);
   if (type == "ushort" || type == "uint16") {
     uint16_t v;
@@ -259,8 +253,7 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
     } else if (keyword == "property" && in_vertex) {
       PlyProperty property;
       tokens >> property.type;
-      if (property.type == "list")
-        Fail(path, "list property in vertex element");
+      if (property.type == "list") Fail(path, "list property in vertex element");
       tokens >> property.name;
       property.size = PlyTypeSize(property.type);
       if (property.size == 0) {
@@ -272,8 +265,7 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
     }
   }
   if (line.rfind("end_header", 0) != 0) Fail(path, "no end_header");
-  if (format != "ascii" && format != "binary_little_endian" &&
-      format != "binary_big_endian") {
+  if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") {
     Fail(path, "unknown format '" + format + "'");
   }
   auto index_of = [&](std::initializer_list<const char*> names) {
@@ -292,8 +284,7 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
   const int ir = index_of({"red", "r"});
   const int ig = index_of({"green", "g"});
   const int ib = index_of({"blue", "b"});
-  const int ii =
-      index_of({"intensity", "scalar_intensity", "scalar_Intensity"});
+  const int ii = index_of({"intensity", "scalar_intensity", "scalar_Intensity"});
   const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
   const bool colors = ir >= 0 && ig >= 0 && ib >= 0;
   CloudBuilder builder(normals, colors, ii >= 0);
@@ -306,8 +297,8 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
     if (format == "ascii") {
       if (!std::getline(file, line)) {
         Fail(path,
-             "truncated: " + std::to_string(v) + " of " +
-                 std::to_string(num_vertices) + " vertices");
+             "truncated: " + std::to_string(v) + " of " + std::to_string(num_vertices) +
+                 " vertices");
       }
       std::istringstream tokens(line);
       for (double& value : values) {
@@ -321,17 +312,15 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
           if (token == "nan" || token == "-nan") {
             value = std::nan("");
           } else {
-            Fail(path,
-                 "vertex " + std::to_string(v) + ": '" + token +
-                     "' is not a number");
+            Fail(path, "vertex " + std::to_string(v) + ": '" + token + "' is not a number");
           }
         }
       }
     } else {
       if (!file.read(record.data(), record_size)) {
         Fail(path,
-             "truncated: " + std::to_string(v) + " of " +
-                 std::to_string(num_vertices) + " vertices");
+             "truncated: " + std::to_string(v) + " of " + std::to_string(num_vertices) +
+                 " vertices");
       }
       size_t offset = 0;
       for (size_t i = 0; i < properties.size(); ++i) {
@@ -341,14 +330,12 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
     }
     const Eigen::Vector3d point(values[ix], values[iy], values[iz]);
     const Eigen::Vector3d normal =
-        normals ? Eigen::Vector3d(values[inx], values[iny], values[inz])
-                : Eigen::Vector3d::Zero();
+        normals ? Eigen::Vector3d(values[inx], values[iny], values[inz]) : Eigen::Vector3d::Zero();
     const Color3ub color = colors ? Color3ub(static_cast<uint8_t>(values[ir]),
                                              static_cast<uint8_t>(values[ig]),
                                              static_cast<uint8_t>(values[ib]))
                                   : Color3ub(0, 0, 0);
-    builder.Add(
-        point, normal, color, ii >= 0 ? static_cast<float>(values[ii]) : 0.f);
+    builder.Add(point, normal, color, ii >= 0 ? static_cast<float>(values[ii]) : 0.f);
   }
   return builder.Finish(path, stats);
 }
@@ -396,14 +383,11 @@ PointCloud ReadXyzText(const std::string& path, CloudReadStats* stats) {
       try {
         values.push_back(std::stod(token));
       } catch (const std::exception&) {
-        Fail(path,
-             "line " + std::to_string(line_number) + ": '" + token +
-                 "' is not a number");
+        Fail(path, "line " + std::to_string(line_number) + ": '" + token + "' is not a number");
       }
     }
     if (values.size() < 3) {
-      Fail(path,
-           "line " + std::to_string(line_number) + " has fewer than 3 values");
+      Fail(path, "line " + std::to_string(line_number) + " has fewer than 3 values");
     }
     if (!builder) builder = values.size() >= 4 ? &with_i : &without_i;
     builder->Add(Eigen::Vector3d(values[0], values[1], values[2]),
@@ -417,8 +401,7 @@ PointCloud ReadXyzText(const std::string& path, CloudReadStats* stats) {
 // ---------------------------------------------------------------- writers
 
 void WritePcdBinary(std::ostream& out, const PointCloud& cloud) {
-  std::string fields = "x y z", sizes = "4 4 4", types = "F F F",
-              counts = "1 1 1";
+  std::string fields = "x y z", sizes = "4 4 4", types = "F F F", counts = "1 1 1";
   auto add = [&](const char* name, const char* type) {
     fields += std::string(" ") + name;
     sizes += " 4";
@@ -434,10 +417,9 @@ void WritePcdBinary(std::ostream& out, const PointCloud& cloud) {
   if (cloud.HasColors()) add("rgb", "F");
   out << "# .PCD v0.7 - Point Cloud Data file format (written by "
          "colmap-lidar)\n"
-      << "VERSION 0.7\nFIELDS " << fields << "\nSIZE " << sizes << "\nTYPE "
-      << types << "\nCOUNT " << counts << "\nWIDTH " << cloud.Size()
-      << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << cloud.Size()
-      << "\nDATA binary\n";
+      << "VERSION 0.7\nFIELDS " << fields << "\nSIZE " << sizes << "\nTYPE " << types << "\nCOUNT "
+      << counts << "\nWIDTH " << cloud.Size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
+      << cloud.Size() << "\nDATA binary\n";
   std::vector<float> row;
   for (size_t i = 0; i < cloud.Size(); ++i) {
     row.assign(cloud.points[i].data(), cloud.points[i].data() + 3);
@@ -447,22 +429,19 @@ void WritePcdBinary(std::ostream& out, const PointCloud& cloud) {
     }
     if (cloud.HasColors()) {
       const uint32_t rgb = (uint32_t(cloud.colors[i][0]) << 16) |
-                           (uint32_t(cloud.colors[i][1]) << 8) |
-                           cloud.colors[i][2];
+                           (uint32_t(cloud.colors[i][1]) << 8) | cloud.colors[i][2];
       float packed;
       std::memcpy(&packed, &rgb, 4);
       row.push_back(packed);
     }
-    out.write(reinterpret_cast<const char*>(row.data()),
-              row.size() * sizeof(float));
+    out.write(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(float));
   }
 }
 
 void WritePlyBinary(std::ostream& out, const PointCloud& cloud) {
   out << "ply\nformat binary_little_endian 1.0\ncomment written by "
          "colmap-lidar\nelement vertex "
-      << cloud.Size()
-      << "\nproperty float x\nproperty float y\nproperty float z\n";
+      << cloud.Size() << "\nproperty float x\nproperty float y\nproperty float z\n";
   if (cloud.HasNormals()) {
     out << "property float nx\nproperty float ny\nproperty float nz\n";
   }
@@ -500,8 +479,7 @@ PointCloud ReadPointCloud(const std::string& path, CloudReadStats* stats) {
   if (ext == ".ply") return ReadPly(path, stats);
   if (ext == ".bin") return ReadKittiBin(path, stats);
   if (ext == ".xyz" || ext == ".txt") return ReadXyzText(path, stats);
-  Fail(path,
-       "unknown extension '" + ext + "' (expected .pcd .ply .bin .xyz .txt)");
+  Fail(path, "unknown extension '" + ext + "' (expected .pcd .ply .bin .xyz .txt)");
 }
 
 void WritePointCloud(const std::string& path, const PointCloud& cloud) {
@@ -511,13 +489,11 @@ void WritePointCloud(const std::string& path, const PointCloud& cloud) {
     throw std::invalid_argument("Cannot write point cloud " + path +
                                 ": extension must be .pcd or .ply");
   }
-  const std::string tmp_path =
-      path + ".tmp" + std::to_string(static_cast<long>(::getpid()));
+  const std::string tmp_path = path + ".tmp" + std::to_string(static_cast<long>(::getpid()));
   {
     std::ofstream out(tmp_path, std::ios::binary);
     if (!out) {
-      throw std::runtime_error("Cannot write point cloud " + path +
-                               ": cannot create " + tmp_path);
+      throw std::runtime_error("Cannot write point cloud " + path + ": cannot create " + tmp_path);
     }
     if (ext == ".pcd") {
       WritePcdBinary(out, cloud);
@@ -528,8 +504,7 @@ void WritePointCloud(const std::string& path, const PointCloud& cloud) {
     if (!out) {
       out.close();
       fs::remove(tmp_path);
-      throw std::runtime_error("Cannot write point cloud " + path +
-                               ": write failed (disk full?)");
+      throw std::runtime_error("Cannot write point cloud " + path + ": write failed (disk full?)");
     }
   }
   fs::rename(tmp_path, path);

@@ -20,8 +20,7 @@ struct CloudReadStats {
   size_t num_dropped_non_finite = 0;  // NaN/Inf points dropped
 };
 
-PointCloud ReadPointCloud(const std::string& path,
-                          CloudReadStats* stats = nullptr);
+PointCloud ReadPointCloud(const std::string& path, CloudReadStats* stats = nullptr);
 
 void WritePointCloud(const std::string& path, const PointCloud& cloud);
 

@@ -26,8 +26,7 @@ class CloudIoTest : public ::testing::Test {
     for (size_t i = 0; i < n; ++i) {
       cloud.points.emplace_back(u(rng), u(rng), u(rng));
       if (attributes) {
-        cloud.normals.push_back(
-            Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
+        cloud.normals.push_back(Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized());
         cloud.colors.emplace_back(i % 256, (3 * i) % 256, 255 - i % 256);
         cloud.intensities.push_back(static_cast<float>(i % 100));
       }
@@ -57,14 +56,12 @@ TEST_F(CloudIoTest, PcdAndPlyRoundTripWithAllAttributes) {
     CloudReadStats stats;
     const PointCloud read = ReadPointCloud(Path(name), &stats);
     ASSERT_EQ(read.Size(), cloud.Size()) << name;
-    ASSERT_TRUE(read.HasNormals() && read.HasColors() && read.HasIntensities())
-        << name;
+    ASSERT_TRUE(read.HasNormals() && read.HasColors() && read.HasIntensities()) << name;
     EXPECT_EQ(stats.num_read, 1000u);
     EXPECT_EQ(stats.num_dropped_non_finite, 0u);
     double max_error = 0;
     for (size_t i = 0; i < cloud.Size(); ++i) {
-      max_error =
-          std::max(max_error, (read.points[i] - cloud.points[i]).norm());
+      max_error = std::max(max_error, (read.points[i] - cloud.points[i]).norm());
       EXPECT_EQ(read.colors[i], cloud.colors[i]);
       EXPECT_FLOAT_EQ(read.intensities[i], cloud.intensities[i]);
       EXPECT_NEAR((read.normals[i] - cloud.normals[i]).norm(), 0, 1e-6);
@@ -79,23 +76,19 @@ TEST_F(CloudIoTest, ReadsEveryPcdEncodingWrittenByPcl) {
   pcl::PointCloud<pcl::PointXYZI> cloud;
   for (int i = 0; i < 300; ++i) {
     pcl::PointXYZI p;
-    p.x = 0.1f * i, p.y = -0.2f * i, p.z = 3.0f,
-    p.intensity = static_cast<float>(i % 7);
+    p.x = 0.1f * i, p.y = -0.2f * i, p.z = 3.0f, p.intensity = static_cast<float>(i % 7);
     cloud.push_back(p);
   }
-  cloud[5].x =
-      std::nanf("");  // one NaN point inside a good file: dropped and counted
+  cloud[5].x = std::nanf("");  // one NaN point inside a good file: dropped and counted
   ASSERT_EQ(pcl::io::savePCDFileASCII(Path("ascii.pcd"), cloud), 0);
   ASSERT_EQ(pcl::io::savePCDFileBinary(Path("binary.pcd"), cloud), 0);
-  ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(Path("compressed.pcd"), cloud),
-            0);
+  ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(Path("compressed.pcd"), cloud), 0);
   for (const char* name : {"ascii.pcd", "binary.pcd", "compressed.pcd"}) {
     CloudReadStats stats;
     const PointCloud read = ReadPointCloud(Path(name), &stats);
     ASSERT_EQ(read.Size(), 299u) << name;
     EXPECT_EQ(stats.num_dropped_non_finite, 1u) << name;
-    EXPECT_NEAR(read.points[10].x(), 1.1, 1e-5)
-        << name;  // index 10 is point 11 after the NaN
+    EXPECT_NEAR(read.points[10].x(), 1.1, 1e-5) << name;  // index 10 is point 11 after the NaN
     EXPECT_FLOAT_EQ(read.intensities[10], 11 % 7) << name;
   }
 }
@@ -116,11 +109,10 @@ TEST_F(CloudIoTest, ReadsKittiBinAndXyzText) {
 }
 
 TEST_F(CloudIoTest, ReadsAsciiPlyAndDropsNonFinitePoints) {
-  std::ofstream(Path("a.ply"))
-      << "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\n"
-         "property double y\nproperty double z\nelement face 0\n"
-         "property list uchar int vertex_indices\nend_header\n"
-         "0 0 0\n1 nan 1\n2 2 2\ninf 0 0\n";
+  std::ofstream(Path("a.ply")) << "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\n"
+                                  "property double y\nproperty double z\nelement face 0\n"
+                                  "property list uchar int vertex_indices\nend_header\n"
+                                  "0 0 0\n1 nan 1\n2 2 2\ninf 0 0\n";
   CloudReadStats stats;
   const PointCloud cloud = ReadPointCloud(Path("a.ply"), &stats);
   EXPECT_EQ(cloud.Size(), 2u);
@@ -138,8 +130,7 @@ TEST_F(CloudIoTest, RejectsBadFilesWithTheFileNamed) {
   for (const char* name : {"cut.ply", "cut.pcd"}) {
     WritePointCloud(Path(name), cloud);
     fs::resize_file(Path(name), fs::file_size(Path(name)) - 100);
-    ExpectReadError(Path(name),
-                    std::string(name) == "cut.ply" ? "truncated" : "PCD");
+    ExpectReadError(Path(name), std::string(name) == "cut.ply" ? "truncated" : "PCD");
   }
 
   std::ofstream(Path("cut.bin"), std::ios::binary) << "0123456789";
@@ -150,14 +141,12 @@ TEST_F(CloudIoTest, RejectsBadFilesWithTheFileNamed) {
   WritePointCloud(Path("nan.pcd"), nan_cloud);
   ExpectReadError(Path("nan.pcd"), "NaN");
 
-  std::ofstream(Path("typed.ply"))
-      << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
-         "property float y\nproperty float z\nend_header\n1 two 3\n";
+  std::ofstream(Path("typed.ply")) << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                                      "property float y\nproperty float z\nend_header\n1 two 3\n";
   ExpectReadError(Path("typed.ply"), "not a number");
 
-  std::ofstream(Path("noxyz.ply"))
-      << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\n"
-         "end_header\n1\n";
+  std::ofstream(Path("noxyz.ply")) << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\n"
+                                      "end_header\n1\n";
   ExpectReadError(Path("noxyz.ply"), "x, y, z");
 
   std::ofstream(Path("notes.las")) << "x";

@@ -15,18 +15,17 @@ struct VectorAdaptor {
   }
 };
 
-using Index = nanoflann::KDTreeSingleIndexAdaptor<
-    nanoflann::L2_Simple_Adaptor<double, VectorAdaptor>,
-    VectorAdaptor,
-    3,
-    size_t>;
+using Index =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, VectorAdaptor>,
+                                        VectorAdaptor,
+                                        3,
+                                        size_t>;
 
 }  // namespace
 
 struct KdTree3::Impl {
   explicit Impl(const std::vector<Eigen::Vector3d>& points)
-      : adaptor{points},
-        index(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+      : adaptor{points}, index(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
     index.buildIndex();
   }
   VectorAdaptor adaptor;
@@ -38,9 +37,7 @@ KdTree3::KdTree3(const std::vector<Eigen::Vector3d>& points)
 
 KdTree3::~KdTree3() = default;
 
-bool KdTree3::Nearest(const Eigen::Vector3d& query,
-                      size_t* index,
-                      double* squared_distance) const {
+bool KdTree3::Nearest(const Eigen::Vector3d& query, size_t* index, double* squared_distance) const {
   if (points_.empty()) return false;
   nanoflann::KNNResultSet<double, size_t> result(1);
   result.init(index, squared_distance);
@@ -56,8 +53,8 @@ void KdTree3::KNearest(const Eigen::Vector3d& query,
   indices->resize(k);
   squared_distances->resize(k);
   if (k == 0) return;
-  const size_t n = impl_->index.knnSearch(
-      query.data(), k, indices->data(), squared_distances->data());
+  const size_t n =
+      impl_->index.knnSearch(query.data(), k, indices->data(), squared_distances->data());
   indices->resize(n);
   squared_distances->resize(n);
 }
@@ -66,10 +63,8 @@ void KdTree3::RadiusSearch(const Eigen::Vector3d& query,
                            double radius,
                            std::vector<size_t>* indices) const {
   std::vector<std::pair<size_t, double>> matches;
-  impl_->index.radiusSearch(query.data(),
-                            radius * radius,
-                            matches,
-                            nanoflann::SearchParams(32, 0, false));
+  impl_->index.radiusSearch(
+      query.data(), radius * radius, matches, nanoflann::SearchParams(32, 0, false));
   indices->resize(matches.size());
   for (size_t i = 0; i < matches.size(); ++i) (*indices)[i] = matches[i].first;
 }

@@ -17,9 +17,7 @@ class KdTree3 {
   KdTree3& operator=(const KdTree3&) = delete;
 
   // Index of the nearest point and its squared distance; false if the tree is empty.
-  bool Nearest(const Eigen::Vector3d& query,
-               size_t* index,
-               double* squared_distance) const;
+  bool Nearest(const Eigen::Vector3d& query, size_t* index, double* squared_distance) const;
   // The k nearest points (fewer if the tree is smaller), closest first.
   void KNearest(const Eigen::Vector3d& query,
                 size_t k,

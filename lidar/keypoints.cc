@@ -9,10 +9,9 @@
 namespace colmap_lidar {
 
 bool KeypointOptions::Check() const {
-  if (!(radius > 0) || !(nms_radius >= 0) || min_neighbors < 3 ||
-      !(max_ratio_21 > 0) || !(max_ratio_32 > 0) || max_keypoints == 0) {
-    throw std::invalid_argument(
-        "KeypointOptions: invalid radius, ratio or count");
+  if (!(radius > 0) || !(nms_radius >= 0) || min_neighbors < 3 || !(max_ratio_21 > 0) ||
+      !(max_ratio_32 > 0) || max_keypoints == 0) {
+    throw std::invalid_argument("KeypointOptions: invalid radius, ratio or count");
   }
   return true;
 }
@@ -38,8 +37,7 @@ std::vector<size_t> DetectKeypoints(const PointCloud& cloud,
         covariance += d * d.transpose();
       }
       const Eigen::Vector3d ascending =
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance,
-                                                         Eigen::EigenvaluesOnly)
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance, Eigen::EigenvaluesOnly)
               .eigenvalues()
               .cwiseMax(0);
       const double l1 = ascending(2), l2 = ascending(1), l3 = ascending(0);
@@ -53,10 +51,9 @@ std::vector<size_t> DetectKeypoints(const PointCloud& cloud,
   for (size_t i = 0; i < cloud.Size(); ++i) {
     if (curvature[i] >= 0) candidates.push_back(i);
   }
-  std::stable_sort(
-      candidates.begin(), candidates.end(), [&](size_t a, size_t b) {
-        return curvature[a] > curvature[b];
-      });
+  std::stable_sort(candidates.begin(), candidates.end(), [&](size_t a, size_t b) {
+    return curvature[a] > curvature[b];
+  });
   // Greedy NMS: take the strongest remaining, suppress its neighbours.
   std::vector<char> suppressed(cloud.Size(), 0);
   std::vector<size_t> keypoints;

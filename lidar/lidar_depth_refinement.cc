@@ -8,17 +8,15 @@
 namespace colmap_lidar {
 namespace {
 
-using IndexImage =
-    Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using IndexImage = Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 double DegToRad(double degrees) { return degrees * M_PI / 180; }
 
 // Projected centre of every sample (NaN behind the camera).
-std::vector<Eigen::Vector2d> ProjectSamples(
-    const LidarSurface& surface, const PinholeIntrinsics& intrinsics) {
+std::vector<Eigen::Vector2d> ProjectSamples(const LidarSurface& surface,
+                                            const PinholeIntrinsics& intrinsics) {
   std::vector<Eigen::Vector2d> xy(
-      surface.Size(),
-      Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
+      surface.Size(), Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
   for (size_t i = 0; i < surface.Size(); ++i) {
     intrinsics.Project(surface.points[i], &xy[i]);
   }
@@ -29,18 +27,14 @@ IndexImage Splat(const LidarSurface& surface,
                  const std::vector<Eigen::Vector2d>& xy,
                  const PinholeIntrinsics& intrinsics,
                  int max_radius_px) {
-  IndexImage index =
-      IndexImage::Constant(intrinsics.height, intrinsics.width, -1);
-  DepthImage zbuffer =
-      DepthImage::Constant(intrinsics.height,
-                           intrinsics.width,
-                           std::numeric_limits<float>::infinity());
+  IndexImage index = IndexImage::Constant(intrinsics.height, intrinsics.width, -1);
+  DepthImage zbuffer = DepthImage::Constant(
+      intrinsics.height, intrinsics.width, std::numeric_limits<float>::infinity());
   for (size_t i = 0; i < surface.Size(); ++i) {
     if (!std::isfinite(xy[i].x())) continue;
     const double z = surface.points[i].z();
     const int radius = std::min(
-        max_radius_px,
-        static_cast<int>(0.5 * surface.spacing[i] * intrinsics.fx / z + 0.5));
+        max_radius_px, static_cast<int>(0.5 * surface.spacing[i] * intrinsics.fx / z + 0.5));
     const int col0 = static_cast<int>(std::floor(xy[i].x()));
     const int row0 = static_cast<int>(std::floor(xy[i].y()));
     for (int row = std::max(0, row0 - radius);
@@ -49,8 +43,7 @@ IndexImage Splat(const LidarSurface& surface,
       for (int col = std::max(0, col0 - radius);
            col <= std::min(intrinsics.width - 1, col0 + radius);
            ++col) {
-        if ((row - row0) * (row - row0) + (col - col0) * (col - col0) >
-            radius * radius) {
+        if ((row - row0) * (row - row0) + (col - col0) * (col - col0) > radius * radius) {
           continue;
         }
         if (z < zbuffer(row, col)) {
@@ -63,14 +56,7 @@ IndexImage Splat(const LidarSurface& surface,
   return index;
 }
 
-enum class FillVerdict {
-  kFill,
-  kNoLayer,
-  kEdge,
-  kSparse,
-  kViewAngle,
-  kCurvature
-};
+enum class FillVerdict { kFill, kNoLayer, kEdge, kSparse, kViewAngle, kCurvature };
 
 FillVerdict JudgeFill(const std::vector<int>& layer,
                       size_t window_size,
@@ -93,8 +79,7 @@ FillVerdict JudgeFill(const std::vector<int>& layer,
     if (d.squaredNorm() < 0.25) {
       quadrants = 0xF;
     } else {
-      quadrants |=
-          1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3) : (d.y() >= 0 ? 1 : 2));
+      quadrants |= 1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3) : (d.y() >= 0 ? 1 : 2));
     }
   }
   int num_quadrants = 0;
@@ -115,31 +100,23 @@ int AutomaticWindowRadius(const LidarSurface& surface,
   std::vector<double> spacing_px;
   for (size_t i = 0; i < surface.Size(); ++i) {
     if (std::isfinite(xy[i].x()) && intrinsics.Contains(xy[i])) {
-      spacing_px.push_back(surface.spacing[i] * intrinsics.fx /
-                           surface.points[i].z());
+      spacing_px.push_back(surface.spacing[i] * intrinsics.fx / surface.points[i].z());
     }
   }
   if (spacing_px.empty()) return 3;
-  std::nth_element(spacing_px.begin(),
-                   spacing_px.begin() + spacing_px.size() / 2,
-                   spacing_px.end());
-  return std::clamp(
-      static_cast<int>(std::lround(1.5 * spacing_px[spacing_px.size() / 2])),
-      3,
-      30);
+  std::nth_element(
+      spacing_px.begin(), spacing_px.begin() + spacing_px.size() / 2, spacing_px.end());
+  return std::clamp(static_cast<int>(std::lround(1.5 * spacing_px[spacing_px.size() / 2])), 3, 30);
 }
 
 }  // namespace
 
 bool LidarDepthRefinementOptions::Check() const {
   auto fail = [](const char* what) {
-    throw std::invalid_argument(std::string("LidarDepthRefinementOptions: ") +
-                                what);
+    throw std::invalid_argument(std::string("LidarDepthRefinementOptions: ") + what);
   };
-  if (window_radius_px < 0)
-    fail("window_radius_px must be >= 0 (0: automatic)");
-  if (!(max_abs_diff_m >= 0) || !(max_rel_diff >= 0) ||
-      !(max_check_curvature >= 0) ||
+  if (window_radius_px < 0) fail("window_radius_px must be >= 0 (0: automatic)");
+  if (!(max_abs_diff_m >= 0) || !(max_rel_diff >= 0) || !(max_check_curvature >= 0) ||
       !(max_unreplaceable_diff_m >= max_abs_diff_m)) {
     fail(
         "need max_abs_diff_m, max_rel_diff, max_check_curvature >= 0 and "
@@ -168,56 +145,45 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
   intrinsics.Check();
   if (stereo.rows() != intrinsics.height || stereo.cols() != intrinsics.width) {
     throw std::invalid_argument(
-        "RefineDepthWithLidar: the depth map is " +
-        std::to_string(stereo.cols()) + "x" + std::to_string(stereo.rows()) +
-        " but the camera is " + std::to_string(intrinsics.width) + "x" +
-        std::to_string(intrinsics.height));
+        "RefineDepthWithLidar: the depth map is " + std::to_string(stereo.cols()) + "x" +
+        std::to_string(stereo.rows()) + " but the camera is " + std::to_string(intrinsics.width) +
+        "x" + std::to_string(intrinsics.height));
   }
   const int width = intrinsics.width;
   const int height = intrinsics.height;
   const std::vector<Eigen::Vector2d> xy = ProjectSamples(surface, intrinsics);
-  const int radius = options.window_radius_px > 0
-                         ? options.window_radius_px
-                         : AutomaticWindowRadius(surface, xy, intrinsics);
+  const int radius = options.window_radius_px > 0 ? options.window_radius_px
+                                                  : AutomaticWindowRadius(surface, xy, intrinsics);
   // Footprints reach at most half the window: a sample never hides a whole window.
-  const IndexImage index =
-      Splat(surface, xy, intrinsics, std::max(1, radius / 2));
+  const IndexImage index = Splat(surface, xy, intrinsics, std::max(1, radius / 2));
   // The visible samples (those owning a pixel of the z-buffer), bucketed in cells of the window's
   // size: a pixel's window is gathered from 3 x 3 cells, not from (2 radius + 1)^2 pixels, which at
   // 12 MP and a 30 px window would be thousands of lookups per pixel.
   const int cell = radius;
-  const int cells_x = (width + cell - 1) / cell,
-            cells_y = (height + cell - 1) / cell;
+  const int cells_x = (width + cell - 1) / cell, cells_y = (height + cell - 1) / cell;
   std::vector<uint8_t> visible(surface.Size(), 0);
   for (Eigen::Index k = 0; k < index.size(); ++k) {
     if (index.data()[k] >= 0) visible[index.data()[k]] = 1;
   }
   std::vector<int> cell_start(size_t(cells_x) * cells_y + 1, 0);
-  auto cell_of =
-      [&](int s) {  // visible samples may project just outside the image
-        const int cx = std::clamp(
-            static_cast<int>(std::floor(xy[s].x())) / cell, 0, cells_x - 1);
-        const int cy = std::clamp(
-            static_cast<int>(std::floor(xy[s].y())) / cell, 0, cells_y - 1);
-        return size_t(cy) * cells_x + cx;
-      };
+  auto cell_of = [&](int s) {  // visible samples may project just outside the image
+    const int cx = std::clamp(static_cast<int>(std::floor(xy[s].x())) / cell, 0, cells_x - 1);
+    const int cy = std::clamp(static_cast<int>(std::floor(xy[s].y())) / cell, 0, cells_y - 1);
+    return size_t(cy) * cells_x + cx;
+  };
   for (size_t s = 0; s < surface.Size(); ++s) {
     if (visible[s]) ++cell_start[cell_of(static_cast<int>(s)) + 1];
   }
-  for (size_t c = 1; c < cell_start.size(); ++c)
-    cell_start[c] += cell_start[c - 1];
+  for (size_t c = 1; c < cell_start.size(); ++c) cell_start[c] += cell_start[c - 1];
   std::vector<int> cell_samples(cell_start.back());
   {
     std::vector<int> fill = cell_start;
     for (size_t s = 0; s < surface.Size(); ++s) {
-      if (visible[s])
-        cell_samples[fill[cell_of(static_cast<int>(s))]++] = int(s);
+      if (visible[s]) cell_samples[fill[cell_of(static_cast<int>(s))]++] = int(s);
     }
   }
-  const double min_normal_cos =
-      std::cos(DegToRad(options.max_normal_angle_deg));
-  const double min_view_cos =
-      std::cos(DegToRad(options.max_fill_view_angle_deg));
+  const double min_normal_cos = std::cos(DegToRad(options.max_normal_angle_deg));
+  const double min_view_cos = std::cos(DegToRad(options.max_fill_view_angle_deg));
   const double kMinRayCos = std::cos(DegToRad(85));
 
   RefinedDepth result;
@@ -243,27 +209,20 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
         window.clear();
         const Eigen::Vector2d pixel_centre(col + 0.5, row + 0.5);
         const int cell_x = col / cell, cell_y = row / cell;
-        for (int cy = std::max(0, cell_y - 1);
-             cy <= std::min(cells_y - 1, cell_y + 1);
-             ++cy) {
-          for (int cx = std::max(0, cell_x - 1);
-               cx <= std::min(cells_x - 1, cell_x + 1);
-               ++cx) {
+        for (int cy = std::max(0, cell_y - 1); cy <= std::min(cells_y - 1, cell_y + 1); ++cy) {
+          for (int cx = std::max(0, cell_x - 1); cx <= std::min(cells_x - 1, cell_x + 1); ++cx) {
             const size_t c = size_t(cy) * cells_x + cx;
             for (int k = cell_start[c]; k < cell_start[c + 1]; ++k) {
               const int s = cell_samples[k];
-              if ((xy[s] - pixel_centre).squaredNorm() <=
-                  double(radius) * radius) {
+              if ((xy[s] - pixel_centre).squaredNorm() <= double(radius) * radius) {
                 window.push_back(s);
               }
             }
           }
         }
         if (index(row, col) >= 0 &&
-            std::find(window.begin(), window.end(), index(row, col)) ==
-                window.end()) {
-          window.push_back(
-              index(row, col));  // a splat reaching the pixel from farther away
+            std::find(window.begin(), window.end(), index(row, col)) == window.end()) {
+          window.push_back(index(row, col));  // a splat reaching the pixel from farther away
         }
 
         // The layer of the visible sample nearest the pixel, and its plane.
@@ -290,8 +249,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
           Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
           Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
           for (int s : window) {
-            if (std::abs(n0.dot(surface.points[s] - x0)) <=
-                    options.plane_tolerance_m &&
+            if (std::abs(n0.dot(surface.points[s] - x0)) <= options.plane_tolerance_m &&
                 n0.dot(surface.normals[s]) >= min_normal_cos) {
               layer.push_back(s);
               normal_sum += surface.normals[s];
@@ -299,8 +257,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
             }
           }
           for (int s : layer) {
-            layer_curvature =
-                std::max(layer_curvature, double(surface.curvature[s]));
+            layer_curvature = std::max(layer_curvature, double(surface.curvature[s]));
           }
           normal = normal_sum.normalized();
           centroid /= double(layer.size());
@@ -316,41 +273,35 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
         // layer that surrounds the pixel. With a second surface in the window (a depth edge or a
         // crease) the layer must surround the pixel on all four sides: a pixel beyond the layer's
         // border, on the other surface, never has layer samples on the other surface's side.
-        const FillVerdict verdict = has_plane && options.fill_holes
-                                        ? JudgeFill(layer,
-                                                    window.size(),
-                                                    xy,
-                                                    centre,
-                                                    normal,
-                                                    unit_ray,
-                                                    layer_curvature,
-                                                    min_view_cos,
-                                                    options)
-                                        : FillVerdict::kNoLayer;
+        const FillVerdict verdict = has_plane && options.fill_holes ? JudgeFill(layer,
+                                                                                window.size(),
+                                                                                xy,
+                                                                                centre,
+                                                                                normal,
+                                                                                unit_ray,
+                                                                                layer_curvature,
+                                                                                min_view_cos,
+                                                                                options)
+                                                                    : FillVerdict::kNoLayer;
 
         if (has_stereo) {
           // Fold 1 (paper, mapping step (1)). Disagreement is the stereo point's distance to the
           // LiDAR plane (what the model's accuracy is measured by), not the depth difference along
           // the ray, which an obliquely seen plane magnifies by 1 / cos(view angle).
-          const double distance =
-              std::abs(normal.dot(ray * double(stereo_z)) - plane_offset);
-          const bool flat_layer =
-              has_plane && layer_curvature <= options.max_check_curvature;
+          const double distance = std::abs(normal.dot(ray * double(stereo_z)) - plane_offset);
+          const bool flat_layer = has_plane && layer_curvature <= options.max_check_curvature;
           const bool replaceable = verdict == FillVerdict::kFill;
-          const double tolerance =
-              replaceable
-                  ? options.max_abs_diff_m + options.max_rel_diff * lidar_z
-                  : options.max_unreplaceable_diff_m;
+          const double tolerance = replaceable
+                                       ? options.max_abs_diff_m + options.max_rel_diff * lidar_z
+                                       : options.max_unreplaceable_diff_m;
           if (!flat_layer || !options.remove_inconsistent) {
             ++local.stereo_without_lidar;  // kept, not judged
           } else if (distance <= tolerance) {
-            if (distance <=
-                options.max_abs_diff_m + options.max_rel_diff * lidar_z) {
+            if (distance <= options.max_abs_diff_m + options.max_rel_diff * lidar_z) {
               ++local.stereo_confirmed;
               result.normals.normals[pixel] = normal.cast<float>();
             } else {
-              ++local
-                    .stereo_without_lidar;  // off, but nothing better to put there
+              ++local.stereo_without_lidar;  // off, but nothing better to put there
             }
           } else {
             ++local.stereo_removed;
@@ -409,8 +360,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
   // Stereo pixels without a LiDAR layer take their normal from the depth map.
   const NormalImage from_depth = NormalsFromDepth(result.depth, intrinsics);
   for (size_t pixel = 0; pixel < result.source.size(); ++pixel) {
-    if (result.depth.data()[pixel] > 0 &&
-        result.normals.normals[pixel].isZero()) {
+    if (result.depth.data()[pixel] > 0 && result.normals.normals[pixel].isZero()) {
       result.normals.normals[pixel] = from_depth.normals[pixel];
     }
   }

@@ -48,37 +48,26 @@ struct LidarDepthRefinementOptions {
   double max_normal_angle_deg = 30;
   // Fold 2.
   bool fill_holes = true;
-  int min_fill_samples = 4;  // layer samples in the window
-  int min_fill_quadrants =
-      3;  // of the 4 quadrants around the pixel holding a sample (interpolate,
-          // never extrapolate past the LiDAR's coverage)
-  double max_fill_curvature =
-      0.05;  // LidarSurface::curvature of every window sample
-  double max_fill_view_angle_deg =
-      75;  // between the plane normal and the viewing ray
+  int min_fill_samples = 4;    // layer samples in the window
+  int min_fill_quadrants = 3;  // of the 4 quadrants around the pixel holding a sample (interpolate,
+                               // never extrapolate past the LiDAR's coverage)
+  double max_fill_curvature = 0.05;     // LidarSurface::curvature of every window sample
+  double max_fill_view_angle_deg = 75;  // between the plane normal and the viewing ray
 
   bool Check() const;  // throws std::invalid_argument
 };
 
 // kRemoved: no depth, the stereo depth was removed by fold 1 and not filled.
-enum class DepthSource : uint8_t {
-  kNone = 0,
-  kStereo = 1,
-  kLidar = 2,
-  kRemoved = 3
-};
+enum class DepthSource : uint8_t { kNone = 0, kStereo = 1, kLidar = 2, kRemoved = 3 };
 
 struct LidarDepthRefinementStats {
-  size_t stereo_pixels = 0;  // valid in the input
-  size_t stereo_without_lidar =
-      0;                        // kept unchecked: no flat LiDAR surface near
-  size_t stereo_confirmed = 0;  // kept: agrees with the LiDAR
-  size_t stereo_removed =
-      0;              // fold 1 (replaced by the LiDAR depth when fold 2 allows)
-  size_t filled = 0;  // fold 2 (holes and removed stereo)
+  size_t stereo_pixels = 0;         // valid in the input
+  size_t stereo_without_lidar = 0;  // kept unchecked: no flat LiDAR surface near
+  size_t stereo_confirmed = 0;      // kept: agrees with the LiDAR
+  size_t stereo_removed = 0;        // fold 1 (replaced by the LiDAR depth when fold 2 allows)
+  size_t filled = 0;                // fold 2 (holes and removed stereo)
   // Pixels without depth next to a LiDAR layer that fold 2 did not fill, by the first failed test.
-  size_t fill_refused_edge =
-      0;  // a second surface in the window, the layer not all round
+  size_t fill_refused_edge = 0;    // a second surface in the window, the layer not all round
   size_t fill_refused_sparse = 0;  // too few samples or quadrants
   size_t fill_refused_view_angle = 0;
   size_t fill_refused_curvature = 0;
@@ -87,8 +76,7 @@ struct LidarDepthRefinementStats {
 
 struct RefinedDepth {
   DepthImage depth;
-  NormalImage
-      normals;  // LiDAR plane normal where a layer exists, else from the depth map
+  NormalImage normals;  // LiDAR plane normal where a layer exists, else from the depth map
   std::vector<DepthSource> source;  // row-major
   LidarDepthRefinementStats stats;
 };

@@ -44,8 +44,7 @@ std::vector<Eigen::Vector3d> LidarPoints() {
       const Eigen::Vector3d wall(x, y, kWallZ);
       const Eigen::Vector3d d = wall - lidar;
       // Intersection with the plate's plane z = 2 - 0.2 x along lidar + t d.
-      const double t =
-          (2.0 - 0.2 * lidar.x() - lidar.z()) / (d.z() + 0.2 * d.x());
+      const double t = (2.0 - 0.2 * lidar.x() - lidar.z()) / (d.z() + 0.2 * d.x());
       const bool hidden = t > 0 && t < 1 && (lidar + t * d).x() < 0;
       if (!hidden) points.emplace_back(x, y, kWallZ + noise(rng));
     }
@@ -53,15 +52,13 @@ std::vector<Eigen::Vector3d> LidarPoints() {
   return points;
 }
 
-TEST(LidarDepthRefinement,
-     RemovesWrongStereoAndFillsHolesWithoutCrossingTheStepEdge) {
+TEST(LidarDepthRefinement, RemovesWrongStereoAndFillsHolesWithoutCrossingTheStepEdge) {
   const PinholeIntrinsics intrinsics = Camera();
   LidarSurfaceOptions surface_options;
   surface_options.sample_spacing_m = 0.006;
   surface_options.radius_m = 0.03;
   surface_options.curvature_radius_m = 0.06;
-  const LidarSurface surface =
-      BuildLidarSurface(LidarPoints(), surface_options);
+  const LidarSurface surface = BuildLidarSurface(LidarPoints(), surface_options);
   ASSERT_GT(surface.Size(), 10000u);
 
   DepthImage truth(intrinsics.height, intrinsics.width);
@@ -95,17 +92,14 @@ TEST(LidarDepthRefinement,
   }
 
   const LidarDepthRefinementOptions options;
-  const RefinedDepth refined =
-      RefineDepthWithLidar(stereo, surface, intrinsics, options);
+  const RefinedDepth refined = RefineDepthWithLidar(stereo, surface, intrinsics, options);
 
   // Fold 1: every outlier and every fattened pixel is gone (or replaced by the LiDAR's true depth).
   for (const auto& [row, col] : outliers) {
     if (refined.depth(row, col) > 0) {
-      EXPECT_LT(std::abs(refined.depth(row, col) - truth(row, col)), 0.003f)
-          << row << "," << col;
+      EXPECT_LT(std::abs(refined.depth(row, col) - truth(row, col)), 0.003f) << row << "," << col;
     }
-    EXPECT_NE(refined.source[size_t(row) * intrinsics.width + col],
-              DepthSource::kStereo);
+    EXPECT_NE(refined.source[size_t(row) * intrinsics.width + col], DepthSource::kStereo);
   }
   for (int row = 110; row < 140; ++row) {
     for (int col = edge_col; col < edge_col + 4; ++col) {
@@ -121,21 +115,18 @@ TEST(LidarDepthRefinement,
   double max_fill_error = 0;
   for (int row = 0; row < intrinsics.height; ++row) {
     for (int col = 0; col < intrinsics.width; ++col) {
-      if (refined.source[size_t(row) * intrinsics.width + col] !=
-          DepthSource::kLidar) {
+      if (refined.source[size_t(row) * intrinsics.width + col] != DepthSource::kLidar) {
         continue;
       }
       ++filled;
       max_fill_error =
-          std::max(max_fill_error,
-                   double(std::abs(refined.depth(row, col) - truth(row, col))));
+          std::max(max_fill_error, double(std::abs(refined.depth(row, col) - truth(row, col))));
       filled_in_plate_hole += row >= 20 && row < 50 && col >= 30 && col < 70;
       filled_in_band += row >= 60 && row < 100 && col >= 100 && col < 140;
     }
   }
-  std::cout << "filled " << filled << " pixels, max error "
-            << max_fill_error * 1000 << " mm; plate hole "
-            << filled_in_plate_hole << "/1200, edge band " << filled_in_band
+  std::cout << "filled " << filled << " pixels, max error " << max_fill_error * 1000
+            << " mm; plate hole " << filled_in_plate_hole << "/1200, edge band " << filled_in_band
             << "/1600" << std::endl;
   EXPECT_LT(max_fill_error,
             0.003);  // 1 mm LiDAR noise, interpolated on the local plane
@@ -155,8 +146,7 @@ TEST(LidarDepthRefinement, DoesNotFillGrazingOrCurvedSurfaces) {
   surface_options.sample_spacing_m = 0.006;
   surface_options.radius_m = 0.03;
   surface_options.curvature_radius_m = 0.06;
-  const DepthImage empty =
-      DepthImage::Zero(intrinsics.height, intrinsics.width);
+  const DepthImage empty = DepthImage::Zero(intrinsics.height, intrinsics.width);
 
   // A plane tilted 70 degrees about the camera's y axis: seen at 55-85 degrees from its normal.
   std::vector<Eigen::Vector3d> tilted;
@@ -169,25 +159,20 @@ TEST(LidarDepthRefinement, DoesNotFillGrazingOrCurvedSurfaces) {
   const LidarSurface plane = BuildLidarSurface(tilted, surface_options);
   LidarDepthRefinementOptions angle_only;
   angle_only.max_fill_curvature = 1;
-  const RefinedDepth by_angle =
-      RefineDepthWithLidar(empty, plane, intrinsics, angle_only);
+  const RefinedDepth by_angle = RefineDepthWithLidar(empty, plane, intrinsics, angle_only);
   angle_only.max_fill_view_angle_deg = 89;
-  const RefinedDepth permissive =
-      RefineDepthWithLidar(empty, plane, intrinsics, angle_only);
-  const Eigen::Vector3d normal =
-      Eigen::Vector3d(-slope, 0, 1).normalized();  // faces the camera
+  const RefinedDepth permissive = RefineDepthWithLidar(empty, plane, intrinsics, angle_only);
+  const Eigen::Vector3d normal = Eigen::Vector3d(-slope, 0, 1).normalized();  // faces the camera
   size_t steep_filled = 0;
   for (int row = 0; row < intrinsics.height; ++row) {
     for (int col = 0; col < intrinsics.width; ++col) {
-      const double angle = std::acos(std::abs(normal.dot(
-                               intrinsics.PixelRay(col, row).normalized()))) *
-                           180 / M_PI;
+      const double angle =
+          std::acos(std::abs(normal.dot(intrinsics.PixelRay(col, row).normalized()))) * 180 / M_PI;
       const size_t pixel = size_t(row) * intrinsics.width + col;
       if (by_angle.source[pixel] == DepthSource::kLidar) {
         EXPECT_LE(angle, 75.5) << row << "," << col;
       }
-      steep_filled +=
-          angle > 77 && permissive.source[pixel] == DepthSource::kLidar;
+      steep_filled += angle > 77 && permissive.source[pixel] == DepthSource::kLidar;
     }
   }
   EXPECT_GT(by_angle.stats.filled, 100u);
@@ -207,13 +192,9 @@ TEST(LidarDepthRefinement, DoesNotFillGrazingOrCurvedSurfaces) {
   curvature_only.plane_tolerance_m = 0.1;
   curvature_only.max_normal_angle_deg = 89;
   curvature_only.max_fill_view_angle_deg = 89;
-  EXPECT_EQ(RefineDepthWithLidar(empty, sphere, intrinsics, curvature_only)
-                .stats.filled,
-            0u);
+  EXPECT_EQ(RefineDepthWithLidar(empty, sphere, intrinsics, curvature_only).stats.filled, 0u);
   curvature_only.max_fill_curvature = 1;
-  EXPECT_GT(RefineDepthWithLidar(empty, sphere, intrinsics, curvature_only)
-                .stats.filled,
-            10u);
+  EXPECT_GT(RefineDepthWithLidar(empty, sphere, intrinsics, curvature_only).stats.filled, 10u);
 }
 
 TEST(LidarDepthRefinement, RejectsAMapOfTheWrongSize) {

@@ -21,8 +21,7 @@ class RelativePoseError {
         measured_translation_(target_from_source.translation()),
         sqrt_weight_(std::sqrt(weight)) {}
 
-  static ceres::CostFunction* Create(
-      const Eigen::Isometry3d& target_from_source, double weight) {
+  static ceres::CostFunction* Create(const Eigen::Isometry3d& target_from_source, double weight) {
     return new ceres::AutoDiffCostFunction<RelativePoseError, 6, 4, 3, 4, 3>(
         new RelativePoseError(target_from_source, weight));
   }
@@ -40,8 +39,7 @@ class RelativePoseError {
     // target_from_source predicted = inverse(world_from_target) * world_from_source
     const Eigen::Quaternion<T> q_pred = q_i.conjugate() * q_j;
     const Eigen::Matrix<T, 3, 1> t_pred = q_i.conjugate() * (t_j - t_i);
-    const Eigen::Quaternion<T> q_err =
-        measured_rotation_.cast<T>().conjugate() * q_pred;
+    const Eigen::Quaternion<T> q_err = measured_rotation_.cast<T>().conjugate() * q_pred;
     Eigen::Map<Eigen::Matrix<T, 6, 1>> r(residuals);
     r.template head<3>() = T(2.0) * q_err.vec();
     r.template tail<3>() = t_pred - measured_translation_.cast<T>();
@@ -79,8 +77,7 @@ std::vector<std::pair<size_t, size_t>> CandidatePairs(
     }
   } else {
     std::vector<std::vector<double>> histograms;
-    for (const StationCloud* s : stations)
-      histograms.push_back(GlobalHistogram(*s));
+    for (const StationCloud* s : stations) histograms.push_back(GlobalHistogram(*s));
     for (size_t i = 0; i < n; ++i) {
       std::vector<std::pair<double, size_t>> distances;
       for (size_t j = 0; j < n; ++j) {
@@ -92,8 +89,7 @@ std::vector<std::pair<size_t, size_t>> CandidatePairs(
       }
       std::sort(distances.begin(), distances.end());
       for (size_t k = 0; k < std::min(max_neighbors, distances.size()); ++k) {
-        pairs.insert({std::min(i, distances[k].second),
-                      std::max(i, distances[k].second)});
+        pairs.insert({std::min(i, distances[k].second), std::max(i, distances[k].second)});
       }
     }
   }
@@ -104,10 +100,9 @@ std::vector<std::pair<size_t, size_t>> CandidatePairs(
 
 bool LidarGraphOptions::Check() const { return pair.Check(); }
 
-LidarGraph RegisterAllStations(
-    const std::vector<const StationCloud*>& stations,
-    const LidarGraphOptions& options,
-    const std::function<void(size_t, size_t)>& progress) {
+LidarGraph RegisterAllStations(const std::vector<const StationCloud*>& stations,
+                               const LidarGraphOptions& options,
+                               const std::function<void(size_t, size_t)>& progress) {
   options.Check();
   const size_t n = stations.size();
   if (n == 0) throw std::invalid_argument("RegisterAllStations: no stations");
@@ -118,8 +113,7 @@ LidarGraph RegisterAllStations(
     LidarEdge edge;
     edge.target = i;
     edge.source = j;
-    edge.registration =
-        RegisterStationClouds(*stations[j], *stations[i], options.pair);
+    edge.registration = RegisterStationClouds(*stations[j], *stations[i], options.pair);
     edge.target_from_source = edge.registration.target_from_source;
     (edge.registration.accepted ? graph.edges : graph.refused).push_back(edge);
     if (progress) progress(k + 1, pairs.size());
@@ -150,11 +144,9 @@ LidarGraph RegisterAllStations(
       // world_from_source = world_from_target * target_from_source
       graph.world_from_lidar[added] =
           target_in ? graph.world_from_lidar[e->target] * e->target_from_source
-                    : graph.world_from_lidar[e->source] *
-                          e->target_from_source.inverse();
+                    : graph.world_from_lidar[e->source] * e->target_from_source.inverse();
       graph.component[added] = c;
-      for (const LidarEdge* next : adjacent[added])
-        queue.push({next->Weight(), next});
+      for (const LidarEdge* next : adjacent[added]) queue.push({next->Weight(), next});
     }
   }
   if (!options.refine || graph.edges.empty()) return graph;
@@ -168,19 +160,17 @@ LidarGraph RegisterAllStations(
   }
   ceres::Problem problem;
   for (const LidarEdge& e : graph.edges) {
-    problem.AddResidualBlock(
-        RelativePoseError::Create(e.target_from_source, e.Weight()),
-        nullptr,
-        rotations[e.target].coeffs().data(),
-        translations[e.target].data(),
-        rotations[e.source].coeffs().data(),
-        translations[e.source].data());
+    problem.AddResidualBlock(RelativePoseError::Create(e.target_from_source, e.Weight()),
+                             nullptr,
+                             rotations[e.target].coeffs().data(),
+                             translations[e.target].data(),
+                             rotations[e.source].coeffs().data(),
+                             translations[e.source].data());
   }
   std::vector<bool> gauge_set(graph.num_components, false);
   for (size_t i = 0; i < n; ++i) {
     if (!problem.HasParameterBlock(rotations[i].coeffs().data())) continue;
-    problem.SetManifold(rotations[i].coeffs().data(),
-                        new ceres::EigenQuaternionManifold);
+    problem.SetManifold(rotations[i].coeffs().data(), new ceres::EigenQuaternionManifold);
     if (!gauge_set[graph.component[i]]) {
       gauge_set[graph.component[i]] = true;
       problem.SetParameterBlockConstant(rotations[i].coeffs().data());
@@ -196,8 +186,7 @@ LidarGraph RegisterAllStations(
   graph.refinement_final_cost = summary.final_cost;
   for (size_t i = 0; i < n; ++i) {
     graph.world_from_lidar[i] = Eigen::Isometry3d::Identity();
-    graph.world_from_lidar[i].linear() =
-        rotations[i].normalized().toRotationMatrix();
+    graph.world_from_lidar[i].linear() = rotations[i].normalized().toRotationMatrix();
     graph.world_from_lidar[i].translation() = translations[i];
   }
   return graph;

@@ -16,14 +16,11 @@
 namespace colmap_lidar {
 
 struct LidarEdge {
-  size_t target = 0;  // i
-  size_t source = 0;  // j
-  Eigen::Isometry3d target_from_source =
-      Eigen::Isometry3d::Identity();  // lidar_i_from_lidar_j
+  size_t target = 0;                                                     // i
+  size_t source = 0;                                                     // j
+  Eigen::Isometry3d target_from_source = Eigen::Isometry3d::Identity();  // lidar_i_from_lidar_j
   PairRegistration registration;
-  double Weight() const {
-    return registration.num_inliers * registration.overlap;
-  }
+  double Weight() const { return registration.num_inliers * registration.overlap; }
 };
 
 struct LidarGraphOptions {
@@ -37,20 +34,17 @@ struct LidarGraphOptions {
 };
 
 struct LidarGraph {
-  std::vector<LidarEdge> edges;  // accepted
-  std::vector<LidarEdge>
-      refused;  // attempted, not accepted (registration.reason says why)
+  std::vector<LidarEdge> edges;    // accepted
+  std::vector<LidarEdge> refused;  // attempted, not accepted (registration.reason says why)
   std::vector<Eigen::Isometry3d> world_from_lidar;  // per station
-  std::vector<int>
-      component;  // per station, 0-based; component 0 holds station 0
+  std::vector<int> component;  // per station, 0-based; component 0 holds station 0
   int num_components = 0;
   double refinement_initial_cost = 0, refinement_final_cost = 0;
 };
 
 // Progress: called after each pair with (pairs done, pairs total).
-LidarGraph RegisterAllStations(
-    const std::vector<const StationCloud*>& stations,
-    const LidarGraphOptions& options,
-    const std::function<void(size_t, size_t)>& progress = nullptr);
+LidarGraph RegisterAllStations(const std::vector<const StationCloud*>& stations,
+                               const LidarGraphOptions& options,
+                               const std::function<void(size_t, size_t)>& progress = nullptr);
 
 }  // namespace colmap_lidar

@@ -15,7 +15,7 @@ namespace {
 struct Pca {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();  // ascending
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // smallest eigenvector
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();      // smallest eigenvector
 };
 
 // PCA of the indexed samples, at most `max_count` of them taken evenly.
@@ -49,23 +49,19 @@ double Curvature(const Pca& pca) {
 
 bool LidarSurfaceOptions::Check() const {
   if (!(sample_spacing_m > 0) || !(radius_m > sample_spacing_m)) {
-    throw std::invalid_argument(
-        "LidarSurfaceOptions: need 0 < sample_spacing_m < radius_m");
+    throw std::invalid_argument("LidarSurfaceOptions: need 0 < sample_spacing_m < radius_m");
   }
   if (!(curvature_radius_m > 0)) {
-    throw std::invalid_argument(
-        "LidarSurfaceOptions: curvature_radius_m must be > 0");
+    throw std::invalid_argument("LidarSurfaceOptions: curvature_radius_m must be > 0");
   }
   if (min_neighbors < 3 || max_neighbors < min_neighbors) {
-    throw std::invalid_argument(
-        "LidarSurfaceOptions: need 3 <= min_neighbors <= max_neighbors");
+    throw std::invalid_argument("LidarSurfaceOptions: need 3 <= min_neighbors <= max_neighbors");
   }
   return true;
 }
 
-LidarSurface BuildLidarSurface(
-    const std::vector<Eigen::Vector3d>& points_in_cam,
-    const LidarSurfaceOptions& options) {
+LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam,
+                               const LidarSurfaceOptions& options) {
   options.Check();
   LidarSurface surface;
   if (points_in_cam.empty()) return surface;
@@ -93,8 +89,8 @@ LidarSurface BuildLidarSurface(
       tree.KNearest(samples[i], 5, &nearest, &squared);
       double sum = 0;
       for (size_t k = 1; k < nearest.size(); ++k) sum += std::sqrt(squared[k]);
-      spacing[i] = float(nearest.size() > 1 ? sum / (nearest.size() - 1)
-                                            : options.sample_spacing_m);
+      spacing[i] =
+          float(nearest.size() > 1 ? sum / (nearest.size() - 1) : options.sample_spacing_m);
       if (options.num_shifted_neighbourhoods > 0) {
         // Neighbourhood shifting: also fit the neighbourhoods centred on samples half a radius
         // away and keep the flattest. Near a corner that is a neighbourhood on the sample's own face,
@@ -106,15 +102,13 @@ LidarSurface BuildLidarSurface(
             candidates.push_back(j);
           }
         }
-        const size_t stride = std::max<size_t>(
-            1, candidates.size() / options.num_shifted_neighbourhoods);
+        const size_t stride =
+            std::max<size_t>(1, candidates.size() / options.num_shifted_neighbourhoods);
         double best = Curvature(pca);
         for (size_t k = 0; k < candidates.size(); k += stride) {
           tree.RadiusSearch(samples[candidates[k]], options.radius_m, &shifted);
-          if (static_cast<int>(shifted.size()) < options.min_neighbors)
-            continue;
-          const Pca other =
-              NeighbourhoodPca(samples, shifted, options.max_neighbors);
+          if (static_cast<int>(shifted.size()) < options.min_neighbors) continue;
+          const Pca other = NeighbourhoodPca(samples, shifted, options.max_neighbors);
           const double c = Curvature(other);
           if (c < best) best = c, pca = other;
         }
@@ -126,8 +120,7 @@ LidarSurface BuildLidarSurface(
       double c = Curvature(pca);
       if (options.curvature_radius_m != options.radius_m) {
         tree.RadiusSearch(samples[i], options.curvature_radius_m, &indices);
-        c = Curvature(
-            NeighbourhoodPca(samples, indices, options.max_neighbors));
+        c = Curvature(NeighbourhoodPca(samples, indices, options.max_neighbors));
       }
       curvature[i] = float(c);
     }

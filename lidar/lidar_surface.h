@@ -16,7 +16,7 @@ namespace colmap_lidar {
 
 struct LidarSurfaceOptions {
   double sample_spacing_m = 0.005;  // voxel edge of the thinning
-  double radius_m = 0.04;  // PCA neighbourhood radius (normal, position)
+  double radius_m = 0.04;           // PCA neighbourhood radius (normal, position)
   // Neighbourhood of the curvature. Larger than radius_m: range noise sigma alone gives a flat patch
   // a curvature of about 3 sigma^2 / r^2 (0.19 for a VLP-16's 1 cm at 4 cm, 0.03 at 10 cm).
   double curvature_radius_m = 0.1;
@@ -43,8 +43,7 @@ struct LidarSurface {
 
 // `points_in_cam`: the LiDAR points in the camera frame. Normals face the camera (the origin): LiDAR
 // and camera see the same side of any surface both see.
-LidarSurface BuildLidarSurface(
-    const std::vector<Eigen::Vector3d>& points_in_cam,
-    const LidarSurfaceOptions& options);
+LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam,
+                               const LidarSurfaceOptions& options);
 
 }  // namespace colmap_lidar

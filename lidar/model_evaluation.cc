@@ -23,10 +23,9 @@ double DistanceToSampledSurface(const PointCloud& truth,
   double best = nearest;
   for (size_t k = 0; k < indices.size(); ++k) {
     const Eigen::Vector3d offset = point - truth.points[indices[k]];
-    const double normal_distance =
-        std::abs(truth.normals[indices[k]].dot(offset));
-    const double tangential = std::sqrt(
-        std::max(0.0, squared[k] - normal_distance * normal_distance));
+    const double normal_distance = std::abs(truth.normals[indices[k]].dot(offset));
+    const double tangential =
+        std::sqrt(std::max(0.0, squared[k] - normal_distance * normal_distance));
     // Within the footprint of this sample, the plane is the surface.
     if (tangential <= spacing) best = std::min(best, normal_distance);
   }
@@ -37,8 +36,7 @@ namespace {
 
 double Percentile(std::vector<double> values, double q) {
   if (values.empty()) return 0;
-  const size_t k = std::min(values.size() - 1,
-                            static_cast<size_t>(q * (values.size() - 1) + 0.5));
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
   std::nth_element(values.begin(), values.begin() + k, values.end());
   return values[k];
 }
@@ -50,8 +48,7 @@ bool ModelEvaluationOptions::Check() const {
     throw std::invalid_argument("ModelEvaluationOptions: non-positive value");
   }
   for (double t : thresholds_m) {
-    if (t <= 0)
-      throw std::invalid_argument("ModelEvaluationOptions: threshold <= 0");
+    if (t <= 0) throw std::invalid_argument("ModelEvaluationOptions: threshold <= 0");
   }
   return true;
 }
@@ -62,8 +59,7 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
   options.Check();
   if (model.Empty()) throw std::invalid_argument("The model cloud is empty");
   if (truth.Empty() || !truth.HasNormals()) {
-    throw std::invalid_argument(
-        "The ground-truth surface needs points with normals");
+    throw std::invalid_argument("The ground-truth surface needs points with normals");
   }
   ModelEvaluation result;
   result.num_model_points = model.Size();
@@ -72,8 +68,7 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
 
   // The sampling spacing of the truth: median nearest-neighbour distance over a subset.
   std::vector<double> spacings;
-  for (size_t i = 0; i < truth.Size();
-       i += std::max<size_t>(1, truth.Size() / 2000)) {
+  for (size_t i = 0; i < truth.Size(); i += std::max<size_t>(1, truth.Size() / 2000)) {
     std::vector<size_t> indices;
     std::vector<double> squared;
     truth_tree.KNearest(truth.points[i], 2, &indices, &squared);
@@ -95,11 +90,10 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
     IcpOptions icp;
     icp.max_iterations = std::max(1, options.icp_max_iterations);
     icp.max_correspondence_distance = options.crop_distance_m;
-    icp.min_correspondence_distance =
-        std::min(options.crop_distance_m, 4 * spacing);
+    icp.min_correspondence_distance = std::min(options.crop_distance_m, 4 * spacing);
     icp.max_source_points = 100000;
-    const IcpResult aligned = PointToPlaneIcp(
-        cropped, truth, truth_tree, Eigen::Isometry3d::Identity(), icp);
+    const IcpResult aligned =
+        PointToPlaneIcp(cropped, truth, truth_tree, Eigen::Isometry3d::Identity(), icp);
     result.truth_from_model = aligned.target_from_source;
     result.icp_converged = aligned.converged;
     result.icp_iterations = aligned.iterations;
@@ -129,8 +123,7 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
   result.p90 = Percentile(result.distances, 0.9);
   result.p95 = Percentile(result.distances, 0.95);
   result.p99 = Percentile(result.distances, 0.99);
-  result.max =
-      *std::max_element(result.distances.begin(), result.distances.end());
+  result.max = *std::max_element(result.distances.begin(), result.distances.end());
 
   // Completeness: distance from each truth sample to the nearest model point, queried once.
   const KdTree3 model_tree(moved);
@@ -151,8 +144,7 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
     at.precision = static_cast<double>(precise) / result.distances.size();
     at.completeness = static_cast<double>(complete) / truth.Size();
     at.f_score = at.precision + at.completeness > 0
-                     ? 2 * at.precision * at.completeness /
-                           (at.precision + at.completeness)
+                     ? 2 * at.precision * at.completeness / (at.precision + at.completeness)
                      : 0;
     result.at_thresholds.push_back(at);
   }
@@ -160,10 +152,8 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
   // Density on the structure: evaluated points per cm^2 of the true surface they cover. Each truth
   // sample stands for spacing^2 of surface; the covered part is the completeness at the largest threshold.
   const double covered_fraction =
-      result.at_thresholds.empty() ? 1.0
-                                   : result.at_thresholds.back().completeness;
-  const double covered_area_cm2 =
-      covered_fraction * truth.Size() * spacing * spacing * 1e4;
+      result.at_thresholds.empty() ? 1.0 : result.at_thresholds.back().completeness;
+  const double covered_area_cm2 = covered_fraction * truth.Size() * spacing * spacing * 1e4;
   result.density_points_per_cm2 =
       covered_area_cm2 > 0 ? result.num_evaluated / covered_area_cm2 : 0;
   return result;

@@ -13,13 +13,11 @@
 namespace colmap_lidar {
 
 struct ModelEvaluationOptions {
-  bool align_icp =
-      true;  // rigid point-to-plane ICP of the model onto the truth first
+  bool align_icp = true;  // rigid point-to-plane ICP of the model onto the truth first
   int icp_max_iterations = 30;
   double crop_distance_m =
       0.05;  // model points farther than this from the truth are not the structure
-  std::vector<double> thresholds_m = {
-      0.002, 0.005, 0.010};  // completeness / precision / F-score
+  std::vector<double> thresholds_m = {0.002, 0.005, 0.010};  // completeness / precision / F-score
 
   bool Check() const;  // throws std::invalid_argument on a bad value
 };
@@ -28,8 +26,7 @@ struct ModelEvaluation {
   size_t num_model_points = 0;
   size_t num_evaluated = 0;  // after cropping
   size_t num_truth_points = 0;
-  Eigen::Isometry3d truth_from_model =
-      Eigen::Isometry3d::Identity();  // the ICP alignment
+  Eigen::Isometry3d truth_from_model = Eigen::Isometry3d::Identity();  // the ICP alignment
   bool icp_converged = false;
   int icp_iterations = 0;
   // Unsigned distance of each evaluated model point to the true surface [m].

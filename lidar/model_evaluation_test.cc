@@ -36,8 +36,7 @@ PointCloud BoxSurface(double spacing) {
 
 TEST(ModelEvaluationTest, TruthAgainstItselfIsExact) {
   const PointCloud truth = BoxSurface(0.005);
-  const ModelEvaluation result =
-      EvaluateModel(truth, truth, ModelEvaluationOptions());
+  const ModelEvaluation result = EvaluateModel(truth, truth, ModelEvaluationOptions());
   EXPECT_EQ(result.num_evaluated, truth.Size());
   EXPECT_LT(result.mean, 1e-9);
   EXPECT_LT(result.max, 1e-9);
@@ -54,15 +53,12 @@ TEST(ModelEvaluationTest, KnownOffsetsAndNoiseAreMeasured) {
   options.align_icp = false;
   // Every point pushed 3 mm outwards, on a denser, differently placed grid.
   PointCloud model = BoxSurface(0.0035);
-  for (size_t i = 0; i < model.Size(); ++i)
-    model.points[i] += 0.003 * model.normals[i];
+  for (size_t i = 0; i < model.Size(); ++i) model.points[i] += 0.003 * model.normals[i];
   ModelEvaluation result = EvaluateModel(model, truth, options);
   EXPECT_NEAR(result.mean, 0.003, 1e-4);
   EXPECT_NEAR(result.median, 0.003, 1e-5);
-  EXPECT_NEAR(
-      result.at_thresholds[0].precision, 0.0, 0.02);  // 2 mm: nothing within
-  EXPECT_NEAR(
-      result.at_thresholds[1].precision, 1.0, 1e-9);  // 5 mm: everything
+  EXPECT_NEAR(result.at_thresholds[0].precision, 0.0, 0.02);  // 2 mm: nothing within
+  EXPECT_NEAR(result.at_thresholds[1].precision, 1.0, 1e-9);  // 5 mm: everything
   // A 3.5 mm grid: 1 / 0.35^2 = 8.2 points per cm^2.
   EXPECT_NEAR(result.density_points_per_cm2, 1 / (0.35 * 0.35), 0.4);
 
@@ -70,8 +66,7 @@ TEST(ModelEvaluationTest, KnownOffsetsAndNoiseAreMeasured) {
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0, 0.002);
   model = BoxSurface(0.003);
-  for (size_t i = 0; i < model.Size(); ++i)
-    model.points[i] += noise(rng) * model.normals[i];
+  for (size_t i = 0; i < model.Size(); ++i) model.points[i] += noise(rng) * model.normals[i];
   result = EvaluateModel(model, truth, options);
   EXPECT_NEAR(result.mean, 0.002 * std::sqrt(2 / M_PI), 1e-4);
   EXPECT_NEAR(result.rmse, 0.002, 1.5e-4);
@@ -81,16 +76,14 @@ TEST(ModelEvaluationTest, IcpRemovesARigidMisalignmentAndReportsIt) {
   const PointCloud truth = BoxSurface(0.005);
   const Eigen::Isometry3d model_from_truth =
       Eigen::Translation3d(0.012, -0.008, 0.01) *
-      Eigen::AngleAxisd(1.0 * M_PI / 180,
-                        Eigen::Vector3d(0.3, 1, 0.2).normalized());
+      Eigen::AngleAxisd(1.0 * M_PI / 180, Eigen::Vector3d(0.3, 1, 0.2).normalized());
   PointCloud model = BoxSurface(0.004);
   for (Eigen::Vector3d& p : model.points) p = model_from_truth * p;
   ModelEvaluationOptions options;
   const ModelEvaluation aligned = EvaluateModel(model, truth, options);
   EXPECT_TRUE(aligned.icp_converged);
   EXPECT_LT(aligned.mean, 5e-5);
-  const Eigen::Isometry3d residual =
-      aligned.truth_from_model * model_from_truth;
+  const Eigen::Isometry3d residual = aligned.truth_from_model * model_from_truth;
   EXPECT_LT(residual.translation().norm(), 1e-4);
   EXPECT_LT(Eigen::AngleAxisd(residual.linear()).angle(), 1e-4);
   options.align_icp = false;
@@ -102,20 +95,17 @@ TEST(ModelEvaluationTest, PointsAwayFromTheStructureAreCropped) {
   PointCloud model = truth;
   model.normals.clear();
   model.points.emplace_back(3, 3, 0);  // ground / background
-  const ModelEvaluation result =
-      EvaluateModel(model, truth, ModelEvaluationOptions());
+  const ModelEvaluation result = EvaluateModel(model, truth, ModelEvaluationOptions());
   EXPECT_EQ(result.num_evaluated, truth.Size());
   EXPECT_LT(result.max, 1e-9);
 }
 
 TEST(ModelEvaluationTest, RejectsBadInput) {
   const PointCloud truth = BoxSurface(0.01);
-  EXPECT_THROW(EvaluateModel(PointCloud(), truth, ModelEvaluationOptions()),
-               std::invalid_argument);
+  EXPECT_THROW(EvaluateModel(PointCloud(), truth, ModelEvaluationOptions()), std::invalid_argument);
   PointCloud no_normals = truth;
   no_normals.normals.clear();
-  EXPECT_THROW(EvaluateModel(truth, no_normals, ModelEvaluationOptions()),
-               std::invalid_argument);
+  EXPECT_THROW(EvaluateModel(truth, no_normals, ModelEvaluationOptions()), std::invalid_argument);
 }
 
 }  // namespace

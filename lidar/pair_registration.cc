@@ -10,8 +10,7 @@
 namespace colmap_lidar {
 namespace {
 
-Eigen::Isometry3d Kabsch(const Eigen::Matrix3Xd& source,
-                         const Eigen::Matrix3Xd& target) {
+Eigen::Isometry3d Kabsch(const Eigen::Matrix3Xd& source, const Eigen::Matrix3Xd& target) {
   Eigen::Isometry3d result;
   result.matrix() = Eigen::umeyama(source, target, /*with_scaling=*/false);
   return result;
@@ -46,18 +45,17 @@ std::vector<Nearest> NearestInHamming(const std::vector<BscFeature>& from,
 
 bool PairRegistrationOptions::Check() const {
   if (!(max_ratio > 0) || ransac_iterations < 1 || !(inlier_threshold > 0) ||
-      !(edge_tolerance > 0) || min_inliers < 3 || num_hypotheses < 1 ||
-      !(min_overlap >= 0) || !(max_rmse > 0)) {
+      !(edge_tolerance > 0) || min_inliers < 3 || num_hypotheses < 1 || !(min_overlap >= 0) ||
+      !(max_rmse > 0)) {
     throw std::invalid_argument("PairRegistrationOptions: invalid value");
   }
   return icp.Check();
 }
 
-std::vector<std::pair<size_t, size_t>> MatchBscFeatures(
-    const std::vector<BscFeature>& source,
-    const std::vector<BscFeature>& target,
-    double max_ratio,
-    bool mutual) {
+std::vector<std::pair<size_t, size_t>> MatchBscFeatures(const std::vector<BscFeature>& source,
+                                                        const std::vector<BscFeature>& target,
+                                                        double max_ratio,
+                                                        bool mutual) {
   std::vector<std::pair<size_t, size_t>> matches;
   if (source.empty() || target.empty()) return matches;
   const std::vector<Nearest> forward = NearestInHamming(source, target);
@@ -77,12 +75,11 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
                                        const PairRegistrationOptions& options) {
   options.Check();
   PairRegistration result;
-  const auto matches = MatchBscFeatures(
-      source.features, target.features, options.max_ratio, options.mutual);
+  const auto matches =
+      MatchBscFeatures(source.features, target.features, options.max_ratio, options.mutual);
   result.num_matches = matches.size();
   if (static_cast<int>(matches.size()) < options.min_inliers) {
-    result.reason =
-        "too few BSC matches (" + std::to_string(matches.size()) + ")";
+    result.reason = "too few BSC matches (" + std::to_string(matches.size()) + ")";
     return result;
   }
   const size_t n = matches.size();
@@ -91,12 +88,10 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
     source_points.col(k) = source.features[matches[k].first].position;
     target_points.col(k) = target.features[matches[k].second].position;
   }
-  auto inliers_of = [&](const Eigen::Isometry3d& t,
-                        std::vector<size_t>* inliers) {
+  auto inliers_of = [&](const Eigen::Isometry3d& t, std::vector<size_t>* inliers) {
     inliers->clear();
     for (size_t k = 0; k < n; ++k) {
-      if ((t * source_points.col(k) - target_points.col(k)).norm() <
-          options.inlier_threshold) {
+      if ((t * source_points.col(k) - target_points.col(k)).norm() < options.inlier_threshold) {
         inliers->push_back(k);
       }
     }
@@ -110,8 +105,7 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
   std::vector<Hypothesis> hypotheses;
   auto distinct = [](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
     const Eigen::Isometry3d d = a * b.inverse();
-    return Eigen::AngleAxisd(d.linear()).angle() > 5 * M_PI / 180 ||
-           d.translation().norm() > 0.5;
+    return Eigen::AngleAxisd(d.linear()).angle() > 5 * M_PI / 180 || d.translation().norm() > 0.5;
   };
   std::mt19937_64 rng(options.seed);
   std::uniform_int_distribution<size_t> pick(0, n - 1);
@@ -123,12 +117,10 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
     if (a == b || b == c || a == c) continue;
     // Edge-length consistency: a rigid motion preserves the triangle.
     bool consistent = true;
-    for (const auto& [i, j] :
-         {std::pair{a, b}, std::pair{b, c}, std::pair{a, c}}) {
+    for (const auto& [i, j] : {std::pair{a, b}, std::pair{b, c}, std::pair{a, c}}) {
       const double ds = (source_points.col(i) - source_points.col(j)).norm();
       const double dt = (target_points.col(i) - target_points.col(j)).norm();
-      if (std::abs(ds - dt) > options.edge_tolerance ||
-          ds < 2 * options.inlier_threshold) {
+      if (std::abs(ds - dt) > options.edge_tolerance || ds < 2 * options.inlier_threshold) {
         consistent = false;
       }
     }
@@ -148,18 +140,14 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
       }
     }
     if (!merged) hypotheses.push_back({candidate, inliers});
-    std::sort(hypotheses.begin(),
-              hypotheses.end(),
-              [](const Hypothesis& x, const Hypothesis& y) {
-                return x.inliers.size() > y.inliers.size();
-              });
-    if (static_cast<int>(hypotheses.size()) > options.num_hypotheses)
-      hypotheses.pop_back();
+    std::sort(hypotheses.begin(), hypotheses.end(), [](const Hypothesis& x, const Hypothesis& y) {
+      return x.inliers.size() > y.inliers.size();
+    });
+    if (static_cast<int>(hypotheses.size()) > options.num_hypotheses) hypotheses.pop_back();
   }
   if (hypotheses.empty()) {
-    result.reason = "too few RANSAC inliers (fewer than " +
-                    std::to_string(options.min_inliers) + " of " +
-                    std::to_string(n) + " matches)";
+    result.reason = "too few RANSAC inliers (fewer than " + std::to_string(options.min_inliers) +
+                    " of " + std::to_string(n) + " matches)";
     return result;
   }
   bool have_candidate = false;
@@ -176,11 +164,8 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
       if (inliers.size() < h.inliers.size()) break;
       h = {refit_pose, inliers};
     }
-    const IcpResult fine = PointToPlaneIcp(source.cloud,
-                                           target.cloud,
-                                           *target.tree,
-                                           h.target_from_source,
-                                           options.icp);
+    const IcpResult fine = PointToPlaneIcp(
+        source.cloud, target.cloud, *target.tree, h.target_from_source, options.icp);
     if (!have_candidate || fine.overlap_ratio > result.overlap) {
       have_candidate = true;
       result.target_from_source = fine.target_from_source;
@@ -196,8 +181,8 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
     result.reason = "overlap " + std::to_string(result.overlap) + " below " +
                     std::to_string(options.min_overlap);
   } else if (result.rmse > options.max_rmse) {
-    result.reason = "ICP RMSE " + std::to_string(result.rmse) + " m above " +
-                    std::to_string(options.max_rmse);
+    result.reason =
+        "ICP RMSE " + std::to_string(result.rmse) + " m above " + std::to_string(options.max_rmse);
   } else {
     result.accepted = true;
   }

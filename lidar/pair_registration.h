@@ -21,11 +21,9 @@ struct PairRegistrationOptions {
   bool mutual = true;       // keep only mutual nearest neighbours
   int ransac_iterations = 200000;
   double inlier_threshold = 0.3;  // keypoint distance after alignment [m]
-  double edge_tolerance =
-      0.2;  // |edge_source - edge_target| of the 3-point sample [m]
+  double edge_tolerance = 0.2;    // |edge_source - edge_target| of the 3-point sample [m]
   int min_inliers = 6;
-  int num_hypotheses =
-      10;  // distinct RANSAC hypotheses refined by ICP; best overlap wins
+  int num_hypotheses = 10;  // distinct RANSAC hypotheses refined by ICP; best overlap wins
   uint64_t seed = 0;
   IcpOptions icp;
   double min_overlap = 0.3;  // ICP inlier fraction of the source
@@ -37,8 +35,7 @@ struct PairRegistrationOptions {
 struct PairRegistration {
   Eigen::Isometry3d target_from_source = Eigen::Isometry3d::Identity();
   size_t num_matches = 0;
-  size_t num_inliers =
-      0;  // RANSAC inliers among the matches (of the chosen hypothesis)
+  size_t num_inliers = 0;  // RANSAC inliers among the matches (of the chosen hypothesis)
   double overlap = 0;      // ICP overlap ratio
   double rmse = 0;         // ICP RMSE [m]
   bool converged = false;  // ICP converged
@@ -47,11 +44,10 @@ struct PairRegistration {
 };
 
 // Matches of source features to target features: (source index, target index).
-std::vector<std::pair<size_t, size_t>> MatchBscFeatures(
-    const std::vector<BscFeature>& source,
-    const std::vector<BscFeature>& target,
-    double max_ratio,
-    bool mutual);
+std::vector<std::pair<size_t, size_t>> MatchBscFeatures(const std::vector<BscFeature>& source,
+                                                        const std::vector<BscFeature>& target,
+                                                        double max_ratio,
+                                                        bool mutual);
 
 PairRegistration RegisterStationClouds(const StationCloud& source,
                                        const StationCloud& target,

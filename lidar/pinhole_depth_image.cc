@@ -8,8 +8,7 @@ namespace colmap_lidar {
 
 bool PinholeIntrinsics::Check() const {
   if (width <= 0 || height <= 0) {
-    throw std::invalid_argument(
-        "PinholeIntrinsics: image size must be positive");
+    throw std::invalid_argument("PinholeIntrinsics: image size must be positive");
   }
   if (!(fx > 0) || !(fy > 0) || !std::isfinite(cx) || !std::isfinite(cy)) {
     throw std::invalid_argument(
@@ -31,8 +30,7 @@ NormalImage NormalsFromDepth(const DepthImage& depth,
   };
   // The neighbour `offset` pixels away along one axis if it has depth close to `z`, else none.
   auto usable = [&](int col, int row, float z) {
-    return col >= 0 && row >= 0 && col < width && row < height &&
-           depth(row, col) > 0 &&
+    return col >= 0 && row >= 0 && col < width && row < height && depth(row, col) > 0 &&
            std::abs(depth(row, col) - z) <= max_relative_jump * z;
   };
 #pragma omp parallel for schedule(dynamic, 16)
@@ -48,8 +46,7 @@ NormalImage NormalsFromDepth(const DepthImage& depth,
         const bool plus = usable(col + dc, row + dr, z);
         const bool minus = usable(col - dc, row - dr, z);
         if (plus && minus) {
-          tangents[axis] =
-              point(col + dc, row + dr) - point(col - dc, row - dr);
+          tangents[axis] = point(col + dc, row + dr) - point(col - dc, row - dr);
         } else if (plus) {
           tangents[axis] = point(col + dc, row + dr) - point(col, row);
         } else if (minus) {

@@ -12,8 +12,7 @@
 namespace colmap_lidar {
 
 // z-depth [m] per pixel, indexed (row, col); 0 = no depth.
-using DepthImage =
-    Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using DepthImage = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 struct PinholeIntrinsics {
   int width = 0;
@@ -47,12 +46,8 @@ struct NormalImage {
   NormalImage() = default;
   NormalImage(int w, int h)
       : width(w), height(h), normals(size_t(w) * h, Eigen::Vector3f::Zero()) {}
-  Eigen::Vector3f& At(int row, int col) {
-    return normals[size_t(row) * width + col];
-  }
-  const Eigen::Vector3f& At(int row, int col) const {
-    return normals[size_t(row) * width + col];
-  }
+  Eigen::Vector3f& At(int row, int col) { return normals[size_t(row) * width + col]; }
+  const Eigen::Vector3f& At(int row, int col) const { return normals[size_t(row) * width + col]; }
 };
 
 // Normals of a depth image from its back-projected neighbours (central differences over `step` pixels,

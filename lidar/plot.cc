@@ -20,24 +20,14 @@ std::string Format(double value) {
   return out.str();
 }
 
-void PutText(cv::Mat* canvas,
-             const std::string& text,
-             const cv::Point& origin,
-             double scale) {
-  cv::putText(*canvas,
-              text,
-              origin,
-              cv::FONT_HERSHEY_SIMPLEX,
-              scale,
-              cv::Scalar(0, 0, 0),
-              1,
-              cv::LINE_AA);
+void PutText(cv::Mat* canvas, const std::string& text, const cv::Point& origin, double scale) {
+  cv::putText(
+      *canvas, text, origin, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 }
 
 void WritePngAtomically(const std::string& path, const cv::Mat& canvas) {
   const std::string tmp = path + ".tmp" + std::to_string(::getpid()) + ".png";
-  if (!cv::imwrite(tmp, canvas))
-    throw std::runtime_error("Cannot write plot " + path);
+  if (!cv::imwrite(tmp, canvas)) throw std::runtime_error("Cannot write plot " + path);
   std::filesystem::rename(tmp, path);
 }
 
@@ -46,15 +36,11 @@ void WritePngAtomically(const std::string& path, const cv::Mat& canvas) {
 void WriteLinePlotPng(const std::string& path,
                       const std::vector<PlotSeries>& series,
                       const LinePlotOptions& options) {
-  constexpr int kWidth = 800, kHeight = 500, kLeft = 80, kRight = 150,
-                kTop = 50, kBottom = 60;
+  constexpr int kWidth = 800, kHeight = 500, kLeft = 80, kRight = 150, kTop = 50, kBottom = 60;
   const int plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
   cv::Mat canvas(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
-  const auto y_value = [&](double y) {
-    return options.log_y ? std::log10(y) : y;
-  };
-  double x_min = INFINITY, x_max = -INFINITY, y_min = INFINITY,
-         y_max = -INFINITY;
+  const auto y_value = [&](double y) { return options.log_y ? std::log10(y) : y; };
+  double x_min = INFINITY, x_max = -INFINITY, y_min = INFINITY, y_max = -INFINITY;
   for (const PlotSeries& s : series) {
     for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       if (options.log_y && s.y[i] <= 0) continue;
@@ -75,8 +61,7 @@ void WriteLinePlotPng(const std::string& path,
   const auto to_pixel = [&](double x, double y) {
     return cv::Point(
         kLeft + static_cast<int>((x - x_min) / (x_max - x_min) * plot_w),
-        kTop + plot_h -
-            static_cast<int>((y_value(y) - y_min) / (y_max - y_min) * plot_h));
+        kTop + plot_h - static_cast<int>((y_value(y) - y_min) / (y_max - y_min) * plot_h));
   };
   const cv::Scalar black(0, 0, 0);
   cv::rectangle(canvas, {kLeft, kTop}, {kLeft + plot_w, kTop + plot_h}, black);
@@ -98,8 +83,7 @@ void WriteLinePlotPng(const std::string& path,
                 black);
   }
   for (size_t k = 0; k < series.size(); ++k) {
-    const Color3ub c = ErrorColor(static_cast<double>(k),
-                                  std::max<double>(1, series.size() - 1));
+    const Color3ub c = ErrorColor(static_cast<double>(k), std::max<double>(1, series.size() - 1));
     const cv::Scalar colour(0.8 * c[2], 0.8 * c[1], 0.8 * c[0]);
     const PlotSeries& s = series[k];
     bool has_previous = false;
@@ -121,33 +105,25 @@ void WriteLinePlotPng(const std::string& path,
     PutText(&canvas, s.label, {kLeft + plot_w + 40, legend_y}, 0.45);
   }
   PutText(&canvas, options.title, {kLeft, 30}, 0.6);
-  PutText(
-      &canvas, options.x_label, {kLeft + plot_w / 2 - 60, kHeight - 12}, 0.5);
-  PutText(&canvas,
-          options.y_label + (options.log_y ? " (log)" : ""),
-          {5, kTop - 10},
-          0.45);
+  PutText(&canvas, options.x_label, {kLeft + plot_w / 2 - 60, kHeight - 12}, 0.5);
+  PutText(&canvas, options.y_label + (options.log_y ? " (log)" : ""), {5, kTop - 10}, 0.45);
   WritePngAtomically(path, canvas);
 }
 
 Color3ub ErrorColor(double value, double max_value) {
-  const double t =
-      std::clamp(max_value > 0 ? value / max_value : 0.0, 0.0, 1.0);
+  const double t = std::clamp(max_value > 0 ? value / max_value : 0.0, 0.0, 1.0);
   // Piecewise linear: blue (0) -> cyan -> green -> yellow -> red (1).
   const double r = std::clamp(4 * t - 2, 0.0, 1.0);
-  const double g =
-      t < 0.75 ? std::clamp(4 * t, 0.0, 1.0) : std::clamp(4 - 4 * t, 0.0, 1.0);
+  const double g = t < 0.75 ? std::clamp(4 * t, 0.0, 1.0) : std::clamp(4 - 4 * t, 0.0, 1.0);
   const double b = std::clamp(2 - 4 * t, 0.0, 1.0);
-  return Color3ub(static_cast<uint8_t>(255 * r),
-                  static_cast<uint8_t>(255 * g),
-                  static_cast<uint8_t>(255 * b));
+  return Color3ub(
+      static_cast<uint8_t>(255 * r), static_cast<uint8_t>(255 * g), static_cast<uint8_t>(255 * b));
 }
 
 void WriteHistogramPng(const std::string& path,
                        const std::vector<double>& values,
                        const HistogramPlotOptions& options) {
-  constexpr int kWidth = 800, kHeight = 500, kLeft = 70, kRight = 45, kTop = 50,
-                kBottom = 60;
+  constexpr int kWidth = 800, kHeight = 500, kLeft = 70, kRight = 45, kTop = 50, kBottom = 60;
   cv::Mat canvas(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
   double max_value = options.max_value;
   if (max_value <= 0 && !values.empty()) {
@@ -156,19 +132,16 @@ void WriteHistogramPng(const std::string& path,
     std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
     max_value = sorted[k];
   }
-  if (max_value <= 0)
-    max_value = 1.0 / options.value_scale;  // one unit on the axis
+  if (max_value <= 0) max_value = 1.0 / options.value_scale;  // one unit on the axis
   const int bins = std::max(1, options.num_bins);
   std::vector<int> counts(bins, 0);
   for (double v : values) {
     counts[std::clamp(static_cast<int>(v / max_value * bins), 0, bins - 1)]++;
   }
-  const int max_count =
-      std::max(1, *std::max_element(counts.begin(), counts.end()));
+  const int max_count = std::max(1, *std::max_element(counts.begin(), counts.end()));
   const int plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
   for (int b = 0; b < bins; ++b) {
-    const int x0 = kLeft + b * plot_w / bins,
-              x1 = kLeft + (b + 1) * plot_w / bins - 1;
+    const int x0 = kLeft + b * plot_w / bins, x1 = kLeft + (b + 1) * plot_w / bins - 1;
     const int h = counts[b] * plot_h / max_count;
     const Color3ub c = ErrorColor(b + 0.5, bins);
     cv::rectangle(canvas,
@@ -178,8 +151,7 @@ void WriteHistogramPng(const std::string& path,
                   cv::FILLED);
   }
   const cv::Scalar black(0, 0, 0);
-  cv::line(
-      canvas, {kLeft, kTop + plot_h}, {kLeft + plot_w, kTop + plot_h}, black);
+  cv::line(canvas, {kLeft, kTop + plot_h}, {kLeft + plot_w, kTop + plot_h}, black);
   cv::line(canvas, {kLeft, kTop}, {kLeft, kTop + plot_h}, black);
   for (int tick = 0; tick <= 5; ++tick) {
     const int x = kLeft + tick * plot_w / 5;
@@ -191,18 +163,10 @@ void WriteHistogramPng(const std::string& path,
                 0.45,
                 black);
   }
-  cv::putText(canvas,
-              Format(max_count),
-              {5, kTop + 10},
-              cv::FONT_HERSHEY_SIMPLEX,
-              0.45,
-              black);
-  PutText(&canvas,
-          options.title + "  (n = " + std::to_string(values.size()) + ")",
-          {kLeft, 30},
-          0.6);
+  cv::putText(canvas, Format(max_count), {5, kTop + 10}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black);
   PutText(
-      &canvas, options.x_label, {kLeft + plot_w / 2 - 60, kHeight - 12}, 0.5);
+      &canvas, options.title + "  (n = " + std::to_string(values.size()) + ")", {kLeft, 30}, 0.6);
+  PutText(&canvas, options.x_label, {kLeft + plot_w / 2 - 60, kHeight - 12}, 0.5);
   WritePngAtomically(path, canvas);
 }
 

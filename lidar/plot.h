@@ -11,10 +11,8 @@ namespace colmap_lidar {
 struct HistogramPlotOptions {
   std::string title;
   std::string x_label;
-  double value_scale =
-      1.0;  // values are multiplied by this for the axis (e.g. 1000 for mm)
-  double max_value =
-      0;  // upper end of the axis in input units; 0 = 99th percentile
+  double value_scale = 1.0;  // values are multiplied by this for the axis (e.g. 1000 for mm)
+  double max_value = 0;      // upper end of the axis in input units; 0 = 99th percentile
   int num_bins = 50;
 };
 

@@ -8,9 +8,8 @@ namespace {
 
 void CheckAttribute(size_t num_points, size_t num_values, const char* name) {
   if (num_values != 0 && num_values != num_points) {
-    throw std::invalid_argument(std::string("Point cloud has ") +
-                                std::to_string(num_points) + " points but " +
-                                std::to_string(num_values) + " " + name);
+    throw std::invalid_argument(std::string("Point cloud has ") + std::to_string(num_points) +
+                                " points but " + std::to_string(num_values) + " " + name);
   }
 }
 
@@ -22,10 +21,7 @@ void PointCloud::CheckConsistent() const {
   CheckAttribute(points.size(), intensities.size(), "intensities");
 }
 
-void PointCloud::Reserve(size_t n,
-                         bool with_normals,
-                         bool with_colors,
-                         bool with_intensities) {
+void PointCloud::Reserve(size_t n, bool with_normals, bool with_colors, bool with_intensities) {
   points.reserve(n);
   if (with_normals) normals.reserve(n);
   if (with_colors) colors.reserve(n);

@@ -27,12 +27,10 @@ std::vector<PointToPlaneObservation> AssociatePointToPlane(
   if (!target.HasNormals())
     throw std::invalid_argument("AssociatePointToPlane: target needs normals");
   if (target_tree.Size() != target.Size()) {
-    throw std::invalid_argument(
-        "AssociatePointToPlane: the k-d tree is not built over the target");
+    throw std::invalid_argument("AssociatePointToPlane: the k-d tree is not built over the target");
   }
   if (target_curvature && target_curvature->size() != target.Size()) {
-    throw std::invalid_argument(
-        "AssociatePointToPlane: one curvature per target point expected");
+    throw std::invalid_argument("AssociatePointToPlane: one curvature per target point expected");
   }
   // A seeded partial Fisher-Yates shuffle: the first num_samples of a random permutation.
   std::vector<size_t> order(source.Size());
@@ -50,14 +48,12 @@ std::vector<PointToPlaneObservation> AssociatePointToPlane(
     const Eigen::Vector3d& p = source.points[order[k]];
     size_t index;
     double squared;
-    if (!target_tree.Nearest(target_from_source * p, &index, &squared) ||
-        squared > max_squared) {
+    if (!target_tree.Nearest(target_from_source * p, &index, &squared) || squared > max_squared) {
       continue;
     }
     const Eigen::Vector3d& n = target.normals[index];
     if (n.squaredNorm() < 0.5) continue;
-    if (target_curvature && (*target_curvature)[index] > options.max_curvature)
-      continue;
+    if (target_curvature && (*target_curvature)[index] > options.max_curvature) continue;
     observations.push_back({p, target.points[index], n});
   }
   return observations;

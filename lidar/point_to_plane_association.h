@@ -21,10 +21,9 @@ struct PointToPlaneObservation {
 };
 
 struct AssociationOptions {
-  size_t num_samples = 2000;  // source points drawn (without replacement)
-  double max_distance = 0.1;  // gate on |T p - q| [m]
-  double max_curvature =
-      0.05;  // only planar target neighbourhoods (if curvature is given)
+  size_t num_samples = 2000;    // source points drawn (without replacement)
+  double max_distance = 0.1;    // gate on |T p - q| [m]
+  double max_curvature = 0.05;  // only planar target neighbourhoods (if curvature is given)
   uint64_t seed = 0;
 
   bool Check() const;  // throws std::invalid_argument

@@ -23,13 +23,12 @@ struct NormalEquations {
 };
 
 // Linearised about the current pose: r = n^T (p' - q), d r / d[omega, t] = [p' x n, n].
-NormalEquations BuildNormalEquations(
-    const PointCloud& source,
-    const PointCloud& target,
-    const KdTree3& tree,
-    const Eigen::Isometry3d& target_from_source,
-    size_t stride,
-    double gate) {
+NormalEquations BuildNormalEquations(const PointCloud& source,
+                                     const PointCloud& target,
+                                     const KdTree3& tree,
+                                     const Eigen::Isometry3d& target_from_source,
+                                     size_t stride,
+                                     double gate) {
   NormalEquations total;
   const long num = static_cast<long>((source.Size() + stride - 1) / stride);
 #pragma omp parallel
@@ -62,10 +61,8 @@ NormalEquations BuildNormalEquations(
 bool IcpOptions::Check() const {
   if (max_iterations < 1 || !(max_correspondence_distance > 0) ||
       !(min_correspondence_distance > 0) ||
-      min_correspondence_distance > max_correspondence_distance ||
-      max_source_points < 6) {
-    throw std::invalid_argument(
-        "IcpOptions: invalid iteration count, gates or point budget");
+      min_correspondence_distance > max_correspondence_distance || max_source_points < 6) {
+    throw std::invalid_argument("IcpOptions: invalid iteration count, gates or point budget");
   }
   return true;
 }
@@ -76,42 +73,35 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
                           const Eigen::Isometry3d& initial_target_from_source,
                           const IcpOptions& options) {
   options.Check();
-  if (source.Empty() || target.Empty())
-    throw std::invalid_argument("PointToPlaneIcp: empty cloud");
+  if (source.Empty() || target.Empty()) throw std::invalid_argument("PointToPlaneIcp: empty cloud");
   if (!target.HasNormals())
     throw std::invalid_argument("PointToPlaneIcp: the target needs normals");
   if (target_tree.Size() != target.Size()) {
-    throw std::invalid_argument(
-        "PointToPlaneIcp: the k-d tree is not built over the target");
+    throw std::invalid_argument("PointToPlaneIcp: the k-d tree is not built over the target");
   }
-  const size_t stride =
-      std::max<size_t>(1, source.Size() / options.max_source_points);
+  const size_t stride = std::max<size_t>(1, source.Size() / options.max_source_points);
   const size_t num_used = (source.Size() + stride - 1) / stride;
   IcpResult result;
   result.target_from_source = initial_target_from_source;
   double gate = options.max_correspondence_distance;
   for (int it = 0; it < options.max_iterations; ++it) {
-    const NormalEquations eq = BuildNormalEquations(
-        source, target, target_tree, result.target_from_source, stride, gate);
+    const NormalEquations eq =
+        BuildNormalEquations(source, target, target_tree, result.target_from_source, stride, gate);
     result.iterations = it + 1;
     if (eq.count < 6) break;
     const Eigen::Matrix<double, 6, 1> x = eq.H.ldlt().solve(-eq.g);
     if (!x.allFinite()) break;
     Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
     const double angle = x.head<3>().norm();
-    if (angle > 0)
-      step.linear() =
-          Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
+    if (angle > 0) step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
     step.translation() = x.tail<3>();
     result.target_from_source = step * result.target_from_source;
-    const bool small_step =
-        angle < options.convergence_rotation_rad &&
-        x.tail<3>().norm() < options.convergence_translation_m;
+    const bool small_step = angle < options.convergence_rotation_rad &&
+                            x.tail<3>().norm() < options.convergence_translation_m;
     // Shrink the gate towards a few times the residual, never below the minimum.
     const double rms = std::sqrt(eq.squared_error / eq.count);
-    const double next_gate =
-        std::max(options.min_correspondence_distance,
-                 std::min(gate, std::max(0.7 * gate, 6 * rms)));
+    const double next_gate = std::max(options.min_correspondence_distance,
+                                      std::min(gate, std::max(0.7 * gate, 6 * rms)));
     // Converged: a small step with the gate settled (at its floor or at a few times the noise).
     if (small_step && next_gate > 0.98 * gate) {
       result.converged = true;
@@ -119,12 +109,11 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
     }
     gate = next_gate;
   }
-  const NormalEquations final_eq = BuildNormalEquations(
-      source, target, target_tree, result.target_from_source, stride, gate);
+  const NormalEquations final_eq =
+      BuildNormalEquations(source, target, target_tree, result.target_from_source, stride, gate);
   result.num_inliers = final_eq.count;
   result.overlap_ratio = static_cast<double>(final_eq.count) / num_used;
-  result.rmse =
-      final_eq.count ? std::sqrt(final_eq.squared_error / final_eq.count) : 0;
+  result.rmse = final_eq.count ? std::sqrt(final_eq.squared_error / final_eq.count) : 0;
   return result;
 }
 

@@ -11,8 +11,7 @@ namespace {
 Eigen::Isometry3d MakePose(double angle_deg,
                            const Eigen::Vector3d& axis,
                            const Eigen::Vector3d& t) {
-  return Eigen::Translation3d(t) *
-         Eigen::AngleAxisd(angle_deg * M_PI / 180, axis.normalized());
+  return Eigen::Translation3d(t) * Eigen::AngleAxisd(angle_deg * M_PI / 180, axis.normalized());
 }
 
 double AngleDeg(const Eigen::Isometry3d& pose) {
@@ -21,27 +20,22 @@ double AngleDeg(const Eigen::Isometry3d& pose) {
 
 TEST(PointToPlaneIcpTest, RecoversARelativePoseFromIndependentNoisySamplings) {
   const PointCloud target = testing::SyntheticRoom(1000, 10, 0.005);
-  const Eigen::Isometry3d target_from_source = MakePose(
-      7, Eigen::Vector3d(0.2, 0.3, 1), Eigen::Vector3d(0.4, -0.3, 0.05));
-  PointCloud source = testing::SyntheticRoom(
-      1000, 11, 0.005);  // another sampling of the same room
+  const Eigen::Isometry3d target_from_source =
+      MakePose(7, Eigen::Vector3d(0.2, 0.3, 1), Eigen::Vector3d(0.4, -0.3, 0.05));
+  PointCloud source = testing::SyntheticRoom(1000, 11, 0.005);  // another sampling of the same room
   for (Eigen::Vector3d& p : source.points) p = target_from_source.inverse() * p;
   const KdTree3 tree(target.points);
   // Start 3 deg and 20 cm off.
   const Eigen::Isometry3d initial =
-      target_from_source * MakePose(3,
-                                    Eigen::Vector3d(1, -1, 0.5),
-                                    Eigen::Vector3d(0.12, 0.1, -0.12));
-  const IcpResult result =
-      PointToPlaneIcp(source, target, tree, initial, IcpOptions());
+      target_from_source *
+      MakePose(3, Eigen::Vector3d(1, -1, 0.5), Eigen::Vector3d(0.12, 0.1, -0.12));
+  const IcpResult result = PointToPlaneIcp(source, target, tree, initial, IcpOptions());
   EXPECT_TRUE(result.converged) << result.iterations << " iterations";
-  const Eigen::Isometry3d error =
-      result.target_from_source * target_from_source.inverse();
+  const Eigen::Isometry3d error = result.target_from_source * target_from_source.inverse();
   EXPECT_LT(AngleDeg(error), 0.02);
   EXPECT_LT(error.translation().norm(), 0.002);
   EXPECT_GT(result.overlap_ratio, 0.95);
-  EXPECT_NEAR(result.rmse,
-              0.005 * std::sqrt(2.0),
+  EXPECT_NEAR(result.rmse, 0.005 * std::sqrt(2.0),
               0.002);  // two independent 5 mm noises
 }
 
@@ -50,41 +44,36 @@ TEST(PointToPlaneIcpTest, DisjointCloudsHaveNoOverlap) {
   PointCloud source = testing::SyntheticRoom(100, 13);
   for (Eigen::Vector3d& p : source.points) p += Eigen::Vector3d(100, 0, 0);
   const KdTree3 tree(target.points);
-  const IcpResult result = PointToPlaneIcp(
-      source, target, tree, Eigen::Isometry3d::Identity(), IcpOptions());
+  const IcpResult result =
+      PointToPlaneIcp(source, target, tree, Eigen::Isometry3d::Identity(), IcpOptions());
   EXPECT_EQ(result.num_inliers, 0u);
   EXPECT_FALSE(result.converged);
 }
 
 TEST(PointToPlaneAssociationTest, ResidualsMeasureTheTransformError) {
   const PointCloud target = testing::SyntheticRoom(200, 14);
-  const Eigen::Isometry3d target_from_source = MakePose(
-      20, Eigen::Vector3d(0.1, 0.2, 1), Eigen::Vector3d(1.0, 0.5, 0.0));
+  const Eigen::Isometry3d target_from_source =
+      MakePose(20, Eigen::Vector3d(0.1, 0.2, 1), Eigen::Vector3d(1.0, 0.5, 0.0));
   PointCloud source = target;
   for (Eigen::Vector3d& p : source.points) p = target_from_source.inverse() * p;
   const KdTree3 tree(target.points);
   AssociationOptions options;
   options.num_samples = 3000;
   options.seed = 5;
-  const auto exact =
-      AssociatePointToPlane(source, target, tree, target_from_source, options);
+  const auto exact = AssociatePointToPlane(source, target, tree, target_from_source, options);
   EXPECT_GT(exact.size(), 2900u);
   for (const auto& o : exact) {
-    EXPECT_NEAR(o.normal_in_target.dot(target_from_source * o.point_in_source -
-                                       o.point_in_target),
+    EXPECT_NEAR(o.normal_in_target.dot(target_from_source * o.point_in_source - o.point_in_target),
                 0,
                 1e-9);
   }
   // A 2 cm shift along x: observations on planes facing x measure it, others do not.
-  const Eigen::Isometry3d shifted =
-      Eigen::Translation3d(0.02, 0, 0) * target_from_source;
+  const Eigen::Isometry3d shifted = Eigen::Translation3d(0.02, 0, 0) * target_from_source;
   // (Near edges the nearest point may jump to the neighbouring face: allow a few per cent.)
-  const auto off =
-      AssociatePointToPlane(source, target, tree, shifted, options);
+  const auto off = AssociatePointToPlane(source, target, tree, shifted, options);
   size_t facing_x = 0, measured = 0;
   for (const auto& o : off) {
-    const double r =
-        o.normal_in_target.dot(shifted * o.point_in_source - o.point_in_target);
+    const double r = o.normal_in_target.dot(shifted * o.point_in_source - o.point_in_target);
     if (std::abs(o.normal_in_target.x()) > 0.99) {
       ++facing_x;
       measured += std::abs(std::abs(r) - 0.02) < 1e-9;
@@ -93,13 +82,10 @@ TEST(PointToPlaneAssociationTest, ResidualsMeasureTheTransformError) {
   EXPECT_GT(facing_x, 300u);
   EXPECT_GT(measured, facing_x * 95 / 100);
   // Same seed, same sample; a gate of 1 mm on the shifted pose keeps only points on planes parallel to x.
-  EXPECT_EQ(
-      AssociatePointToPlane(source, target, tree, target_from_source, options)
-          .size(),
-      exact.size());
+  EXPECT_EQ(AssociatePointToPlane(source, target, tree, target_from_source, options).size(),
+            exact.size());
   options.max_distance = 0.001;
-  for (const auto& o :
-       AssociatePointToPlane(source, target, tree, shifted, options)) {
+  for (const auto& o : AssociatePointToPlane(source, target, tree, shifted, options)) {
     EXPECT_LT(std::abs(o.normal_in_target.x()), 0.5);
   }
 }

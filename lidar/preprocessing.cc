@@ -11,8 +11,7 @@ namespace {
 
 struct VoxelKeyHash {
   size_t operator()(const Eigen::Vector3i& key) const {
-    return static_cast<size_t>(key.x()) * 73856093u ^
-           static_cast<size_t>(key.y()) * 19349663u ^
+    return static_cast<size_t>(key.x()) * 73856093u ^ static_cast<size_t>(key.y()) * 19349663u ^
            static_cast<size_t>(key.z()) * 83492791u;
   }
 };
@@ -28,15 +27,13 @@ struct VoxelSum {
 }  // namespace
 
 PointCloud VoxelDownsample(const PointCloud& cloud, double voxel_size) {
-  if (!(voxel_size > 0))
-    throw std::invalid_argument("VoxelDownsample: voxel_size must be > 0");
+  if (!(voxel_size > 0)) throw std::invalid_argument("VoxelDownsample: voxel_size must be > 0");
   cloud.CheckConsistent();
   std::unordered_map<Eigen::Vector3i, VoxelSum, VoxelKeyHash> voxels;
   voxels.reserve(cloud.Size() / 4 + 1);
   std::vector<Eigen::Vector3i> order;  // first-seen order: deterministic output
   for (size_t i = 0; i < cloud.Size(); ++i) {
-    const Eigen::Vector3i key =
-        (cloud.points[i] / voxel_size).array().floor().cast<int>();
+    const Eigen::Vector3i key = (cloud.points[i] / voxel_size).array().floor().cast<int>();
     auto [it, inserted] = voxels.try_emplace(key);
     if (inserted) order.push_back(key);
     VoxelSum& sum = it->second;
@@ -47,10 +44,7 @@ PointCloud VoxelDownsample(const PointCloud& cloud, double voxel_size) {
     ++sum.count;
   }
   PointCloud result;
-  result.Reserve(order.size(),
-                 cloud.HasNormals(),
-                 cloud.HasColors(),
-                 cloud.HasIntensities());
+  result.Reserve(order.size(), cloud.HasNormals(), cloud.HasColors(), cloud.HasIntensities());
   for (const Eigen::Vector3i& key : order) {
     const VoxelSum& sum = voxels.at(key);
     result.points.push_back(sum.point / sum.count);
@@ -60,18 +54,15 @@ PointCloud VoxelDownsample(const PointCloud& cloud, double voxel_size) {
                                         : Eigen::Vector3d::Zero());
     }
     if (cloud.HasColors())
-      result.colors.push_back(
-          (sum.color / sum.count).array().round().cast<uint8_t>());
+      result.colors.push_back((sum.color / sum.count).array().round().cast<uint8_t>());
     if (cloud.HasIntensities())
-      result.intensities.push_back(
-          static_cast<float>(sum.intensity / sum.count));
+      result.intensities.push_back(static_cast<float>(sum.intensity / sum.count));
   }
   return result;
 }
 
 bool NormalEstimationOptions::Check() const {
-  if (num_neighbors < 3 || radius < 0 || min_neighbors < 3 ||
-      !viewpoint.allFinite()) {
+  if (num_neighbors < 3 || radius < 0 || min_neighbors < 3 || !viewpoint.allFinite()) {
     throw std::invalid_argument(
         "NormalEstimationOptions: need num_neighbors >= 3, radius >= 0, "
         "min_neighbors >= 3 and a finite viewpoint");
@@ -85,8 +76,7 @@ void EstimateNormals(const KdTree3& tree,
                      std::vector<double>* curvature) {
   options.Check();
   if (tree.Size() != cloud->Size()) {
-    throw std::invalid_argument(
-        "EstimateNormals: the k-d tree is not built over this cloud");
+    throw std::invalid_argument("EstimateNormals: the k-d tree is not built over this cloud");
   }
   const std::vector<Eigen::Vector3d>& points = cloud->points;
   cloud->normals.assign(points.size(), Eigen::Vector3d::Zero());
@@ -112,14 +102,12 @@ void EstimateNormals(const KdTree3& tree,
         covariance += d * d.transpose();
       }
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-      Eigen::Vector3d normal =
-          solver.eigenvectors().col(0);  // eigenvalues ascending
+      Eigen::Vector3d normal = solver.eigenvectors().col(0);  // eigenvalues ascending
       if (normal.dot(options.viewpoint - points[i]) < 0) normal = -normal;
       cloud->normals[i] = normal;
       if (curvature) {
         const double sum = solver.eigenvalues().sum();
-        (*curvature)[i] =
-            sum > 0 ? std::max(0.0, solver.eigenvalues()(0)) / sum : 0;
+        (*curvature)[i] = sum > 0 ? std::max(0.0, solver.eigenvalues()(0)) / sum : 0;
       }
     }
   }
@@ -135,8 +123,7 @@ std::vector<size_t> StatisticalInliers(const PointCloud& cloud,
     std::vector<double> squared;
 #pragma omp for schedule(dynamic, 256)
     for (size_t i = 0; i < cloud.Size(); ++i) {
-      tree.KNearest(
-          cloud.points[i], options.num_neighbors + 1, &indices, &squared);
+      tree.KNearest(cloud.points[i], options.num_neighbors + 1, &indices, &squared);
       double sum = 0;
       for (size_t k = 1; k < squared.size(); ++k) sum += std::sqrt(squared[k]);
       mean_distance[i] = squared.size() > 1 ? sum / (squared.size() - 1) : 0;
@@ -148,8 +135,8 @@ std::vector<size_t> StatisticalInliers(const PointCloud& cloud,
     mean_squared += d * d;
   }
   mean /= std::max<size_t>(1, cloud.Size());
-  const double std_dev = std::sqrt(std::max(
-      0.0, mean_squared / std::max<size_t>(1, cloud.Size()) - mean * mean));
+  const double std_dev =
+      std::sqrt(std::max(0.0, mean_squared / std::max<size_t>(1, cloud.Size()) - mean * mean));
   const double limit = mean + options.std_ratio * std_dev;
   std::vector<size_t> inliers;
   for (size_t i = 0; i < cloud.Size(); ++i) {
@@ -158,19 +145,14 @@ std::vector<size_t> StatisticalInliers(const PointCloud& cloud,
   return inliers;
 }
 
-PointCloud SelectPoints(const PointCloud& cloud,
-                        const std::vector<size_t>& indices) {
+PointCloud SelectPoints(const PointCloud& cloud, const std::vector<size_t>& indices) {
   PointCloud result;
-  result.Reserve(indices.size(),
-                 cloud.HasNormals(),
-                 cloud.HasColors(),
-                 cloud.HasIntensities());
+  result.Reserve(indices.size(), cloud.HasNormals(), cloud.HasColors(), cloud.HasIntensities());
   for (size_t i : indices) {
     result.points.push_back(cloud.points.at(i));
     if (cloud.HasNormals()) result.normals.push_back(cloud.normals[i]);
     if (cloud.HasColors()) result.colors.push_back(cloud.colors[i]);
-    if (cloud.HasIntensities())
-      result.intensities.push_back(cloud.intensities[i]);
+    if (cloud.HasIntensities()) result.intensities.push_back(cloud.intensities[i]);
   }
   return result;
 }

@@ -36,22 +36,19 @@ TEST(PreprocessingTest, NormalsOnATiltedNoisyPlaneFaceTheSensor) {
   const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
   PointCloud cloud;
   for (int i = 0; i < 20000; ++i) {
-    cloud.points.push_back(Eigen::Vector3d(1, 2, 3) + unit(rng) * u +
-                           unit(rng) * v + noise(rng) * normal);
+    cloud.points.push_back(Eigen::Vector3d(1, 2, 3) + unit(rng) * u + unit(rng) * v +
+                           noise(rng) * normal);
   }
   const KdTree3 tree(cloud.points);
   NormalEstimationOptions options;
-  options.viewpoint = Eigen::Vector3d(1, 2, 3) -
-                      5 * normal;  // the sensor is on the -normal side
+  options.viewpoint = Eigen::Vector3d(1, 2, 3) - 5 * normal;  // the sensor is on the -normal side
   std::vector<double> curvature;
   EstimateNormals(tree, options, &cloud, &curvature);
   double worst_deg = 0;
   for (size_t i = 0; i < cloud.Size(); ++i) {
-    EXPECT_LT(cloud.normals[i].dot(normal), 0)
-        << "normal not oriented towards the sensor";
-    worst_deg = std::max(
-        worst_deg,
-        std::acos(std::min(1.0, -cloud.normals[i].dot(normal))) * 180 / M_PI);
+    EXPECT_LT(cloud.normals[i].dot(normal), 0) << "normal not oriented towards the sensor";
+    worst_deg =
+        std::max(worst_deg, std::acos(std::min(1.0, -cloud.normals[i].dot(normal))) * 180 / M_PI);
   }
   // 2 mm noise over kNN patches of ~2 cm: a few degrees at worst.
   EXPECT_LT(worst_deg, 12.0);
@@ -66,8 +63,7 @@ TEST(PreprocessingTest, NormalsAgreeWithPcl) {
   options.radius = 0.1;
   EstimateNormals(tree, options, &cloud);
 
-  pcl::PointCloud<pcl::PointXYZ>::Ptr pcl_cloud(
-      new pcl::PointCloud<pcl::PointXYZ>);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr pcl_cloud(new pcl::PointCloud<pcl::PointXYZ>);
   for (const Eigen::Vector3d& p : cloud.points)
     pcl_cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
   pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
@@ -80,8 +76,7 @@ TEST(PreprocessingTest, NormalsAgreeWithPcl) {
   size_t compared = 0, agree = 0, same_orientation = 0;
   for (size_t i = 0; i < cloud.Size(); ++i) {
     const auto& n = pcl_normals[i];
-    if (!std::isfinite(n.normal_x) || cloud.normals[i].squaredNorm() < 0.5)
-      continue;
+    if (!std::isfinite(n.normal_x) || cloud.normals[i].squaredNorm() < 0.5) continue;
     const Eigen::Vector3d pcl_normal(n.normal_x, n.normal_y, n.normal_z);
     const double dot = cloud.normals[i].dot(pcl_normal);
     ++compared;
@@ -100,13 +95,11 @@ TEST(PreprocessingTest, StatisticalOutlierRemovalDropsIsolatedPoints) {
   std::uniform_real_distribution<double> unit(-1, 1);
   for (int i = 0; i < 50; ++i) {
     // Floating in free space, at least 0.5 m from every surface of the room.
-    cloud.points.emplace_back(
-        3 * unit(rng), 0.8 * unit(rng), 3 + 0.5 * unit(rng));
+    cloud.points.emplace_back(3 * unit(rng), 0.8 * unit(rng), 3 + 0.5 * unit(rng));
     cloud.normals.emplace_back(0, 0, 1);
   }
   const KdTree3 tree(cloud.points);
-  const std::vector<size_t> inliers =
-      StatisticalInliers(cloud, tree, OutlierRemovalOptions());
+  const std::vector<size_t> inliers = StatisticalInliers(cloud, tree, OutlierRemovalOptions());
   size_t kept_outliers = 0;
   for (size_t i : inliers) kept_outliers += i >= num_surface;
   EXPECT_EQ(kept_outliers, 0u);

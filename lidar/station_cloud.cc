@@ -11,27 +11,24 @@ bool StationCloudOptions::Check() const {
   return normals.Check() && keypoints.Check() && bsc.Check();
 }
 
-std::unique_ptr<StationCloud> PrepareStationCloud(
-    const PointCloud& raw, const StationCloudOptions& options) {
+std::unique_ptr<StationCloud> PrepareStationCloud(const PointCloud& raw,
+                                                  const StationCloudOptions& options) {
   options.Check();
-  if (raw.Empty())
-    throw std::invalid_argument("PrepareStationCloud: empty cloud");
+  if (raw.Empty()) throw std::invalid_argument("PrepareStationCloud: empty cloud");
   auto station = std::make_unique<StationCloud>();
   station->cloud = VoxelDownsample(raw, options.voxel_size);
   station->cloud.normals.clear();
   station->tree = std::make_unique<KdTree3>(station->cloud.points);
-  EstimateNormals(
-      *station->tree, options.normals, &station->cloud, &station->curvature);
+  EstimateNormals(*station->tree, options.normals, &station->cloud, &station->curvature);
 
   if (!options.compute_features) return station;
 
   // Features on a coarser copy: keypoint PCA and descriptors need metres of support, not millimetres.
   const PointCloud coarse = VoxelDownsample(raw, options.feature_voxel_size);
   const KdTree3 coarse_tree(coarse.points);
-  const std::vector<size_t> keypoints =
-      DetectKeypoints(coarse, coarse_tree, options.keypoints);
-  station->features = ComputeBscFeatures(
-      coarse, coarse_tree, keypoints, options.normals.viewpoint, options.bsc);
+  const std::vector<size_t> keypoints = DetectKeypoints(coarse, coarse_tree, options.keypoints);
+  station->features =
+      ComputeBscFeatures(coarse, coarse_tree, keypoints, options.normals.viewpoint, options.bsc);
   return station;
 }
 

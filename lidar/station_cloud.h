@@ -14,15 +14,12 @@
 namespace colmap_lidar {
 
 struct StationCloudOptions {
-  double voxel_size =
-      0.05;  // downsampling for normals, ICP and association [m]
-  double feature_voxel_size =
-      0.1;  // coarser copy for keypoints and descriptors [m]
+  double voxel_size = 0.05;         // downsampling for normals, ICP and association [m]
+  double feature_voxel_size = 0.1;  // coarser copy for keypoints and descriptors [m]
   NormalEstimationOptions normals;  // viewpoint: the LiDAR origin (0, 0, 0)
   KeypointOptions keypoints;
   BscOptions bsc;
-  bool compute_features =
-      true;  // false: only what association needs (cloud, normals, tree)
+  bool compute_features = true;  // false: only what association needs (cloud, normals, tree)
 
   bool Check() const;  // throws std::invalid_argument
 };
@@ -32,14 +29,14 @@ struct StationCloud {
   StationCloud(const StationCloud&) = delete;
   StationCloud& operator=(const StationCloud&) = delete;
 
-  PointCloud cloud;               // point_in_lidar, downsampled, with normals
-  std::vector<double> curvature;  // per point of `cloud`
-  std::unique_ptr<KdTree3> tree;  // over cloud.points
+  PointCloud cloud;                  // point_in_lidar, downsampled, with normals
+  std::vector<double> curvature;     // per point of `cloud`
+  std::unique_ptr<KdTree3> tree;     // over cloud.points
   std::vector<BscFeature> features;  // positions in the lidar frame
 };
 
 // Downsamples, estimates normals/curvature, detects keypoints and describes them.
-std::unique_ptr<StationCloud> PrepareStationCloud(
-    const PointCloud& raw, const StationCloudOptions& options);
+std::unique_ptr<StationCloud> PrepareStationCloud(const PointCloud& raw,
+                                                  const StationCloudOptions& options);
 
 }  // namespace colmap_lidar

@@ -14,13 +14,10 @@ namespace colmap_lidar {
 
 class VoxelAccumulator {
  public:
-  explicit VoxelAccumulator(
-      double voxel_size);  // throws std::invalid_argument for <= 0
+  explicit VoxelAccumulator(double voxel_size);  // throws std::invalid_argument for <= 0
 
   // `normal` may be zero (no normal); `color` is ignored when the accumulator has none.
-  void Add(const Eigen::Vector3d& point,
-           const Eigen::Vector3f& normal,
-           const Color3ub& color);
+  void Add(const Eigen::Vector3d& point, const Eigen::Vector3f& normal, const Color3ub& color);
 
   size_t NumVoxels() const { return voxels_.size(); }
   size_t NumPointsAdded() const { return num_added_; }

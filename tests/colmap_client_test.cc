@@ -21,10 +21,8 @@ using testing::RunCommand;
 
 const std::string kColmap = COLMAP_LIDAR_COLMAP_EXE;
 
-std::string SiftCommands(const std::string& database,
-                         const std::string& images) {
-  return kColmap + " feature_extractor --database_path " + database +
-         " --image_path " + images +
+std::string SiftCommands(const std::string& database, const std::string& images) {
+  return kColmap + " feature_extractor --database_path " + database + " --image_path " + images +
          " --ImageReader.camera_model PINHOLE --ImageReader.single_camera 1"
          " --SiftExtraction.use_gpu 0 --SiftExtraction.num_threads 2"
          " --SiftExtraction.max_num_features 4096 && " +
@@ -33,8 +31,7 @@ std::string SiftCommands(const std::string& database,
 }
 
 // Simulates `num_stations` of the default scene (images only matter here; few LiDAR points).
-std::string SimulateImages(const testing::ScopedTempDir& dir,
-                           int num_stations) {
+std::string SimulateImages(const testing::ScopedTempDir& dir, int num_stations) {
   sim::SimulationOptions options;
   options.output_path = dir.File("dataset");
   options.num_stations = num_stations;
@@ -47,17 +44,11 @@ TEST(ColmapClientTest, ColmapKeepsUsingADatabaseWithOurTables) {
   testing::ScopedTempDir dir;
   const std::string dataset_path = SimulateImages(dir, 3);
   const std::string database = dir.File("database.db");
-  ASSERT_EQ(
-      RunCommand(kColmap + " database_creator --database_path " + database)
-          .exit_code,
-      0);
-  {
-    ExtensionDatabase extension(database);
-  }  // adds our tables to COLMAP's fresh database
+  ASSERT_EQ(RunCommand(kColmap + " database_creator --database_path " + database).exit_code, 0);
+  { ExtensionDatabase extension(database); }  // adds our tables to COLMAP's fresh database
 
   // COLMAP extracts and matches into it, unaware of our tables.
-  const auto sift =
-      RunCommand(SiftCommands(database, dataset_path + "/images/left"));
+  const auto sift = RunCommand(SiftCommands(database, dataset_path + "/images/left"));
   ASSERT_EQ(sift.exit_code, 0) << sift.output;
 
   std::vector<colmap::image_t> image_ids;
@@ -79,10 +70,8 @@ TEST(ColmapClientTest, ColmapKeepsUsingADatabaseWithOurTables) {
   }
   // COLMAP re-matches and cleans matches with our rows present; our rows survive.
   for (const std::string& command :
-       {kColmap + " exhaustive_matcher --database_path " + database +
-            " --SiftMatching.use_gpu 0",
-        kColmap + " database_cleaner --type matches --database_path " +
-            database}) {
+       {kColmap + " exhaustive_matcher --database_path " + database + " --SiftMatching.use_gpu 0",
+        kColmap + " database_cleaner --type matches --database_path " + database}) {
     const auto result = RunCommand(command);
     EXPECT_EQ(result.exit_code, 0) << command << "\n" << result.output;
   }
@@ -92,22 +81,20 @@ TEST(ColmapClientTest, ColmapKeepsUsingADatabaseWithOurTables) {
     EXPECT_EQ(extension.ReadLidarFrames().size(), 1u);
   }
   // Deleting COLMAP's images cascades into our tables: no dangling rows.
-  const auto clean = RunCommand(
-      kColmap + " database_cleaner --type images --database_path " + database);
+  const auto clean =
+      RunCommand(kColmap + " database_cleaner --type images --database_path " + database);
   ASSERT_EQ(clean.exit_code, 0) << clean.output;
   ExtensionDatabase extension(database);
   EXPECT_EQ(extension.NumDepthPriors(), 0u);
   EXPECT_TRUE(extension.ReadLidarFrames().empty());
 }
 
-TEST(ColmapClientTest,
-     ColmapSiftMatchesNeighbouringStationsOfTheDefaultDataset) {
+TEST(ColmapClientTest, ColmapSiftMatchesNeighbouringStationsOfTheDefaultDataset) {
   testing::ScopedTempDir dir;
   const std::string dataset_path = SimulateImages(dir, 25);
   const StationDataset dataset = ReadStationDataset(dataset_path);
   const std::string database = dir.File("database.db");
-  const auto sift =
-      RunCommand(SiftCommands(database, dataset_path + "/images/left"));
+  const auto sift = RunCommand(SiftCommands(database, dataset_path + "/images/left"));
   ASSERT_EQ(sift.exit_code, 0) << sift.output;
 
   colmap::Database colmap_database(database);
@@ -121,8 +108,7 @@ TEST(ColmapClientTest,
   for (int i = 0; i < 20; ++i) {
     const colmap::image_t a = ids.at(dataset.stations[i] + ".png");
     const colmap::image_t b = ids.at(dataset.stations[(i + 1) % 20] + ".png");
-    const colmap::TwoViewGeometry geometry =
-        colmap_database.ReadTwoViewGeometry(a, b);
+    const colmap::TwoViewGeometry geometry = colmap_database.ReadTwoViewGeometry(a, b);
     if (geometry.inlier_matches.size() >= 30) ++num_matched_neighbours;
   }
   std::cout << "neighbouring tripod stations with >= 30 verified SIFT matches: "
@@ -134,57 +120,46 @@ TEST(CliTest, HelpVersionAndErrors) {
   const std::string cli = COLMAP_LIDAR_CLI_EXE;
   const auto help = RunCommand(cli + " help");
   EXPECT_EQ(help.exit_code, 0);
-  for (const char* command :
-       {"database_creator", "database_info", "simulate_dataset"}) {
+  for (const char* command : {"database_creator", "database_info", "simulate_dataset"}) {
     EXPECT_NE(help.output.find(command), std::string::npos) << command;
   }
   const auto version = RunCommand(cli + " version");
   EXPECT_EQ(version.exit_code, 0);
-  EXPECT_NE(version.output.find("COLMAP 3.10"), std::string::npos)
-      << version.output;
+  EXPECT_NE(version.output.find("COLMAP 3.10"), std::string::npos) << version.output;
 
   const auto unknown = RunCommand(cli + " no_such_command");
   EXPECT_NE(unknown.exit_code, 0);
-  EXPECT_NE(unknown.output.find("unknown command 'no_such_command'"),
-            std::string::npos);
+  EXPECT_NE(unknown.output.find("unknown command 'no_such_command'"), std::string::npos);
 
-  const auto bad_option =
-      RunCommand(cli + " database_creator --no_such_option 1");
+  const auto bad_option = RunCommand(cli + " database_creator --no_such_option 1");
   EXPECT_NE(bad_option.exit_code, 0);
-  EXPECT_NE(bad_option.output.find("no_such_option"), std::string::npos)
-      << bad_option.output;
+  EXPECT_NE(bad_option.output.find("no_such_option"), std::string::npos) << bad_option.output;
 
   testing::ScopedTempDir dir;
-  const auto bad_scene = RunCommand(
-      cli + " simulate_dataset --scene moon --output_path " + dir.File("d"));
+  const auto bad_scene =
+      RunCommand(cli + " simulate_dataset --scene moon --output_path " + dir.File("d"));
   EXPECT_NE(bad_scene.exit_code, 0);
-  EXPECT_NE(bad_scene.output.find("Unknown scene 'moon'"), std::string::npos)
-      << bad_scene.output;
+  EXPECT_NE(bad_scene.output.find("Unknown scene 'moon'"), std::string::npos) << bad_scene.output;
   EXPECT_FALSE(fs::exists(dir.File("d")));
 
-  const auto missing_db =
-      RunCommand(cli + " database_info --database_path " + dir.File("x.db"));
+  const auto missing_db = RunCommand(cli + " database_info --database_path " + dir.File("x.db"));
   EXPECT_NE(missing_db.exit_code, 0);
-  EXPECT_NE(missing_db.output.find(dir.File("x.db")), std::string::npos)
-      << missing_db.output;
-  EXPECT_FALSE(fs::exists(dir.File("x.db")))
-      << "database_info must not create a database";
+  EXPECT_NE(missing_db.output.find(dir.File("x.db")), std::string::npos) << missing_db.output;
+  EXPECT_FALSE(fs::exists(dir.File("x.db"))) << "database_info must not create a database";
 }
 
 TEST(CliTest, OptionsFromAProjectIniFile) {
   const std::string cli = COLMAP_LIDAR_CLI_EXE;
   testing::ScopedTempDir dir;
   std::ofstream(dir.File("project.ini"))
-      << "output_path=" << dir.File("d")
-      << "\nscene=cylinder_pillar\nnum_stations=2\n"
+      << "output_path=" << dir.File("d") << "\nscene=cylinder_pillar\nnum_stations=2\n"
       << "lidar_points=2000\nimage_scale=0.2\n";
-  const auto result = RunCommand(cli + " simulate_dataset --project_path " +
-                                 dir.File("project.ini"));
+  const auto result =
+      RunCommand(cli + " simulate_dataset --project_path " + dir.File("project.ini"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_EQ(ReadStationDataset(dir.File("d")).stations.size(), 2u);
-  const auto db = RunCommand(
-      cli + " database_creator --database_path " + dir.File("db.db") + " && " +
-      cli + " database_info --database_path " + dir.File("db.db"));
+  const auto db = RunCommand(cli + " database_creator --database_path " + dir.File("db.db") +
+                             " && " + cli + " database_info --database_path " + dir.File("db.db"));
   ASSERT_EQ(db.exit_code, 0) << db.output;
   EXPECT_NE(db.output.find("depth priors:  0"), std::string::npos) << db.output;
 }

@@ -31,13 +31,11 @@ using testing::RunCommand;
 
 const std::string kCli = COLMAP_LIDAR_CLI_EXE;
 const std::string kColmap = COLMAP_LIDAR_COLMAP_EXE;
-const std::string kSift =
-    " --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2";
+const std::string kSift = " --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2";
 
 double Quantile(std::vector<double> values, double q) {
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const size_t k = std::min(values.size() - 1,
-                            static_cast<size_t>(q * (values.size() - 1) + 0.5));
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
   std::nth_element(values.begin(), values.begin() + k, values.end());
   return values[k];
 }
@@ -70,9 +68,8 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
   const std::string dataset_path = Simulate(dir, "dataset", 6, "two_axes", 1.0);
   const StationDataset dataset = ReadStationDataset(dataset_path);
 
-  auto result =
-      RunCommand(kCli + " stereo_depth --dataset_path " + dataset_path +
-                 " --output_path " + dir.File("stereo"));
+  auto result = RunCommand(kCli + " stereo_depth --dataset_path " + dataset_path +
+                           " --output_path " + dir.File("stereo"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   std::cout << result.output;
   ASSERT_TRUE(fs::exists(dir.File("stereo/stereo.json")));
@@ -87,8 +84,7 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
     ASSERT_EQ(depth.GetWidth(), truth.GetWidth());
     ASSERT_EQ(depth.GetHeight(), truth.GetHeight());
     EXPECT_TRUE(fs::exists(dir.File("stereo/previews/" + station + ".png")));
-    EXPECT_TRUE(
-        fs::exists(dir.File("stereo/confidence_maps/" + station + ".png")));
+    EXPECT_TRUE(fs::exists(dir.File("stereo/confidence_maps/" + station + ".png")));
     for (size_t row = 0; row < depth.GetHeight(); ++row) {
       for (size_t col = 0; col < depth.GetWidth(); ++col) {
         const double z_true = truth.Get(row, col);
@@ -114,37 +110,31 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
   result = RunCommand(kCli + " import_dataset --dataset_path " + dataset_path +
                       " --database_path " + dir.File("db.db") + kSift);
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  result =
-      RunCommand(kCli + " depth_prior_extractor --database_path " +
-                 dir.File("db.db") + " --depth_path " + dir.File("stereo"));
+  result = RunCommand(kCli + " depth_prior_extractor --database_path " + dir.File("db.db") +
+                      " --depth_path " + dir.File("stereo"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   std::cout << result.output;
 
   // Each prior against the exact depth of the keypoint's ray on the true scene.
   const sim::Scene scene = sim::Scene::Create("t_specimen");
-  const auto cam_from_world =
-      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
   const colmap::Database database(dir.File("db.db"));
-  const ExtensionDatabase extension(dir.File("db.db"),
-                                    ExtensionDatabase::Mode::kReadOnly);
+  const ExtensionDatabase extension(dir.File("db.db"), ExtensionDatabase::Mode::kReadOnly);
   std::vector<double> relative_errors, normalised_errors, signed_errors;
   size_t num_keypoints = 0, num_priors = 0;
   for (const colmap::Image& image : database.ReadAllImages()) {
     const std::string station = fs::path(image.Name()).stem().string();
     const colmap::Rigid3d& pose = cam_from_world.at(station);
     const colmap::Camera camera = database.ReadCamera(image.CameraId());
-    const colmap::FeatureKeypoints keypoints =
-        database.ReadKeypoints(image.ImageId());
-    const std::vector<DepthPrior> priors =
-        extension.ReadDepthPriors(image.ImageId());
+    const colmap::FeatureKeypoints keypoints = database.ReadKeypoints(image.ImageId());
+    const std::vector<DepthPrior> priors = extension.ReadDepthPriors(image.ImageId());
     num_keypoints += keypoints.size();
     num_priors += priors.size();
     const colmap::Rigid3d world_from_cam = colmap::Inverse(pose);
     for (const DepthPrior& prior : priors) {
       const colmap::FeatureKeypoint& keypoint = keypoints.at(prior.point2D_idx);
       const Eigen::Vector3d ray_in_cam =
-          camera.CamFromImg(Eigen::Vector2d(keypoint.x, keypoint.y))
-              .homogeneous();
+          camera.CamFromImg(Eigen::Vector2d(keypoint.x, keypoint.y)).homogeneous();
       sim::RayHit hit;
       if (!scene.Intersect(world_from_cam.translation,
                            (world_from_cam.rotation * ray_in_cam).normalized(),
@@ -162,12 +152,11 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
     }
   }
   const double fraction = static_cast<double>(num_priors) / num_keypoints;
-  std::cout << std::setprecision(3) << "depth priors: " << num_priors << " of "
-            << num_keypoints << " keypoints (" << 100 * fraction
-            << " %); |error|/depth median "
-            << 100 * Quantile(relative_errors, 0.5)
-            << " %; |error|/sigma_d median " << Quantile(normalised_errors, 0.5)
-            << ", 95th percentile " << Quantile(normalised_errors, 0.95)
+  std::cout << std::setprecision(3) << "depth priors: " << num_priors << " of " << num_keypoints
+            << " keypoints (" << 100 * fraction << " %); |error|/depth median "
+            << 100 * Quantile(relative_errors, 0.5) << " %; |error|/sigma_d median "
+            << Quantile(normalised_errors, 0.5) << ", 95th percentile "
+            << Quantile(normalised_errors, 0.95)
             << " (ratio of observed error to sigma_d); signed median "
             << 100 * Quantile(signed_errors, 0.5) << " %" << std::endl;
   EXPECT_GE(fraction, 0.6);
@@ -179,11 +168,10 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
 // COLMAP's own mapper reconstructs from the imported database; a second import adds nothing.
 TEST(FrontEndTest, ImportedDatabaseIsIdempotentAndUsableByColmapMapper) {
   testing::ScopedTempDir dir;
-  const std::string dataset_path =
-      Simulate(dir, "dataset", 4, "fixed_rotation", 0.6);
+  const std::string dataset_path = Simulate(dir, "dataset", 4, "fixed_rotation", 0.6);
   const std::string db = dir.File("db.db");
-  const std::string import = kCli + " import_dataset --dataset_path " +
-                             dataset_path + " --database_path " + db + kSift;
+  const std::string import =
+      kCli + " import_dataset --dataset_path " + dataset_path + " --database_path " + db + kSift;
   auto result = RunCommand(import);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_FALSE(fs::exists(db + ".import-partial"));
@@ -217,8 +205,7 @@ TEST(FrontEndTest, ImportedDatabaseIsIdempotentAndUsableByColmapMapper) {
     }
     EXPECT_EQ(
         names,
-        (std::set<std::string>{
-            "left/000.png", "left/001.png", "left/002.png", "left/003.png"}));
+        (std::set<std::string>{"left/000.png", "left/001.png", "left/002.png", "left/003.png"}));
     const ExtensionDatabase extension(db, ExtensionDatabase::Mode::kReadOnly);
     ASSERT_TRUE(extension.ReadRig());
     EXPECT_NEAR(extension.ReadRig()->BaselineMeters(), 0.38, 1e-9);
@@ -228,10 +215,9 @@ TEST(FrontEndTest, ImportedDatabaseIsIdempotentAndUsableByColmapMapper) {
   EXPECT_EQ(counts(), first) << "a second import changed the database";
 
   fs::create_directories(dir.File("sparse"));
-  result = RunCommand(
-      kColmap + " mapper --database_path " + db + " --image_path " +
-      dataset_path + "/images --output_path " + dir.File("sparse") +
-      " --Mapper.num_threads 2" + " --Mapper.ba_refine_focal_length 0");
+  result = RunCommand(kColmap + " mapper --database_path " + db + " --image_path " + dataset_path +
+                      "/images --output_path " + dir.File("sparse") + " --Mapper.num_threads 2" +
+                      " --Mapper.ba_refine_focal_length 0");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   colmap::Reconstruction reconstruction;
   reconstruction.Read(dir.File("sparse/0"));
@@ -241,22 +227,17 @@ TEST(FrontEndTest, ImportedDatabaseIsIdempotentAndUsableByColmapMapper) {
 // Bad stereo pairs: one clear error naming the station; the database is left exactly as it was.
 TEST(FrontEndTest, BadInputNamesTheStationAndLeavesTheDatabaseUnchanged) {
   testing::ScopedTempDir dir;
-  const std::string dataset_path =
-      Simulate(dir, "dataset", 3, "fixed_rotation", 0.3);
+  const std::string dataset_path = Simulate(dir, "dataset", 3, "fixed_rotation", 0.3);
   const std::string db = dir.File("db.db");
-  ASSERT_EQ(
-      RunCommand(kCli + " database_creator --database_path " + db).exit_code,
-      0);
+  ASSERT_EQ(RunCommand(kCli + " database_creator --database_path " + db).exit_code, 0);
   const std::string before = FileBytes(db);
-  const std::string import = kCli + " import_dataset --dataset_path " +
-                             dataset_path + " --database_path " + db + kSift;
-  const std::string stereo = kCli + " stereo_depth --dataset_path " +
-                             dataset_path + " --output_path " +
-                             dir.File("stereo");
+  const std::string import =
+      kCli + " import_dataset --dataset_path " + dataset_path + " --database_path " + db + kSift;
+  const std::string stereo = kCli + " stereo_depth --dataset_path " + dataset_path +
+                             " --output_path " + dir.File("stereo");
   const std::string right_001 = dataset_path + "/images/right/001.png";
   const std::string saved = FileBytes(right_001);
-  auto expect_error = [&](const std::string& command,
-                          const std::vector<std::string>& needles) {
+  auto expect_error = [&](const std::string& command, const std::vector<std::string>& needles) {
     const auto result = RunCommand(command);
     EXPECT_NE(result.exit_code, 0) << command;
     for (const std::string& needle : needles) {
@@ -308,22 +289,17 @@ TEST(FrontEndTest, BadInputNamesTheStationAndLeavesTheDatabaseUnchanged) {
   other.image_scale = 0.2;
   other.lidar_points = 2000;
   sim::SimulateDataset(other);
-  ASSERT_EQ(
-      RunCommand(kCli + " stereo_depth --dataset_path " + other.output_path +
-                 " --output_path " + dir.File("other_stereo"))
-          .exit_code,
-      0);
-  const auto mismatch =
-      RunCommand(kCli + " depth_prior_extractor --database_path " + db +
-                 " --depth_path " + dir.File("other_stereo"));
+  ASSERT_EQ(RunCommand(kCli + " stereo_depth --dataset_path " + other.output_path +
+                       " --output_path " + dir.File("other_stereo"))
+                .exit_code,
+            0);
+  const auto mismatch = RunCommand(kCli + " depth_prior_extractor --database_path " + db +
+                                   " --depth_path " + dir.File("other_stereo"));
   EXPECT_NE(mismatch.exit_code, 0);
-  EXPECT_NE(mismatch.output.find("belong to another dataset or rig"),
-            std::string::npos)
+  EXPECT_NE(mismatch.output.find("belong to another dataset or rig"), std::string::npos)
       << mismatch.output;
   // No prior was written (COLMAP's own connection may rewrite the WAL header, so bytes are not compared).
-  EXPECT_EQ(ExtensionDatabase(db, ExtensionDatabase::Mode::kReadOnly)
-                .NumDepthPriors(),
-            0u);
+  EXPECT_EQ(ExtensionDatabase(db, ExtensionDatabase::Mode::kReadOnly).NumDepthPriors(), 0u);
 }
 
 }  // namespace

@@ -37,8 +37,7 @@ colmap::Rigid3d Perturb(const colmap::Rigid3d& pose,
   const Eigen::Vector3d direction =
       Eigen::Vector3d(normal(*rng), normal(*rng), normal(*rng)).normalized();
   return colmap::Rigid3d(
-      Eigen::Quaterniond(Eigen::AngleAxisd(angle_deg * M_PI / 180, axis)) *
-          pose.rotation,
+      Eigen::Quaterniond(Eigen::AngleAxisd(angle_deg * M_PI / 180, axis)) * pose.rotation,
       pose.translation + distance_m * direction);
 }
 
@@ -46,9 +45,8 @@ colmap::Rigid3d Perturb(const colmap::Rigid3d& pose,
 struct Workspace {
   std::string dataset;
   std::string database;
-  std::string
-      initial_model;  // true poses perturbed, landmarks from colmap point_triangulator
-  std::string guess;  // cam_from_lidar perturbed by 5 deg and 10 cm
+  std::string initial_model;  // true poses perturbed, landmarks from colmap point_triangulator
+  std::string guess;          // cam_from_lidar perturbed by 5 deg and 10 cm
 };
 
 Workspace Prepare(const testing::ScopedTempDir& dir,
@@ -62,21 +60,19 @@ Workspace Prepare(const testing::ScopedTempDir& dir,
   ws.dataset = options.output_path;
   ws.database = dir.File("db.db");
   for (const std::string& command :
-       {kCli + " stereo_depth --dataset_path " + ws.dataset +
-            " --output_path " + dir.File("stereo"),
-        kCli + " import_dataset --dataset_path " + ws.dataset +
-            " --database_path " + ws.database +
+       {kCli + " stereo_depth --dataset_path " + ws.dataset + " --output_path " +
+            dir.File("stereo"),
+        kCli + " import_dataset --dataset_path " + ws.dataset + " --database_path " + ws.database +
             " --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2",
-        kCli + " depth_prior_extractor --database_path " + ws.database +
-            " --depth_path " + dir.File("stereo")}) {
+        kCli + " depth_prior_extractor --database_path " + ws.database + " --depth_path " +
+            dir.File("stereo")}) {
     const auto result = RunCommand(command);
     EXPECT_EQ(result.exit_code, 0) << command << "\n" << result.output;
   }
 
   // The initial model: COLMAP's images with the true poses, perturbed (the first one exact: the gauge).
   const StationDataset dataset = ReadStationDataset(ws.dataset);
-  const auto truth =
-      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const auto truth = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
   std::mt19937 rng(7);
   colmap::Reconstruction reconstruction;
   {
@@ -91,10 +87,9 @@ Workspace Prepare(const testing::ScopedTempDir& dir,
     for (size_t i = 0; i < images.size(); ++i) {
       colmap::Image image = images[i];
       const colmap::Rigid3d& pose = truth.at(StationOfImageName(image.Name()));
-      image.CamFromWorld() =
-          i == 0 ? pose : Perturb(pose, pose_noise_deg, pose_noise_m, &rng);
-      image.SetPoints2D(colmap::FeatureKeypointsToPointsVector(
-          database.ReadKeypoints(image.ImageId())));
+      image.CamFromWorld() = i == 0 ? pose : Perturb(pose, pose_noise_deg, pose_noise_m, &rng);
+      image.SetPoints2D(
+          colmap::FeatureKeypointsToPointsVector(database.ReadKeypoints(image.ImageId())));
       reconstruction.AddImage(image);
       reconstruction.RegisterImage(image.ImageId());
     }
@@ -102,11 +97,10 @@ Workspace Prepare(const testing::ScopedTempDir& dir,
   fs::create_directories(dir.File("initial"));
   fs::create_directories(dir.File("triangulated"));
   reconstruction.Write(dir.File("initial"));
-  const auto triangulate = RunCommand(
-      kColmap + " point_triangulator --database_path " + ws.database +
-      " --image_path " + ws.dataset + "/images --input_path " +
-      dir.File("initial") + " --output_path " + dir.File("triangulated") +
-      " --Mapper.num_threads 2");
+  const auto triangulate =
+      RunCommand(kColmap + " point_triangulator --database_path " + ws.database + " --image_path " +
+                 ws.dataset + "/images --input_path " + dir.File("initial") + " --output_path " +
+                 dir.File("triangulated") + " --Mapper.num_threads 2");
   EXPECT_EQ(triangulate.exit_code, 0) << triangulate.output;
   ws.initial_model = dir.File("triangulated");
 
@@ -124,14 +118,11 @@ struct JointResult {
   std::string output;
 };
 
-JointResult RunJoint(const Workspace& ws,
-                     const std::string& output,
-                     const std::string& arguments) {
+JointResult RunJoint(const Workspace& ws, const std::string& output, const std::string& arguments) {
   JointResult result;
-  const auto run =
-      RunCommand(kCli + " joint_adjuster --database_path " + ws.database +
-                 " --input_path " + ws.initial_model + " --dataset_path " +
-                 ws.dataset + " --output_path " + output + " " + arguments);
+  const auto run = RunCommand(kCli + " joint_adjuster --database_path " + ws.database +
+                              " --input_path " + ws.initial_model + " --dataset_path " +
+                              ws.dataset + " --output_path " + output + " " + arguments);
   result.output = run.output;
   EXPECT_EQ(run.exit_code, 0) << run.output;
   if (run.exit_code != 0) return result;
@@ -140,21 +131,18 @@ JointResult RunJoint(const Workspace& ws,
   const StationDataset dataset = ReadStationDataset(ws.dataset);
   colmap::Reconstruction reconstruction;
   reconstruction.Read(output);
-  result.evaluation = EvaluateCalibration(
-      ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt")),
-      ReadPoseFile(output + "/cam_from_lidar.txt"),
-      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt")),
-      reconstruction,
-      /*similarity_alignment=*/false);
+  result.evaluation =
+      EvaluateCalibration(ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt")),
+                          ReadPoseFile(output + "/cam_from_lidar.txt"),
+                          ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt")),
+                          reconstruction,
+                          /*similarity_alignment=*/false);
   std::cout << output << ": cam_from_lidar error "
             << result.evaluation.cam_from_lidar_rotation_error_deg << " deg, "
-            << result.evaluation.cam_from_lidar_translation_error_mm
-            << " mm (in camera: "
-            << result.evaluation.cam_from_lidar_translation_error_in_cam_mm
-                   .transpose()
-            << "); poses mean " << result.evaluation.mean_position_error_mm
-            << " mm, max " << result.evaluation.max_position_error_mm
-            << " mm, rotation mean "
+            << result.evaluation.cam_from_lidar_translation_error_mm << " mm (in camera: "
+            << result.evaluation.cam_from_lidar_translation_error_in_cam_mm.transpose()
+            << "); poses mean " << result.evaluation.mean_position_error_mm << " mm, max "
+            << result.evaluation.max_position_error_mm << " mm, rotation mean "
             << result.evaluation.mean_rotation_error_deg << " deg" << std::endl;
   return result;
 }
@@ -170,53 +158,41 @@ sim::SimulationOptions Stations(int num_stations, const std::string& motion) {
 TEST(JointAdjusterTest, DefaultSceneWithNoise) {
   testing::ScopedTempDir dir;
   const Workspace ws = Prepare(dir, Stations(10, "two_axes"), 0.3, 0.01);
-  const JointResult joint =
-      RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess);
+  const JointResult joint = RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess);
   std::cout << joint.output.substr(joint.output.find("Round 1/")) << std::endl;
   const JointResult precalibrated =
-      RunJoint(ws,
-               dir.File("precalibrated"),
-               "--mode precalibrated --cam_from_lidar " + ws.guess);
+      RunJoint(ws, dir.File("precalibrated"), "--mode precalibrated --cam_from_lidar " + ws.guess);
   const JointResult stereo_only =
-      RunJoint(ws,
-               dir.File("stereo_only"),
-               "--mode stereo_only --cam_from_lidar " + ws.guess);
+      RunJoint(ws, dir.File("stereo_only"), "--mode stereo_only --cam_from_lidar " + ws.guess);
 
   EXPECT_LE(joint.evaluation.cam_from_lidar_rotation_error_deg, 0.05);
   EXPECT_LE(joint.evaluation.cam_from_lidar_translation_error_mm, 2.0);
   // Inside 2 sigma of the reported covariance, per camera axis.
   const auto& sigma = joint.report["uncertainty"]["sigma_translation_mm"];
   for (int axis = 0; axis < 3; ++axis) {
-    EXPECT_LE(
-        std::abs(
-            joint.evaluation.cam_from_lidar_translation_error_in_cam_mm[axis]),
-        2 * sigma[axis].get<double>())
+    EXPECT_LE(std::abs(joint.evaluation.cam_from_lidar_translation_error_in_cam_mm[axis]),
+              2 * sigma[axis].get<double>())
         << "axis " << axis;
   }
   EXPECT_LT(joint.evaluation.mean_position_error_mm,
             precalibrated.evaluation.mean_position_error_mm);
-  EXPECT_LT(joint.evaluation.mean_position_error_mm,
-            stereo_only.evaluation.mean_position_error_mm);
+  EXPECT_LT(joint.evaluation.mean_position_error_mm, stereo_only.evaluation.mean_position_error_mm);
   EXPECT_TRUE(fs::exists(dir.File("joint/perturbation_rotation.png")));
   EXPECT_TRUE(fs::exists(dir.File("joint/cost.png")));
 }
 
 // Degenerate motion: the report names what cannot be observed.
-TEST(JointAdjusterTest,
-     OneAxisMotionLeavesTranslationAlongTheAxisUnobservable) {
+TEST(JointAdjusterTest, OneAxisMotionLeavesTranslationAlongTheAxisUnobservable) {
   testing::ScopedTempDir dir;
   sim::SimulationOptions options = Stations(10, "one_axis");
   options.image_scale = 0.6;
   const Workspace ws = Prepare(dir, options, 0.3, 0.01);
-  const JointResult joint =
-      RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess);
+  const JointResult joint = RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess);
   const std::string verdict = joint.report["observability_verdict"];
   std::cout << "verdict: " << verdict << std::endl;
-  EXPECT_NE(verdict.find("translation along the camera y axis is unobservable"),
-            std::string::npos)
+  EXPECT_NE(verdict.find("translation along the camera y axis is unobservable"), std::string::npos)
       << joint.report["unobservable"].dump();
-  EXPECT_NE(verdict.find("rotate about one axis"), std::string::npos)
-      << verdict;
+  EXPECT_NE(verdict.find("rotate about one axis"), std::string::npos) << verdict;
   EXPECT_FALSE(joint.report["motion"]["unique"].get<bool>());
 }
 
@@ -225,12 +201,10 @@ TEST(JointAdjusterTest, FixedRotationLeavesAllTranslationUnobservable) {
   sim::SimulationOptions options = Stations(4, "fixed_rotation");
   options.image_scale = 0.6;
   const Workspace ws = Prepare(dir, options, 0.3, 0.01);
-  const JointResult joint =
-      RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess);
+  const JointResult joint = RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess);
   const std::string verdict = joint.report["observability_verdict"];
   std::cout << "verdict: " << verdict << std::endl;
-  EXPECT_NE(verdict.find("all translation of cam_from_lidar is unobservable"),
-            std::string::npos)
+  EXPECT_NE(verdict.find("all translation of cam_from_lidar is unobservable"), std::string::npos)
       << joint.report["unobservable"].dump();
   EXPECT_NE(verdict.find("do not rotate"), std::string::npos) << verdict;
 }

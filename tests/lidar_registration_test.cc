@@ -37,16 +37,14 @@ class LidarRegistrationTest : public ::testing::Test {
     options.lidar_points = 300000;  // range noise: the default 1 cm
     sim::SimulateDataset(options);
     const StationDataset dataset = ReadStationDataset(options.output_path);
-    const auto cam_from_world =
-        ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+    const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
     const colmap::Rigid3d cam_from_lidar =
         ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
     for (size_t i = 0; i < dataset.stations.size(); ++i) {
       world_from_lidar_.push_back(
-          ToIsometry(colmap::Inverse(cam_from_world.at(dataset.stations[i])) *
-                     cam_from_lidar));
-      stations_.push_back(PrepareStationCloud(
-          ReadPointCloud(dataset.cloud_paths[i]), StationCloudOptions()));
+          ToIsometry(colmap::Inverse(cam_from_world.at(dataset.stations[i])) * cam_from_lidar));
+      stations_.push_back(
+          PrepareStationCloud(ReadPointCloud(dataset.cloud_paths[i]), StationCloudOptions()));
     }
   }
   static void TearDownTestSuite() {
@@ -64,8 +62,7 @@ std::vector<Eigen::Isometry3d> LidarRegistrationTest::world_from_lidar_;
 
 // All stations of the courtyard overlap widely: every pair must be registered within 0.1 deg and 1 cm,
 // and the edges must connect every station.
-TEST_F(LidarRegistrationTest,
-       EveryOverlappingPairWithinATenthOfADegreeAndOneCentimetre) {
+TEST_F(LidarRegistrationTest, EveryOverlappingPairWithinATenthOfADegreeAndOneCentimetre) {
   double worst_deg = 0, worst_m = 0;
   size_t num_pairs = 0, num_accepted = 0;
   std::vector<size_t> component(stations_.size());
@@ -79,23 +76,18 @@ TEST_F(LidarRegistrationTest,
   for (size_t i = 0; i < stations_.size(); ++i) {
     for (size_t j = i + 1; j < stations_.size(); ++j) {
       PairRegistrationOptions options;
-      const PairRegistration r =
-          RegisterStationClouds(*stations_[j], *stations_[i], options);
+      const PairRegistration r = RegisterStationClouds(*stations_[j], *stations_[i], options);
       // lidar_i_from_lidar_j
-      const Eigen::Isometry3d truth =
-          world_from_lidar_[i].inverse() * world_from_lidar_[j];
+      const Eigen::Isometry3d truth = world_from_lidar_[i].inverse() * world_from_lidar_[j];
       const Eigen::Isometry3d error = r.target_from_source * truth.inverse();
-      const double rot_deg =
-          Eigen::AngleAxisd(error.linear()).angle() * 180 / M_PI;
+      const double rot_deg = Eigen::AngleAxisd(error.linear()).angle() * 180 / M_PI;
       const double trans_m = error.translation().norm();
-      std::cout << std::setw(2) << i << " " << std::setw(2) << j << " "
-                << std::setw(8) << stations_[i]->features.size() << std::setw(8)
-                << stations_[j]->features.size() << std::setw(8)
-                << r.num_matches << std::setw(8) << r.num_inliers << std::fixed
-                << std::setprecision(3) << std::setw(8) << r.overlap
-                << std::setw(8) << r.rmse * 1000 << std::setw(9) << rot_deg
-                << std::setw(10) << trans_m * 1000 << " "
-                << (r.accepted ? "" : r.reason) << std::endl;
+      std::cout << std::setw(2) << i << " " << std::setw(2) << j << " " << std::setw(8)
+                << stations_[i]->features.size() << std::setw(8) << stations_[j]->features.size()
+                << std::setw(8) << r.num_matches << std::setw(8) << r.num_inliers << std::fixed
+                << std::setprecision(3) << std::setw(8) << r.overlap << std::setw(8)
+                << r.rmse * 1000 << std::setw(9) << rot_deg << std::setw(10) << trans_m * 1000
+                << " " << (r.accepted ? "" : r.reason) << std::endl;
       ++num_pairs;
       EXPECT_TRUE(r.accepted) << i << "-" << j << ": " << r.reason;
       if (r.accepted) {
@@ -106,9 +98,8 @@ TEST_F(LidarRegistrationTest,
       }
     }
   }
-  std::cout << "accepted " << num_accepted << " of " << num_pairs
-            << " pairs; worst accepted error " << worst_deg << " deg, "
-            << worst_m * 1000 << " mm" << std::endl;
+  std::cout << "accepted " << num_accepted << " of " << num_pairs << " pairs; worst accepted error "
+            << worst_deg << " deg, " << worst_m * 1000 << " mm" << std::endl;
   EXPECT_LT(worst_deg, 0.1);
   EXPECT_LT(worst_m, 0.01);
   EXPECT_EQ(num_accepted, num_pairs);
@@ -130,16 +121,13 @@ TEST_F(LidarRegistrationTest, PoseGraphGivesEveryStationItsTruePose) {
   double worst_deg = 0, worst_mm = 0;
   for (size_t i = 1; i < stations_.size(); ++i) {
     // The graph's world is station 0's LiDAR frame.
-    const Eigen::Isometry3d truth =
-        world_from_lidar_[0].inverse() * world_from_lidar_[i];
+    const Eigen::Isometry3d truth = world_from_lidar_[0].inverse() * world_from_lidar_[i];
     const Eigen::Isometry3d error = graph.world_from_lidar[i] * truth.inverse();
-    worst_deg = std::max(
-        worst_deg, Eigen::AngleAxisd(error.linear()).angle() * 180 / M_PI);
+    worst_deg = std::max(worst_deg, Eigen::AngleAxisd(error.linear()).angle() * 180 / M_PI);
     worst_mm = std::max(worst_mm, error.translation().norm() * 1000);
   }
-  std::cout << "pose graph: " << graph.edges.size()
-            << " edges, worst station error " << worst_deg << " deg, "
-            << worst_mm << " mm" << std::endl;
+  std::cout << "pose graph: " << graph.edges.size() << " edges, worst station error " << worst_deg
+            << " deg, " << worst_mm << " mm" << std::endl;
   EXPECT_LT(worst_deg, 0.1);
   EXPECT_LT(worst_mm, 10.0);
 }
@@ -153,8 +141,7 @@ TEST_F(LidarRegistrationTest, RefusesAPairWithoutOverlap) {
   }
   const auto a = PrepareStationCloud(left, StationCloudOptions());
   const auto b = PrepareStationCloud(right, StationCloudOptions());
-  const PairRegistration r =
-      RegisterStationClouds(*a, *b, PairRegistrationOptions());
+  const PairRegistration r = RegisterStationClouds(*a, *b, PairRegistrationOptions());
   EXPECT_FALSE(r.accepted) << "overlap " << r.overlap << ", rmse " << r.rmse;
   std::cout << "no-overlap pair refused: " << r.reason << std::endl;
 }
@@ -165,48 +152,38 @@ TEST(LidarRegistratorCliTest, WritesTheGraphAndRejectsBadInput) {
   options.output_path = dir.File("dataset");
   options.num_stations = 3;
   options.image_scale = 0.2;
-  options.lidar_points =
-      300000;  // ~200k points per station (at ~100k, pairs start to be refused)
+  options.lidar_points = 300000;  // ~200k points per station (at ~100k, pairs start to be refused)
   sim::SimulateDataset(options);
   const std::string cli = COLMAP_LIDAR_CLI_EXE;
-  auto result = testing::RunCommand(cli + " lidar_registrator --lidar_path " +
-                                    dir.File("dataset/lidar") +
-                                    " --output_path " + dir.File("out"));
+  auto result =
+      testing::RunCommand(cli + " lidar_registrator --lidar_path " + dir.File("dataset/lidar") +
+                          " --output_path " + dir.File("out"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  EXPECT_NE(result.output.find("components 1"), std::string::npos)
-      << result.output;
+  EXPECT_NE(result.output.find("components 1"), std::string::npos) << result.output;
   const auto poses = ReadNamedPoses(dir.File("out/lidar_poses.txt"));
   ASSERT_EQ(poses.size(), 3u);
   const StationDataset dataset = ReadStationDataset(dir.File("dataset"));
-  const auto cam_from_world =
-      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
   const colmap::Rigid3d cam_from_lidar =
       ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
   const colmap::Rigid3d world_from_lidar0 =
       colmap::Inverse(cam_from_world.at("000")) * cam_from_lidar;
   for (const std::string name : {"001", "002"}) {
     const colmap::Rigid3d truth = colmap::Inverse(world_from_lidar0) *
-                                  colmap::Inverse(cam_from_world.at(name)) *
-                                  cam_from_lidar;
-    EXPECT_LT((poses.at(name).translation - truth.translation).norm(), 0.01)
-        << name;
-    EXPECT_LT(
-        poses.at(name).rotation.angularDistance(truth.rotation) * 180 / M_PI,
-        0.1)
-        << name;
+                                  colmap::Inverse(cam_from_world.at(name)) * cam_from_lidar;
+    EXPECT_LT((poses.at(name).translation - truth.translation).norm(), 0.01) << name;
+    EXPECT_LT(poses.at(name).rotation.angularDistance(truth.rotation) * 180 / M_PI, 0.1) << name;
   }
   std::ifstream pairs(dir.File("out/pairs.txt"));
   std::string line;
   int num_edges = 0;
-  while (std::getline(pairs, line))
-    num_edges += !line.empty() && line[0] != '#';
+  while (std::getline(pairs, line)) num_edges += !line.empty() && line[0] != '#';
   EXPECT_EQ(num_edges, 3);
 
   // A truncated cloud: one clear error naming the file, non-zero exit.
   std::filesystem::resize_file(dir.File("dataset/lidar/001.pcd"), 5000);
   result = testing::RunCommand(cli + " lidar_registrator --lidar_path " +
-                               dir.File("dataset/lidar") + " --output_path " +
-                               dir.File("out2"));
+                               dir.File("dataset/lidar") + " --output_path " + dir.File("out2"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("001.pcd"), std::string::npos) << result.output;
   EXPECT_FALSE(std::filesystem::exists(dir.File("out2/pairs.txt")));

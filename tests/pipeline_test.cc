@@ -57,16 +57,14 @@ int ImageGraphComponents(const std::string& database_path, int min_inliers) {
   for (const colmap::Image& image : database.ReadAllImages()) {
     parent[image.ImageId()] = image.ImageId();
   }
-  std::function<colmap::image_t(colmap::image_t)> find =
-      [&](colmap::image_t i) {
-        return parent[i] == i ? i : parent[i] = find(parent[i]);
-      };
+  std::function<colmap::image_t(colmap::image_t)> find = [&](colmap::image_t i) {
+    return parent[i] == i ? i : parent[i] = find(parent[i]);
+  };
   std::vector<std::pair<colmap::image_t, colmap::image_t>> pairs;
   std::vector<int> num_inliers;
   database.ReadTwoViewGeometryNumInliers(&pairs, &num_inliers);
   for (size_t k = 0; k < pairs.size(); ++k) {
-    if (num_inliers[k] >= min_inliers)
-      parent[find(pairs[k].first)] = find(pairs[k].second);
+    if (num_inliers[k] >= min_inliers) parent[find(pairs[k].first)] = find(pairs[k].second);
   }
   int components = 0;
   for (const auto& [image, p] : parent) components += find(image) == image;
@@ -78,69 +76,56 @@ nlohmann::json EvaluateCloud(const std::string& cloud,
                              const std::string& dataset,
                              const std::string& truth_from_model,
                              const std::string& output) {
-  const auto run = RunCommand(kCli + " evaluate_model --model_path " + cloud +
-                              " --ground_truth_path " + dataset +
-                              "/ground_truth/surface.ply --truth_from_model " +
-                              truth_from_model + " --output_path " + output);
+  const auto run =
+      RunCommand(kCli + " evaluate_model --model_path " + cloud + " --ground_truth_path " +
+                 dataset + "/ground_truth/surface.ply --truth_from_model " + truth_from_model +
+                 " --output_path " + output);
   EXPECT_EQ(run.exit_code, 0) << run.output;
   return ReadJson(output + "/metrics.json");
 }
 
 void PrintCloudMetrics(const std::string& name, const nlohmann::json& m) {
-  std::cout << std::fixed << std::setprecision(2) << "  " << std::left
-            << std::setw(34) << name << " mean "
-            << 1000 * m["mean_m"].get<double>() << " mm, median "
-            << 1000 * m["median_m"].get<double>()
-            << " mm, completeness 2/5/10 mm "
-            << m["completeness_2mm"].get<double>() << "/"
-            << m["completeness_5mm"].get<double>() << "/"
-            << m["completeness_10mm"].get<double>() << ", density "
-            << m["density_points_per_cm2"].get<double>() << " points/cm^2"
-            << std::endl;
+  std::cout << std::fixed << std::setprecision(2) << "  " << std::left << std::setw(34) << name
+            << " mean " << 1000 * m["mean_m"].get<double>() << " mm, median "
+            << 1000 * m["median_m"].get<double>() << " mm, completeness 2/5/10 mm "
+            << m["completeness_2mm"].get<double>() << "/" << m["completeness_5mm"].get<double>()
+            << "/" << m["completeness_10mm"].get<double>() << ", density "
+            << m["density_points_per_cm2"].get<double>() << " points/cm^2" << std::endl;
 }
 
 // The dense model of a pipeline workspace (issue 8): LiDAR-refined fused.ply against the unrefined
 // stereo on the same poses and against the stereo-only pipeline; COLMAP's own fusion and Poisson
 // mesher on our dense workspace; the LiDAR map; a missing depth map.
-void CheckDenseModel(const testing::ScopedTempDir& dir,
-                     const std::string& dataset) {
+void CheckDenseModel(const testing::ScopedTempDir& dir, const std::string& dataset) {
   const std::string ws = dir.File("ws");
   const std::string truth_from_joint = ws + "/evaluation/truth_from_model.txt";
-  const nlohmann::json refined =
-      ReadJson(ws + "/evaluation/model/metrics.json");
+  const nlohmann::json refined = ReadJson(ws + "/evaluation/model/metrics.json");
   for (const std::string& step :
-       {kCli + " densifier --input_path " + ws +
-            "/sparse/joint --dataset_path " + dataset + " --depth_path " + ws +
-            "/stereo --output_path " + ws +
+       {kCli + " densifier --input_path " + ws + "/sparse/joint --dataset_path " + dataset +
+            " --depth_path " + ws + "/stereo --output_path " + ws +
             "/dense_unrefined --refine_with_lidar 0",
-        kCli + " joint_adjuster --database_path " + ws +
-            "/database.db --input_path " + ws +
-            "/sparse/initial --dataset_path " + dataset + " --output_path " +
-            ws + "/sparse/stereo_only --mode stereo_only",
-        kCli + " evaluate_calibration --dataset_path " + dataset +
-            " --input_path " + ws + "/sparse/stereo_only --output_path " + ws +
-            "/evaluation_stereo_only",
-        kCli + " densifier --input_path " + ws +
-            "/sparse/stereo_only --dataset_path " + dataset + " --depth_path " +
-            ws + "/stereo --output_path " + ws +
+        kCli + " joint_adjuster --database_path " + ws + "/database.db --input_path " + ws +
+            "/sparse/initial --dataset_path " + dataset + " --output_path " + ws +
+            "/sparse/stereo_only --mode stereo_only",
+        kCli + " evaluate_calibration --dataset_path " + dataset + " --input_path " + ws +
+            "/sparse/stereo_only --output_path " + ws + "/evaluation_stereo_only",
+        kCli + " densifier --input_path " + ws + "/sparse/stereo_only --dataset_path " + dataset +
+            " --depth_path " + ws + "/stereo --output_path " + ws +
             "/dense_stereo_only --refine_with_lidar 0"}) {
     const auto result = RunCommand(step);
     ASSERT_EQ(result.exit_code, 0) << step << "\n" << result.output;
   }
-  const nlohmann::json unrefined =
-      EvaluateCloud(ws + "/dense_unrefined/fused.ply",
-                    dataset,
-                    truth_from_joint,
-                    ws + "/evaluation/model_unrefined");
+  const nlohmann::json unrefined = EvaluateCloud(ws + "/dense_unrefined/fused.ply",
+                                                 dataset,
+                                                 truth_from_joint,
+                                                 ws + "/evaluation/model_unrefined");
   const nlohmann::json stereo_only =
       EvaluateCloud(ws + "/dense_stereo_only/fused.ply",
                     dataset,
                     ws + "/evaluation_stereo_only/truth_from_model.txt",
                     ws + "/evaluation/model_stereo_only");
-  const nlohmann::json lidar_map = EvaluateCloud(ws + "/dense/lidar_map.ply",
-                                                 dataset,
-                                                 truth_from_joint,
-                                                 ws + "/evaluation/lidar_map");
+  const nlohmann::json lidar_map = EvaluateCloud(
+      ws + "/dense/lidar_map.ply", dataset, truth_from_joint, ws + "/evaluation/lidar_map");
   std::cout << "dense models against the true surface:" << std::endl;
   PrintCloudMetrics("LiDAR-refined (fused.ply)", refined);
   PrintCloudMetrics("stereo, joint poses, unrefined", unrefined);
@@ -150,10 +135,8 @@ void CheckDenseModel(const testing::ScopedTempDir& dir,
   // is replaced from the LiDAR surface, closer to the truth); at 5 and 10 mm equal within 0.005:
   // stereo more than 1 cm off that fold 2 cannot replace (foreground fattened across a depth edge)
   // is removed, and it lay within 10 mm of the foreground's border.
-  EXPECT_LT(refined["mean_m"].get<double>(),
-            0.9 * unrefined["mean_m"].get<double>());
-  EXPECT_LT(refined["mean_m"].get<double>(),
-            0.9 * stereo_only["mean_m"].get<double>());
+  EXPECT_LT(refined["mean_m"].get<double>(), 0.9 * unrefined["mean_m"].get<double>());
+  EXPECT_LT(refined["mean_m"].get<double>(), 0.9 * stereo_only["mean_m"].get<double>());
   EXPECT_LT(refined["mean_m"].get<double>(), 0.0025);
   for (const auto* other : {&unrefined, &stereo_only}) {
     EXPECT_GT(refined["completeness_2mm"].get<double>(),
@@ -175,8 +158,7 @@ void CheckDenseModel(const testing::ScopedTempDir& dir,
   }
   EXPECT_GT(filled, 10000u);
   EXPECT_GT(removed, 10000u);
-  EXPECT_TRUE(fs::is_regular_file(
-      ws + "/dense/stereo/depth_maps/left/000.png.geometric.bin"));
+  EXPECT_TRUE(fs::is_regular_file(ws + "/dense/stereo/depth_maps/left/000.png.geometric.bin"));
   EXPECT_TRUE(fs::is_regular_file(ws + "/dense/stereo/previews/000.png"));
 
   // COLMAP's own tools on our dense workspace. Stations are few and far apart, so a fused point
@@ -186,16 +168,13 @@ void CheckDenseModel(const testing::ScopedTempDir& dir,
        {kColmap + " stereo_fusion --workspace_path " + ws +
             "/dense --input_type geometric --output_path " + colmap_fused +
             " --StereoFusion.min_num_pixels 2 --StereoFusion.num_threads 2",
-        kColmap + " poisson_mesher --input_path " + colmap_fused +
-            " --output_path " + ws + "/dense/meshed-poisson.ply"}) {
+        kColmap + " poisson_mesher --input_path " + colmap_fused + " --output_path " + ws +
+            "/dense/meshed-poisson.ply"}) {
     const auto result = RunCommand(step);
     ASSERT_EQ(result.exit_code, 0) << step << "\n" << result.output;
   }
   const nlohmann::json fused_by_colmap =
-      EvaluateCloud(colmap_fused,
-                    dataset,
-                    truth_from_joint,
-                    ws + "/evaluation/colmap_fusion");
+      EvaluateCloud(colmap_fused, dataset, truth_from_joint, ws + "/evaluation/colmap_fusion");
   PrintCloudMetrics("colmap stereo_fusion of our maps", fused_by_colmap);
   EXPECT_GT(fused_by_colmap["num_evaluated"].get<size_t>(), 50000u);
   // Where we measured (the workspace's -0.5 px principal point), multi-view consistent: 1.1-1.3 mm.
@@ -207,38 +186,33 @@ void CheckDenseModel(const testing::ScopedTempDir& dir,
   {
     fs::create_directories(ws + "/stereo_holes/depth_maps");
     fs::copy_file(ws + "/stereo/stereo.json", ws + "/stereo_holes/stereo.json");
-    for (const auto& entry :
-         fs::directory_iterator(ws + "/stereo/depth_maps")) {
+    for (const auto& entry : fs::directory_iterator(ws + "/stereo/depth_maps")) {
       colmap::mvs::DepthMap map;
       map.Read(entry.path().string());
       const size_t w = map.GetWidth(), h = map.GetHeight();
       for (size_t row = h / 3; row < 2 * h / 3; ++row) {
         for (size_t col = w / 3; col < 2 * w / 3; ++col) map.Set(row, col, 0.f);
       }
-      map.Write(ws + "/stereo_holes/depth_maps/" +
-                entry.path().filename().string());
+      map.Write(ws + "/stereo_holes/depth_maps/" + entry.path().filename().string());
     }
     nlohmann::json holes[2];
     for (int refine = 0; refine < 2; ++refine) {
       const std::string out = ws + "/dense_holes" + std::to_string(refine);
       const auto run =
-          RunCommand(kCli + " densifier --input_path " + ws +
-                     "/sparse/joint --dataset_path " + dataset +
-                     " --depth_path " + ws + "/stereo_holes --output_path " +
-                     out + " --refine_with_lidar " + std::to_string(refine));
+          RunCommand(kCli + " densifier --input_path " + ws + "/sparse/joint --dataset_path " +
+                     dataset + " --depth_path " + ws + "/stereo_holes --output_path " + out +
+                     " --refine_with_lidar " + std::to_string(refine));
       ASSERT_EQ(run.exit_code, 0) << run.output;
-      holes[refine] = EvaluateCloud(
-          out + "/fused.ply",
-          dataset,
-          truth_from_joint,
-          ws + "/evaluation/model_holes" + std::to_string(refine));
+      holes[refine] = EvaluateCloud(out + "/fused.ply",
+                                    dataset,
+                                    truth_from_joint,
+                                    ws + "/evaluation/model_holes" + std::to_string(refine));
     }
     PrintCloudMetrics("stereo with holes, unrefined", holes[0]);
     PrintCloudMetrics("stereo with holes, LiDAR-refined", holes[1]);
     EXPECT_GT(holes[1]["completeness_5mm"].get<double>(),
               holes[0]["completeness_5mm"].get<double>() + 0.03);
-    EXPECT_LT(holes[1]["mean_m"].get<double>(),
-              holes[0]["mean_m"].get<double>());
+    EXPECT_LT(holes[1]["mean_m"].get<double>(), holes[0]["mean_m"].get<double>());
   }
 
   // A camera model with distortion goes through COLMAP's undistortion (cameras, keypoints) and our
@@ -260,39 +234,29 @@ void CheckDenseModel(const testing::ScopedTempDir& dir,
     }
     fs::create_directories(ws + "/sparse/joint_opencv");
     model.Write(ws + "/sparse/joint_opencv");
-    const auto run =
-        RunCommand(kCli + " densifier --input_path " + ws +
-                   "/sparse/joint_opencv" + " --cam_from_lidar " + ws +
-                   "/sparse/joint/cam_from_lidar.txt --dataset_path " +
-                   dataset + " --depth_path " + ws + "/stereo --output_path " +
-                   ws + "/dense_opencv");
+    const auto run = RunCommand(
+        kCli + " densifier --input_path " + ws + "/sparse/joint_opencv" + " --cam_from_lidar " +
+        ws + "/sparse/joint/cam_from_lidar.txt --dataset_path " + dataset + " --depth_path " + ws +
+        "/stereo --output_path " + ws + "/dense_opencv");
     ASSERT_EQ(run.exit_code, 0) << run.output;
     EXPECT_NE(run.output.find("is undistorted to PINHOLE"), std::string::npos);
-    const nlohmann::json opencv =
-        EvaluateCloud(ws + "/dense_opencv/fused.ply",
-                      dataset,
-                      truth_from_joint,
-                      ws + "/evaluation/model_opencv");
+    const nlohmann::json opencv = EvaluateCloud(
+        ws + "/dense_opencv/fused.ply", dataset, truth_from_joint, ws + "/evaluation/model_opencv");
     PrintCloudMetrics("same, camera given as OPENCV", opencv);
     // COLMAP's undistorted camera is 1027x750, not 1028x752: the maps are resampled to the nearest
     // pixel (measured 2.10 vs 2.06 mm; completeness at 2 mm 0.59 vs 0.61, at 5 mm equal).
+    EXPECT_NEAR(opencv["mean_m"].get<double>(), refined["mean_m"].get<double>(), 2e-4);
     EXPECT_NEAR(
-        opencv["mean_m"].get<double>(), refined["mean_m"].get<double>(), 2e-4);
-    EXPECT_NEAR(opencv["completeness_5mm"].get<double>(),
-                refined["completeness_5mm"].get<double>(),
-                0.01);
+        opencv["completeness_5mm"].get<double>(), refined["completeness_5mm"].get<double>(), 0.01);
   }
 
   // A missing depth map: one error naming the file, nothing written.
   fs::create_directories(ws + "/empty_stereo");
-  const auto missing =
-      RunCommand(kCli + " densifier --input_path " + ws +
-                 "/sparse/joint --dataset_path " + dataset + " --depth_path " +
-                 ws + "/empty_stereo --output_path " + ws + "/dense_missing");
+  const auto missing = RunCommand(kCli + " densifier --input_path " + ws +
+                                  "/sparse/joint --dataset_path " + dataset + " --depth_path " +
+                                  ws + "/empty_stereo --output_path " + ws + "/dense_missing");
   EXPECT_NE(missing.exit_code, 0);
-  EXPECT_NE(
-      missing.output.find("empty_stereo/depth_maps/000.png.geometric.bin"),
-      std::string::npos)
+  EXPECT_NE(missing.output.find("empty_stereo/depth_maps/000.png.geometric.bin"), std::string::npos)
       << missing.output;
   EXPECT_FALSE(fs::exists(ws + "/dense_missing"));
   EXPECT_FALSE(fs::exists(ws + "/dense_missing.partial"));
@@ -300,26 +264,21 @@ void CheckDenseModel(const testing::ScopedTempDir& dir,
 
 TEST(PipelineTest, DefaultSceneWithoutAGuessEndToEndAndRestartable) {
   testing::ScopedTempDir dir;
-  const std::string dataset =
-      Simulate(dir, "t_specimen", 8, 1.0, 300000, false);
+  const std::string dataset = Simulate(dir, "t_specimen", 8, 1.0, 300000, false);
   ASSERT_FALSE(ReadStationDataset(dataset).rig.cam_from_lidar_guess);
-  const std::string command = kCli + " pipeline --dataset_path " + dataset +
-                              " --workspace_path " + dir.File("ws");
+  const std::string command =
+      kCli + " pipeline --dataset_path " + dataset + " --workspace_path " + dir.File("ws");
   const auto run = RunCommand(command);
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  std::cout << run.output.substr(run.output.find("== Pipeline summary"))
-            << std::endl;
-  const nlohmann::json init =
-      ReadJson(dir.File("ws/sparse/initial/initialization.json"));
+  std::cout << run.output.substr(run.output.find("== Pipeline summary")) << std::endl;
+  const nlohmann::json init = ReadJson(dir.File("ws/sparse/initial/initialization.json"));
   EXPECT_EQ(init["extrinsic_source"], "hand-eye");
   EXPECT_TRUE(init["hand_eye"]["unique"].get<bool>());
-  const nlohmann::json metrics =
-      ReadJson(dir.File("ws/evaluation/metrics.json"));
+  const nlohmann::json metrics = ReadJson(dir.File("ws/evaluation/metrics.json"));
   std::cout << "pipeline without a guess: cam_from_lidar error "
             << metrics["cam_from_lidar_rotation_error_deg"] << " deg, "
-            << metrics["cam_from_lidar_translation_error_mm"]
-            << " mm; poses mean " << metrics["pose_position_error_mean_mm"]
-            << " mm" << std::endl;
+            << metrics["cam_from_lidar_translation_error_mm"] << " mm; poses mean "
+            << metrics["pose_position_error_mean_mm"] << " mm" << std::endl;
   EXPECT_EQ(metrics["num_stations_evaluated"].get<int>(), 8);
   EXPECT_LE(metrics["cam_from_lidar_rotation_error_deg"].get<double>(), 0.05);
   // 8 stations, not the default 25: the translation bound is a regression bound (measured 2.1-3.1 mm;
@@ -335,53 +294,43 @@ TEST(PipelineTest, DefaultSceneWithoutAGuessEndToEndAndRestartable) {
   // frame) rescaled to metres by the depth priors, cam_from_lidar by hand-eye, then the joint adjuster.
   fs::create_directories(dir.File("ws/mapper"));
   for (const std::string& step :
-       {kColmap + " mapper --database_path " + dir.File("ws/database.db") +
-            " --image_path " + dataset + "/images --output_path " +
-            dir.File("ws/mapper") + " --Mapper.ba_refine_focal_length 0" +
+       {kColmap + " mapper --database_path " + dir.File("ws/database.db") + " --image_path " +
+            dataset + "/images --output_path " + dir.File("ws/mapper") +
+            " --Mapper.ba_refine_focal_length 0" +
             " --Mapper.ba_refine_extra_params 0 --Mapper.num_threads 2",
-        kCli + " pose_initializer --database_path " +
-            dir.File("ws/database.db") + " --dataset_path " + dataset +
-            " --registration_path " + dir.File("ws/lidar") + " --input_path " +
-            dir.File("ws/mapper/0") + " --output_path " +
+        kCli + " pose_initializer --database_path " + dir.File("ws/database.db") +
+            " --dataset_path " + dataset + " --registration_path " + dir.File("ws/lidar") +
+            " --input_path " + dir.File("ws/mapper/0") + " --output_path " +
             dir.File("ws/mapper_initial"),
-        kCli + " joint_adjuster --database_path " + dir.File("ws/database.db") +
-            " --input_path " + dir.File("ws/mapper_initial") +
-            " --dataset_path " + dataset + " --output_path " +
+        kCli + " joint_adjuster --database_path " + dir.File("ws/database.db") + " --input_path " +
+            dir.File("ws/mapper_initial") + " --dataset_path " + dataset + " --output_path " +
             dir.File("ws/mapper_joint"),
-        kCli + " evaluate_calibration --dataset_path " + dataset +
-            " --input_path " + dir.File("ws/mapper_joint") + " --output_path " +
-            dir.File("ws/mapper_evaluation")}) {
+        kCli + " evaluate_calibration --dataset_path " + dataset + " --input_path " +
+            dir.File("ws/mapper_joint") + " --output_path " + dir.File("ws/mapper_evaluation")}) {
     const auto result = RunCommand(step);
     ASSERT_EQ(result.exit_code, 0) << step << "\n" << result.output;
   }
-  const nlohmann::json mapper_init =
-      ReadJson(dir.File("ws/mapper_initial/initialization.json"));
+  const nlohmann::json mapper_init = ReadJson(dir.File("ws/mapper_initial/initialization.json"));
   EXPECT_EQ(mapper_init["extrinsic_source"], "hand-eye");
   EXPECT_NE(mapper_init["scale_to_metres"].get<double>(), 1.0);
-  const nlohmann::json from_mapper =
-      ReadJson(dir.File("ws/mapper_evaluation/metrics.json"));
-  std::cout << "from colmap mapper's model (scale "
-            << mapper_init["scale_to_metres"] << "): cam_from_lidar error "
-            << from_mapper["cam_from_lidar_rotation_error_deg"] << " deg, "
-            << from_mapper["cam_from_lidar_translation_error_mm"]
-            << " mm; poses mean " << from_mapper["pose_position_error_mean_mm"]
-            << " mm (" << from_mapper["num_stations_evaluated"] << " stations)"
-            << std::endl;
+  const nlohmann::json from_mapper = ReadJson(dir.File("ws/mapper_evaluation/metrics.json"));
+  std::cout << "from colmap mapper's model (scale " << mapper_init["scale_to_metres"]
+            << "): cam_from_lidar error " << from_mapper["cam_from_lidar_rotation_error_deg"]
+            << " deg, " << from_mapper["cam_from_lidar_translation_error_mm"] << " mm; poses mean "
+            << from_mapper["pose_position_error_mean_mm"] << " mm ("
+            << from_mapper["num_stations_evaluated"] << " stations)" << std::endl;
   // COLMAP's incremental mapper registers only part of 8 stations 45 deg apart (3 here); the
   // rescaled model must still be metric and calibrate cam_from_lidar.
   EXPECT_GE(from_mapper["num_stations_evaluated"].get<int>(), 3);
-  EXPECT_LE(from_mapper["cam_from_lidar_rotation_error_deg"].get<double>(),
-            0.05);
-  EXPECT_LE(from_mapper["cam_from_lidar_translation_error_mm"].get<double>(),
-            5.0);
+  EXPECT_LE(from_mapper["cam_from_lidar_rotation_error_deg"].get<double>(), 0.05);
+  EXPECT_LE(from_mapper["cam_from_lidar_translation_error_mm"].get<double>(), 5.0);
   EXPECT_LE(from_mapper["pose_position_error_mean_mm"].get<double>(), 2.0);
 
   // A second run finds every step done.
   const auto again = RunCommand(command);
   ASSERT_EQ(again.exit_code, 0) << again.output;
   EXPECT_EQ(again.output.find(" ran "), std::string::npos) << again.output;
-  EXPECT_NE(again.output.find("joint_adjuster          skipped"),
-            std::string::npos)
+  EXPECT_NE(again.output.find("joint_adjuster          skipped"), std::string::npos)
       << again.output;
 }
 
@@ -390,8 +339,7 @@ TEST(PipelineTest, DefaultSceneWithoutAGuessEndToEndAndRestartable) {
 // guess the pipeline must stop saying so. With the guess every station is registered.
 TEST(PipelineTest, LidarBridgesADisconnectedImageGraph) {
   testing::ScopedTempDir dir;
-  const std::string dataset =
-      Simulate(dir, "square_pillar", 5, 0.6, 200000, true);
+  const std::string dataset = Simulate(dir, "square_pillar", 5, 0.6, 200000, true);
   const StationDataset with_guess = ReadStationDataset(dataset);
   StationRig rig = with_guess.rig;
   rig.cam_from_lidar_guess.reset();
@@ -399,14 +347,13 @@ TEST(PipelineTest, LidarBridgesADisconnectedImageGraph) {
   const auto refused = RunCommand(kCli + " pipeline --dataset_path " + dataset +
                                   " --workspace_path " + dir.File("ws"));
   EXPECT_NE(refused.exit_code, 0);
-  EXPECT_NE(refused.output.find("degenerate motion for hand-eye calibration"),
-            std::string::npos)
+  EXPECT_NE(refused.output.find("degenerate motion for hand-eye calibration"), std::string::npos)
       << refused.output;
   EXPECT_NE(refused.output.find("add cam_from_lidar_guess"), std::string::npos);
   WriteRigJson(dataset + "/rig.json",
                with_guess.rig);  // the finished steps are kept
-  const auto run = RunCommand(kCli + " pipeline --dataset_path " + dataset +
-                              " --workspace_path " + dir.File("ws"));
+  const auto run = RunCommand(kCli + " pipeline --dataset_path " + dataset + " --workspace_path " +
+                              dir.File("ws"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const int components = ImageGraphComponents(dir.File("ws/database.db"), 20);
   std::cout << "image graph: " << components << " components" << std::endl;
@@ -416,13 +363,11 @@ TEST(PipelineTest, LidarBridgesADisconnectedImageGraph) {
   EXPECT_EQ(reconstruction.NumRegImages(), 5u);
   // No image landmark joins the stations here: the report must say that cam_from_lidar is not
   // calibrated rather than pretend.
-  const nlohmann::json report =
-      ReadJson(dir.File("ws/sparse/joint/report.json"));
+  const nlohmann::json report = ReadJson(dir.File("ws/sparse/joint/report.json"));
   const std::string verdict = report["observability_verdict"];
   std::cout << "square pillar verdict: " << verdict << std::endl;
-  EXPECT_NE(
-      verdict.find("cam_from_lidar cannot be calibrated: no image landmark"),
-      std::string::npos)
+  EXPECT_NE(verdict.find("cam_from_lidar cannot be calibrated: no image landmark"),
+            std::string::npos)
       << verdict;
 }
 

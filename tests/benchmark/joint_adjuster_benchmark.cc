@@ -27,15 +27,13 @@ namespace {
 namespace fs = std::filesystem;
 
 double Seconds(const std::chrono::steady_clock::time_point& start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 std::string TriangulatedTrueModel(const StationDataset& dataset,
                                   const std::string& database_path,
                                   const std::string& work) {
-  const auto truth =
-      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const auto truth = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
   colmap::Reconstruction reconstruction;
   const colmap::Database database(database_path);
   for (const colmap::Camera& camera : database.ReadAllCameras()) {
@@ -43,8 +41,8 @@ std::string TriangulatedTrueModel(const StationDataset& dataset,
   }
   for (colmap::Image image : database.ReadAllImages()) {
     image.CamFromWorld() = truth.at(fs::path(image.Name()).stem().string());
-    image.SetPoints2D(colmap::FeatureKeypointsToPointsVector(
-        database.ReadKeypoints(image.ImageId())));
+    image.SetPoints2D(
+        colmap::FeatureKeypointsToPointsVector(database.ReadKeypoints(image.ImageId())));
     reconstruction.AddImage(image);
     reconstruction.RegisterImage(image.ImageId());
   }
@@ -52,11 +50,9 @@ std::string TriangulatedTrueModel(const StationDataset& dataset,
   fs::create_directories(work + "/triangulated");
   reconstruction.Write(work + "/initial");
   const std::string command =
-      std::string(COLMAP_LIDAR_COLMAP_EXE) +
-      " point_triangulator --database_path " + database_path +
-      " --image_path " + dataset.root + "/images --input_path " + work +
-      "/initial --output_path " + work + "/triangulated > " + work +
-      "/triangulator.log 2>&1";
+      std::string(COLMAP_LIDAR_COLMAP_EXE) + " point_triangulator --database_path " +
+      database_path + " --image_path " + dataset.root + "/images --input_path " + work +
+      "/initial --output_path " + work + "/triangulated > " + work + "/triangulator.log 2>&1";
   if (std::system(command.c_str()) != 0) {
     throw std::runtime_error("colmap point_triangulator failed: " + command);
   }
@@ -69,8 +65,7 @@ struct Timing {
   size_t residual_blocks = 0;
 };
 
-Timing PlainBundleAdjustment(colmap::Reconstruction reconstruction,
-                             int iterations) {
+Timing PlainBundleAdjustment(colmap::Reconstruction reconstruction, int iterations) {
   colmap::BundleAdjustmentOptions options;
   options.refine_focal_length = false;
   options.refine_principal_point = false;
@@ -87,8 +82,7 @@ Timing PlainBundleAdjustment(colmap::Reconstruction reconstruction,
   adjuster.Solve(&reconstruction);
   Timing timing;
   timing.seconds = Seconds(start);
-  timing.iterations =
-      static_cast<int>(adjuster.Summary().iterations.size()) - 1;
+  timing.iterations = static_cast<int>(adjuster.Summary().iterations.size()) - 1;
   timing.residual_blocks = adjuster.Summary().num_residual_blocks;
   return timing;
 }
@@ -103,15 +97,13 @@ Timing JointSolve(colmap::Reconstruction reconstruction,
   options.max_num_iterations = iterations;
   options.initial_association_distance_m = options.association.max_distance;
   JointAdjuster adjuster(options, data);
-  const JointAdjustmentSummary summary =
-      adjuster.Run(&reconstruction, &cam_from_lidar);
+  const JointAdjustmentSummary summary = adjuster.Run(&reconstruction, &cam_from_lidar);
   Timing timing;
   timing.seconds = summary.solves.front().seconds;
   timing.iterations = summary.solves.front().num_iterations - 1;
-  timing.residual_blocks =
-      summary.solves.front().reprojection.num_observations +
-      summary.solves.front().depth.num_observations +
-      summary.solves.front().lidar.num_observations;
+  timing.residual_blocks = summary.solves.front().reprojection.num_observations +
+                           summary.solves.front().depth.num_observations +
+                           summary.solves.front().lidar.num_observations;
   return timing;
 }
 
@@ -132,13 +124,8 @@ int main(int argc, char** argv) {
     const colmap::Rigid3d cam_from_lidar =
         ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
     const auto load_start = std::chrono::steady_clock::now();
-    const std::unique_ptr<LoadedJointData> loaded =
-        LoadJointProblemData(argv[2],
-                             dataset,
-                             reconstruction,
-                             cam_from_lidar,
-                             true,
-                             JointDataOptions());
+    const std::unique_ptr<LoadedJointData> loaded = LoadJointProblemData(
+        argv[2], dataset, reconstruction, cam_from_lidar, true, JointDataOptions());
     const double load_seconds = Seconds(load_start);
 
     std::ostringstream table;
@@ -148,22 +135,20 @@ int main(int argc, char** argv) {
           << "|---|---|---|---|---|\n";
     for (const int iterations : {1, 10}) {
       const Timing plain = PlainBundleAdjustment(reconstruction, iterations);
-      const Timing joint =
-          JointSolve(reconstruction, cam_from_lidar, loaded->data, iterations);
+      const Timing joint = JointSolve(reconstruction, cam_from_lidar, loaded->data, iterations);
       const auto row = [&](const std::string& name, const Timing& t) {
-        table << "| " << name << " | " << t.iterations << " | "
-              << t.residual_blocks << " | " << t.seconds << " | "
-              << t.seconds / std::max(1, t.iterations) << " |\n";
+        table << "| " << name << " | " << t.iterations << " | " << t.residual_blocks << " | "
+              << t.seconds << " | " << t.seconds / std::max(1, t.iterations) << " |\n";
       };
       row("COLMAP BundleAdjuster::Solve", plain);
       row("joint (reprojection + depth + LiDAR + T_e)", joint);
-      table << "| **overhead ratio** (joint / COLMAP) | | | **"
-            << joint.seconds / plain.seconds << "** | |\n";
+      table << "| **overhead ratio** (joint / COLMAP) | | | **" << joint.seconds / plain.seconds
+            << "** | |\n";
     }
-    std::cout << reconstruction.NumRegImages() << " images, "
-              << reconstruction.NumPoints3D() << " landmarks; loading clouds, "
-              << "depth priors and the pose graph (once): " << std::fixed
-              << std::setprecision(1) << load_seconds << " s\n\n"
+    std::cout << reconstruction.NumRegImages() << " images, " << reconstruction.NumPoints3D()
+              << " landmarks; loading clouds, "
+              << "depth priors and the pose graph (once): " << std::fixed << std::setprecision(1)
+              << load_seconds << " s\n\n"
               << table.str();
   } catch (const std::exception& error) {
     std::cerr << "ERROR: " << error.what() << "\n";

@@ -32,10 +32,8 @@ Eigen::Isometry3d ToIsometry(const colmap::Rigid3d& pose) {
 }
 
 struct FpfhCloud {
-  pcl::PointCloud<pcl::PointNormal>::Ptr points{
-      new pcl::PointCloud<pcl::PointNormal>};
-  pcl::PointCloud<pcl::FPFHSignature33>::Ptr features{
-      new pcl::PointCloud<pcl::FPFHSignature33>};
+  pcl::PointCloud<pcl::PointNormal>::Ptr points{new pcl::PointCloud<pcl::PointNormal>};
+  pcl::PointCloud<pcl::FPFHSignature33>::Ptr features{new pcl::PointCloud<pcl::FPFHSignature33>};
 };
 
 // FPFH on the same 0.1 m voxel cloud the BSC features use, normals from our estimator.
@@ -47,16 +45,12 @@ FpfhCloud PrepareFpfh(const PointCloud& raw, double voxel, double radius) {
   FpfhCloud result;
   for (size_t i = 0; i < coarse.Size(); ++i) {
     pcl::PointNormal p;
-    p.x = coarse.points[i].x(), p.y = coarse.points[i].y(),
-    p.z = coarse.points[i].z();
+    p.x = coarse.points[i].x(), p.y = coarse.points[i].y(), p.z = coarse.points[i].z();
     p.normal_x = coarse.normals[i].x(), p.normal_y = coarse.normals[i].y(),
     p.normal_z = coarse.normals[i].z();
     result.points->push_back(p);
   }
-  pcl::FPFHEstimationOMP<pcl::PointNormal,
-                         pcl::PointNormal,
-                         pcl::FPFHSignature33>
-      fpfh;
+  pcl::FPFHEstimationOMP<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> fpfh;
   fpfh.setInputCloud(result.points);
   fpfh.setInputNormals(result.points);
   fpfh.setRadiusSearch(radius);
@@ -82,8 +76,7 @@ int Main(int argc, char** argv) {
     return 1;
   }
   const StationDataset dataset = ReadStationDataset(argv[1]);
-  const auto cam_from_world =
-      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
   const colmap::Rigid3d cam_from_lidar =
       ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
   const size_t n = dataset.stations.size();
@@ -93,8 +86,7 @@ int Main(int argc, char** argv) {
   Tally bsc, pcl_tally;
   for (size_t i = 0; i < n; ++i) {
     world_from_lidar.push_back(
-        ToIsometry(colmap::Inverse(cam_from_world.at(dataset.stations[i])) *
-                   cam_from_lidar));
+        ToIsometry(colmap::Inverse(cam_from_world.at(dataset.stations[i])) * cam_from_lidar));
     const PointCloud raw = ReadPointCloud(dataset.cloud_paths[i]);
     auto start = Clock::now();
     ours.push_back(PrepareStationCloud(raw, StationCloudOptions()));
@@ -107,27 +99,22 @@ int Main(int argc, char** argv) {
   const PairRegistrationOptions options;
   for (size_t i = 0; i < n; ++i) {
     for (size_t j = i + 1; j < n; ++j) {
-      const Eigen::Isometry3d truth =
-          world_from_lidar[i].inverse() * world_from_lidar[j];
-      auto error =
-          [&](const Eigen::Isometry3d& estimate, double* deg, double* mm) {
-            const Eigen::Isometry3d e = estimate * truth.inverse();
-            *deg = Eigen::AngleAxisd(e.linear()).angle() * 180 / M_PI;
-            *mm = e.translation().norm() * 1000;
-          };
+      const Eigen::Isometry3d truth = world_from_lidar[i].inverse() * world_from_lidar[j];
+      auto error = [&](const Eigen::Isometry3d& estimate, double* deg, double* mm) {
+        const Eigen::Isometry3d e = estimate * truth.inverse();
+        *deg = Eigen::AngleAxisd(e.linear()).angle() * 180 / M_PI;
+        *mm = e.translation().norm() * 1000;
+      };
       double deg, mm;
       auto start = Clock::now();
-      const PairRegistration r =
-          RegisterStationClouds(*ours[j], *ours[i], options);
+      const PairRegistration r = RegisterStationClouds(*ours[j], *ours[i], options);
       bsc.seconds += Since(start);
       error(r.target_from_source, &deg, &mm);
       // Success: within the bounds (0.1 deg, 1 cm).
       bsc.Add(r.accepted && deg < 0.1 && mm < 10, deg, mm);
 
       start = Clock::now();
-      pcl::SampleConsensusPrerejective<pcl::PointNormal,
-                                       pcl::PointNormal,
-                                       pcl::FPFHSignature33>
+      pcl::SampleConsensusPrerejective<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33>
           align;
       align.setInputSource(fpfh[j].points);
       align.setSourceFeatures(fpfh[j].features);
@@ -143,8 +130,8 @@ int Main(int argc, char** argv) {
       align.align(aligned);
       Eigen::Isometry3d rough = Eigen::Isometry3d::Identity();
       rough.matrix() = align.getFinalTransformation().cast<double>();
-      const IcpResult fine = PointToPlaneIcp(
-          ours[j]->cloud, ours[i]->cloud, *ours[i]->tree, rough, options.icp);
+      const IcpResult fine =
+          PointToPlaneIcp(ours[j]->cloud, ours[i]->cloud, *ours[i]->tree, rough, options.icp);
       pcl_tally.seconds += Since(start);
       error(fine.target_from_source, &deg, &mm);
       pcl_tally.Add(align.hasConverged() && deg < 0.1 && mm < 10, deg, mm);
@@ -156,20 +143,16 @@ int Main(int argc, char** argv) {
                "rotation error [deg] | "
                "mean / max translation error [mm] | total time [s] "
                "|\n|---|---|---|---|---|\n";
-  for (const auto& [name, t] :
-       {std::pair<std::string, Tally>{"BSC + RANSAC + ICP (ours)", bsc},
-        {"PCL FPFH + SampleConsensusPrerejective + same ICP", pcl_tally}}) {
-    std::cout << "| " << name << " | " << t.success << " / " << t.attempted
-              << " | ";
+  for (const auto& [name, t] : {std::pair<std::string, Tally>{"BSC + RANSAC + ICP (ours)", bsc},
+                                {"PCL FPFH + SampleConsensusPrerejective + same ICP", pcl_tally}}) {
+    std::cout << "| " << name << " | " << t.success << " / " << t.attempted << " | ";
     if (t.success == 0) {
       std::cout << "n/a | n/a";  // no registered pair to measure
     } else {
-      std::cout << t.sum_deg / t.success << " / " << t.max_deg << " | "
-                << std::setprecision(2) << t.sum_mm / t.success << " / "
-                << t.max_mm;
+      std::cout << t.sum_deg / t.success << " / " << t.max_deg << " | " << std::setprecision(2)
+                << t.sum_mm / t.success << " / " << t.max_mm;
     }
-    std::cout << " | " << std::setprecision(1) << t.seconds << " |"
-              << std::setprecision(3) << "\n";
+    std::cout << " | " << std::setprecision(1) << t.seconds << " |" << std::setprecision(3) << "\n";
   }
   return 0;
 }

@@ -18,34 +18,29 @@ cv::Mat RenderImage(const Scene& scene,
   cv::Mat image(height, width, CV_8UC1);
   if (depth) depth->create(height, width, CV_32F);
   const colmap::Rigid3d world_from_cam = colmap::Inverse(cam_from_world);
-  const Eigen::Matrix3d world_from_cam_rotation =
-      world_from_cam.rotation.toRotationMatrix();
+  const Eigen::Matrix3d world_from_cam_rotation = world_from_cam.rotation.toRotationMatrix();
   const Eigen::Vector3d& origin = world_from_cam.translation;
 #pragma omp parallel for schedule(dynamic, 8)
   for (int row = 0; row < height; ++row) {
     std::mt19937_64 rng(options.seed * 1000003ull + row);
     std::normal_distribution<double> noise(0, options.pixel_noise);
     for (int col = 0; col < width; ++col) {
-      const Eigen::Vector2d ray_in_cam =
-          camera.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5));
+      const Eigen::Vector2d ray_in_cam = camera.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5));
       const Eigen::Vector3d ray = ray_in_cam.homogeneous();
-      const Eigen::Vector3d direction =
-          (world_from_cam_rotation * ray).normalized();
+      const Eigen::Vector3d direction = (world_from_cam_rotation * ray).normalized();
       RayHit hit;
       double value = 0;  // sky: black
       float z = 0;
       if (scene.Intersect(origin, direction, 1e3, &hit)) {
         const Eigen::Vector3d point = origin + hit.t * direction;
         value = scene.Shade(point, hit.normal, hit.primitive);
-        z = static_cast<float>(hit.t /
-                               ray.norm());  // z-depth along the optical axis
+        z = static_cast<float>(hit.t / ray.norm());  // z-depth along the optical axis
       }
       if (options.vignetting) {
         value *= std::pow(1.0 / ray.norm(), 4);
       }
       if (options.pixel_noise > 0) value += noise(rng);
-      image.at<uint8_t>(row, col) =
-          static_cast<uint8_t>(std::clamp(std::lround(value), 0l, 255l));
+      image.at<uint8_t>(row, col) = static_cast<uint8_t>(std::clamp(std::lround(value), 0l, 255l));
       if (depth) depth->at<float>(row, col) = z;
     }
   }
@@ -58,12 +53,10 @@ PointCloud ScanLidar(const Scene& scene,
   constexpr int kNumBeams = 16;
   // Azimuth samples per revolution (1800 = 0.2 deg at full density) and motor positions over 180 deg.
   const double per_beam = static_cast<double>(options.num_points) / kNumBeams;
-  const int num_azimuths = std::clamp(
-      static_cast<int>(std::lround(std::sqrt(per_beam * 20))), 60, 1800);
-  const int num_motor_steps =
-      std::max(2, static_cast<int>(std::ceil(per_beam / num_azimuths)));
-  const Eigen::Matrix3d world_from_lidar_rotation =
-      world_from_lidar.rotation.toRotationMatrix();
+  const int num_azimuths =
+      std::clamp(static_cast<int>(std::lround(std::sqrt(per_beam * 20))), 60, 1800);
+  const int num_motor_steps = std::max(2, static_cast<int>(std::ceil(per_beam / num_azimuths)));
+  const Eigen::Matrix3d world_from_lidar_rotation = world_from_lidar.rotation.toRotationMatrix();
   std::vector<PointCloud> per_step(num_motor_steps);
 #pragma omp parallel for schedule(dynamic, 1)
   for (int m = 0; m < num_motor_steps; ++m) {
@@ -79,18 +72,14 @@ PointCloud ScanLidar(const Scene& scene,
       const double azimuth = 2 * M_PI * (a + 0.37 * m) / num_azimuths;
       for (int b = 0; b < kNumBeams; ++b) {
         const double elevation = (-15.0 + 2.0 * b) * M_PI / 180.0;
-        const Eigen::Vector3d ray_in_head(
-            std::cos(elevation) * std::cos(azimuth),
-            std::cos(elevation) * std::sin(azimuth),
-            std::sin(elevation));
+        const Eigen::Vector3d ray_in_head(std::cos(elevation) * std::cos(azimuth),
+                                          std::cos(elevation) * std::sin(azimuth),
+                                          std::sin(elevation));
         const Eigen::Vector3d ray_in_lidar = lidar_from_head * ray_in_head;
-        const Eigen::Vector3d ray_in_world =
-            world_from_lidar_rotation * ray_in_lidar;
+        const Eigen::Vector3d ray_in_world = world_from_lidar_rotation * ray_in_lidar;
         RayHit hit;
-        if (!scene.Intersect(world_from_lidar.translation,
-                             ray_in_world,
-                             options.max_range_m,
-                             &hit)) {
+        if (!scene.Intersect(
+                world_from_lidar.translation, ray_in_world, options.max_range_m, &hit)) {
           continue;
         }
         double range = hit.t;
@@ -98,26 +87,20 @@ PointCloud ScanLidar(const Scene& scene,
           // A second ray 0.17 deg away stands in for the beam's footprint: across a depth edge the
           // sensor reports the average of both returns ("mixed pixels") about a third of the time.
           const Eigen::Vector3d offset_ray =
-              (ray_in_world +
-               0.003 * ray_in_world.cross(Eigen::Vector3d::UnitZ()))
-                  .normalized();
+              (ray_in_world + 0.003 * ray_in_world.cross(Eigen::Vector3d::UnitZ())).normalized();
           RayHit other;
-          if (scene.Intersect(world_from_lidar.translation,
-                              offset_ray,
-                              options.max_range_m,
-                              &other) &&
+          if (scene.Intersect(
+                  world_from_lidar.translation, offset_ray, options.max_range_m, &other) &&
               std::abs(other.t - hit.t) > 0.1 && unit(rng) < 0.35) {
             range = 0.5 * (hit.t + other.t);
           }
         }
-        const Eigen::Vector3d point_in_world =
-            world_from_lidar.translation + hit.t * ray_in_world;
+        const Eigen::Vector3d point_in_world = world_from_lidar.translation + hit.t * ray_in_world;
         const double cos_incidence = std::abs(hit.normal.dot(ray_in_world));
         if (options.range_noise_m > 0) range += noise(rng);
         cloud.points.push_back(range * ray_in_lidar);
         cloud.intensities.push_back(static_cast<float>(
-            255.0 * scene.Albedo(point_in_world, hit.primitive) *
-            cos_incidence));
+            255.0 * scene.Albedo(point_in_world, hit.primitive) * cos_incidence));
       }
     }
   }
@@ -126,11 +109,9 @@ PointCloud ScanLidar(const Scene& scene,
   for (const PointCloud& part : per_step) total += part.Size();
   cloud.Reserve(total, false, false, true);
   for (PointCloud& part : per_step) {
-    cloud.points.insert(
-        cloud.points.end(), part.points.begin(), part.points.end());
-    cloud.intensities.insert(cloud.intensities.end(),
-                             part.intensities.begin(),
-                             part.intensities.end());
+    cloud.points.insert(cloud.points.end(), part.points.begin(), part.points.end());
+    cloud.intensities.insert(
+        cloud.intensities.end(), part.intensities.begin(), part.intensities.end());
   }
   return cloud;
 }

@@ -13,9 +13,8 @@ namespace colmap_lidar {
 namespace sim {
 
 struct ImageOptions {
-  double pixel_noise =
-      1.0;  // std. dev. of additive Gaussian noise, grey levels of 255
-  bool vignetting = false;  // cos^4 fall-off
+  double pixel_noise = 1.0;  // std. dev. of additive Gaussian noise, grey levels of 255
+  bool vignetting = false;   // cos^4 fall-off
   uint64_t seed = 0;
 };
 
@@ -28,8 +27,7 @@ cv::Mat RenderImage(const Scene& scene,
                     cv::Mat* depth);
 
 struct LidarOptions {
-  size_t num_points =
-      1600000;  // rays per station (the seed's 20 s accumulation gives ~1.6 M)
+  size_t num_points = 1600000;  // rays per station (the seed's 20 s accumulation gives ~1.6 M)
   double range_noise_m = 0.01;  // std. dev. along the ray
   double max_range_m = 100;
   bool mixed_edge_points =

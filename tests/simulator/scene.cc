@@ -31,15 +31,14 @@ double ValueNoise(const Eigen::Vector3d& p, uint32_t seed) {
   const Eigen::Vector3d f = p.array().floor();
   const Eigen::Vector3d r = p - f;
   const Eigen::Vector3d s = r.array() * r.array() * (3.0 - 2.0 * r.array());
-  const int64_t x = static_cast<int64_t>(f.x()),
-                y = static_cast<int64_t>(f.y()),
+  const int64_t x = static_cast<int64_t>(f.x()), y = static_cast<int64_t>(f.y()),
                 z = static_cast<int64_t>(f.z());
   double value = 0;
   for (int dz = 0; dz < 2; ++dz) {
     for (int dy = 0; dy < 2; ++dy) {
       for (int dx = 0; dx < 2; ++dx) {
-        const double w = (dx ? s.x() : 1 - s.x()) * (dy ? s.y() : 1 - s.y()) *
-                         (dz ? s.z() : 1 - s.z());
+        const double w =
+            (dx ? s.x() : 1 - s.x()) * (dy ? s.y() : 1 - s.y()) * (dz ? s.z() : 1 - s.z());
         value += w * LatticeValue(x + dx, y + dy, z + dz, seed);
       }
     }
@@ -112,8 +111,7 @@ bool IntersectCylinder(const Primitive& cyl,
       for (const double t : {(-b - sq) / a, (-b + sq) / a}) {
         if (t > 1e-6 && t < best && std::abs(o.z() + t * dir.z()) <= h) {
           best = t;
-          best_normal =
-              Eigen::Vector3d(o.x() + t * dir.x(), o.y() + t * dir.y(), 0) / r;
+          best_normal = Eigen::Vector3d(o.x() + t * dir.x(), o.y() + t * dir.y(), 0) / r;
         }
       }
     }
@@ -142,8 +140,7 @@ bool IntersectGround(const Primitive& ground,
   if (dir.z() > -kEps || origin.z() <= 0) return false;
   const double t = -origin.z() / dir.z();
   const Eigen::Vector3d p = origin + t * dir;
-  if (std::abs(p.x()) > ground.half_size.x() ||
-      std::abs(p.y()) > ground.half_size.y()) {
+  if (std::abs(p.x()) > ground.half_size.x() || std::abs(p.y()) > ground.half_size.y()) {
     return false;
   }
   *t_hit = t;
@@ -288,8 +285,7 @@ double Scene::Albedo(const Eigen::Vector3d& point, int primitive) const {
     fbm += kAmplitudes[o] * (ValueNoise(point / kScales[o], 17 + o) - 0.5);
   }
   const double pores = SmoothStep(0.72, 0.8, ValueNoise(point / 0.015, 101));
-  const double albedo =
-      p.albedo * (1 + p.texture_contrast * 2 * fbm) * (1 - 0.55 * pores);
+  const double albedo = p.albedo * (1 + p.texture_contrast * 2 * fbm) * (1 - 0.55 * pores);
   return std::clamp(albedo, 0.03, 1.0);
 }
 
@@ -297,16 +293,14 @@ double Scene::Shade(const Eigen::Vector3d& point,
                     const Eigen::Vector3d& normal,
                     int primitive) const {
   const double diffuse = std::max(0.0, normal.dot(sun_direction_));
-  return std::clamp(
-      255.0 * Albedo(point, primitive) * (0.45 + 0.6 * diffuse), 0.0, 255.0);
+  return std::clamp(255.0 * Albedo(point, primitive) * (0.45 + 0.6 * diffuse), 0.0, 255.0);
 }
 
 bool Scene::InsideObject(const Eigen::Vector3d& point, double tolerance) const {
   for (const Primitive& p : primitives_) {
     if (!p.is_object) continue;
     if (p.type == Primitive::Type::kBox) {
-      const Eigen::Vector3d local =
-          RotZ(p.yaw).transpose() * (point - p.center);
+      const Eigen::Vector3d local = RotZ(p.yaw).transpose() * (point - p.center);
       if ((local.cwiseAbs() - p.half_size).maxCoeff() <= tolerance) return true;
     } else if (p.type == Primitive::Type::kCylinder) {
       const Eigen::Vector3d d = point - p.center;
@@ -321,9 +315,7 @@ bool Scene::InsideObject(const Eigen::Vector3d& point, double tolerance) const {
 
 PointCloud Scene::SampleObjectSurface(double spacing) const {
   PointCloud cloud;
-  auto keep = [&](const Eigen::Vector3d& point,
-                  const Eigen::Vector3d& normal,
-                  size_t self) {
+  auto keep = [&](const Eigen::Vector3d& point, const Eigen::Vector3d& normal, size_t self) {
     if (point.z() < 1e-4) return;  // resting on the ground
     // Drop samples on or inside another object primitive (hidden faces of a union).
     for (size_t j = 0; j < primitives_.size(); ++j) {
@@ -342,10 +334,8 @@ PointCloud Scene::SampleObjectSurface(double spacing) const {
       const Eigen::Matrix3d R = RotZ(p.yaw);
       for (int axis = 0; axis < 3; ++axis) {
         const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-        const int nu = std::max(
-            1, static_cast<int>(std::ceil(2 * p.half_size[u] / spacing)));
-        const int nv = std::max(
-            1, static_cast<int>(std::ceil(2 * p.half_size[v] / spacing)));
+        const int nu = std::max(1, static_cast<int>(std::ceil(2 * p.half_size[u] / spacing)));
+        const int nv = std::max(1, static_cast<int>(std::ceil(2 * p.half_size[v] / spacing)));
         for (const double side : {-1.0, 1.0}) {
           Eigen::Vector3d n = Eigen::Vector3d::Zero();
           n[axis] = side;
@@ -368,10 +358,7 @@ PointCloud Scene::SampleObjectSurface(double spacing) const {
         const double theta = 2 * M_PI * (a + 0.5) / n_theta;
         const Eigen::Vector3d n(std::cos(theta), std::sin(theta), 0);
         for (int b = 0; b < n_z; ++b) {
-          keep(p.center + r * n +
-                   Eigen::Vector3d(0, 0, -h + (b + 0.5) * 2 * h / n_z),
-               n,
-               i);
+          keep(p.center + r * n + Eigen::Vector3d(0, 0, -h + (b + 0.5) * 2 * h / n_z), n, i);
         }
       }
       const int n_cap = static_cast<int>(std::ceil(2 * r / spacing));

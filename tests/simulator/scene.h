@@ -16,18 +16,16 @@ namespace sim {
 struct Primitive {
   enum class Type { kBox, kCylinder, kGround };
   Type type = Type::kBox;
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // box/cylinder centre
-  Eigen::Vector3d half_size =
-      Eigen::Vector3d::Ones();  // box half extents; cylinder: (r, r, h/2)
-  double yaw = 0;               // box rotation about world z [rad]
-  bool is_object =
-      false;  // part of the scanned structure (sampled into surface.ply)
-  double albedo = 0.6;  // mean albedo in [0, 1]
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();     // box/cylinder centre
+  Eigen::Vector3d half_size = Eigen::Vector3d::Ones();  // box half extents; cylinder: (r, r, h/2)
+  double yaw = 0;                                       // box rotation about world z [rad]
+  bool is_object = false;  // part of the scanned structure (sampled into surface.ply)
+  double albedo = 0.6;     // mean albedo in [0, 1]
   double texture_contrast = 0.45;
 };
 
 struct RayHit {
-  double t = 0;  // distance along the unit ray
+  double t = 0;                                      // distance along the unit ray
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, facing the ray
   int primitive = -1;
 };
@@ -55,8 +53,7 @@ class Scene {
   // ground are dropped), on a grid of the given spacing, with outward normals.
   PointCloud SampleObjectSurface(double spacing) const;
   // True if the point lies on or inside an object primitive (within `tolerance`).
-  bool InsideObject(const Eigen::Vector3d& point_in_world,
-                    double tolerance) const;
+  bool InsideObject(const Eigen::Vector3d& point_in_world, double tolerance) const;
 
   const std::string& Name() const { return name_; }
   const std::vector<Primitive>& Primitives() const { return primitives_; }
@@ -84,8 +81,7 @@ class Scene {
   Eigen::Vector3d object_center_ = Eigen::Vector3d::Zero();
   double object_radius_ = 1;
   double object_height_ = 1;
-  Eigen::Vector3d sun_direction_ =
-      Eigen::Vector3d(0.4, -0.3, 0.866).normalized();
+  Eigen::Vector3d sun_direction_ = Eigen::Vector3d(0.4, -0.3, 0.866).normalized();
 };
 
 }  // namespace sim

@@ -17,23 +17,18 @@ constexpr double kDegToRad = M_PI / 180.0;
 // world_from_cam rotation of a camera with heading `yaw` (angle of the optical axis in the ground
 // plane, from world x towards y), pitched up by `pitch` and rolled by `roll` about its optical axis.
 Eigen::Matrix3d WorldFromCamRotation(double yaw, double pitch, double roll) {
-  const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw),
-                                std::cos(pitch) * std::sin(yaw),
-                                std::sin(pitch));
-  const Eigen::Vector3d right =
-      forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d forward(
+      std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
   const Eigen::Vector3d down = forward.cross(right);
   Eigen::Matrix3d world_from_cam;
   world_from_cam << right, down, forward;
-  return world_from_cam *
-         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return world_from_cam * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
-colmap::Rigid3d CamFromWorld(const Eigen::Matrix3d& world_from_cam,
-                             const Eigen::Vector3d& center) {
+colmap::Rigid3d CamFromWorld(const Eigen::Matrix3d& world_from_cam, const Eigen::Vector3d& center) {
   const Eigen::Matrix3d cam_from_world = world_from_cam.transpose();
-  return colmap::Rigid3d(Eigen::Quaterniond(cam_from_world),
-                         -cam_from_world * center);
+  return colmap::Rigid3d(Eigen::Quaterniond(cam_from_world), -cam_from_world * center);
 }
 
 }  // namespace
@@ -42,9 +37,8 @@ Motion MotionFromName(const std::string& name) {
   if (name == "two_axes") return Motion::kTwoAxes;
   if (name == "one_axis") return Motion::kOneAxis;
   if (name == "fixed_rotation") return Motion::kFixedRotation;
-  throw std::invalid_argument(
-      "Unknown --motion '" + name +
-      "'; expected two_axes, one_axis or fixed_rotation");
+  throw std::invalid_argument("Unknown --motion '" + name +
+                              "'; expected two_axes, one_axis or fixed_rotation");
 }
 
 StationRig MakeStereoRig(double image_scale) {
@@ -56,8 +50,8 @@ StationRig MakeStereoRig(double image_scale) {
       colmap::kInvalidCameraId, "PINHOLE", focal, width, height);
   rig.right = rig.left;
   // The right camera sits 0.38 m to the right, with a small residual misalignment as on a real bar.
-  rig.right_from_left.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(
-      0.15 * kDegToRad, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
+  rig.right_from_left.rotation = Eigen::Quaterniond(
+      Eigen::AngleAxisd(0.15 * kDegToRad, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
   rig.right_from_left.translation = Eigen::Vector3d(-0.38, 0.0, 0.0);
   rig.lidar_model = "VLP-16";
   return rig;
@@ -86,14 +80,11 @@ colmap::Rigid3d PerturbPose(const colmap::Rigid3d& truth,
                             uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal;
-  const Eigen::Vector3d axis =
-      Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-  const Eigen::Vector3d shift =
-      Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  const Eigen::Vector3d shift = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
   colmap::Rigid3d perturbed = truth;
   perturbed.rotation =
-      (Eigen::Quaterniond(Eigen::AngleAxisd(rotation_deg * kDegToRad, axis)) *
-       truth.rotation)
+      (Eigen::Quaterniond(Eigen::AngleAxisd(rotation_deg * kDegToRad, axis)) * truth.rotation)
           .normalized();
   perturbed.translation += translation_m * shift;
   return perturbed;
@@ -114,8 +105,7 @@ std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
   if (motion == Motion::kFixedRotation) {
     // A line of stations in front of the structure, all with the same orientation.
     const double yaw = M_PI / 2;  // looking along +y from the -y side
-    const Eigen::Matrix3d world_from_cam =
-        WorldFromCamRotation(yaw, ring_pitch, 0);
+    const Eigen::Matrix3d world_from_cam = WorldFromCamRotation(yaw, ring_pitch, 0);
     const double distance = scene.ObjectRadius() + 2.3;
     for (int i = 0; i < num_stations; ++i) {
       const double s = -1.2 + 2.4 * i / (num_stations - 1);
@@ -127,43 +117,34 @@ std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
   }
 
   // About a fifth of the stations tilted (at least one), never more than half.
-  const int num_tilted =
-      motion == Motion::kTwoAxes
-          ? std::min(std::max(1, (num_stations + 2) / 5), num_stations / 2)
-          : 0;
+  const int num_tilted = motion == Motion::kTwoAxes
+                             ? std::min(std::max(1, (num_stations + 2) / 5), num_stations / 2)
+                             : 0;
   const int num_ring = num_stations - num_tilted;
-  auto ring_azimuth = [&](double k) {
-    return 2 * M_PI * k / num_ring - M_PI / 2;
-  };
+  auto ring_azimuth = [&](double k) { return 2 * M_PI * k / num_ring - M_PI / 2; };
   for (int i = 0; i < num_ring; ++i) {
-    const double azimuth =
-        ring_azimuth(i);  // position of the station around the structure
+    const double azimuth = ring_azimuth(i);  // position of the station around the structure
     const double distance = scene.ObjectRadius() + 2.0 + 0.8 * unit(rng);
     const Eigen::Vector3d center =
         c + distance * Eigen::Vector3d(std::cos(azimuth), std::sin(azimuth), 0);
     const Eigen::Vector3d eye(
         center.x(), center.y(), look_height + distance * std::tan(-ring_pitch));
     const double yaw = azimuth + M_PI + 0.06 * (unit(rng) - 0.5);
-    stations.push_back(
-        CamFromWorld(WorldFromCamRotation(yaw, ring_pitch, 0), eye));
+    stations.push_back(CamFromWorld(WorldFromCamRotation(yaw, ring_pitch, 0), eye));
   }
   // Stations tilted up from near the ground, between the tripod ones, with alternating roll.
   for (int i = 0; i < num_tilted; ++i) {
-    const double azimuth =
-        ring_azimuth((i + 0.5) * num_ring / double(num_tilted));
+    const double azimuth = ring_azimuth((i + 0.5) * num_ring / double(num_tilted));
     const double distance = scene.ObjectRadius() + 2.2 + 0.5 * unit(rng);
     const Eigen::Vector3d eye =
         c + distance * Eigen::Vector3d(std::cos(azimuth), std::sin(azimuth), 0);
-    const double pitch = std::atan2(look_height - 0.45, distance) +
-                         (8 + 6 * unit(rng)) * kDegToRad;
+    const double pitch = std::atan2(look_height - 0.45, distance) + (8 + 6 * unit(rng)) * kDegToRad;
     const double roll = (i % 2 ? 1 : -1) * (6 + 4 * unit(rng)) * kDegToRad;
-    stations.push_back(
-        CamFromWorld(WorldFromCamRotation(azimuth + M_PI, pitch, roll),
-                     Eigen::Vector3d(eye.x(), eye.y(), 0.45)));
+    stations.push_back(CamFromWorld(WorldFromCamRotation(azimuth + M_PI, pitch, roll),
+                                    Eigen::Vector3d(eye.x(), eye.y(), 0.45)));
   }
   for (const colmap::Rigid3d& station : stations) {
-    if (!station.translation.allFinite() ||
-        !station.rotation.coeffs().allFinite()) {
+    if (!station.translation.allFinite() || !station.rotation.coeffs().allFinite()) {
       throw std::logic_error("Simulator produced a non-finite station pose");
     }
   }

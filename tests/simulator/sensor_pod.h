@@ -19,8 +19,7 @@ enum class Motion {
   kOneAxis,  // every relative rotation about the vertical axis: T_e translation along it unobservable
   kFixedRotation,  // pure translations: T_e translation unobservable
 };
-Motion MotionFromName(
-    const std::string& name);  // "two_axes", "one_axis", "fixed_rotation"
+Motion MotionFromName(const std::string& name);  // "two_axes", "one_axis", "fixed_rotation"
 
 // Left and right PINHOLE cameras of width 1028*image_scale with a 48 deg horizontal FOV, 0.38 m baseline.
 StationRig MakeStereoRig(double image_scale);

@@ -12,15 +12,13 @@ struct SimulationOptions {
   std::string output_path;
   int num_stations = 25;
   std::string motion = "two_axes";  // two_axes | one_axis | fixed_rotation
-  double image_scale =
-      1.0;  // 1 = 1028x752 per camera, 4 = the seed's 4112x3008
-  size_t lidar_points = 1600000;  // LiDAR rays per station
+  double image_scale = 1.0;         // 1 = 1028x752 per camera, 4 = the seed's 4112x3008
+  size_t lidar_points = 1600000;    // LiDAR rays per station
   double range_noise_m = 0.01;
   double pixel_noise = 1.0;  // grey levels
   bool vignetting = false;
   bool mixed_edge_points = false;
-  double guess_rotation_deg =
-      3.0;  // cam_from_lidar_guess = truth perturbed by this much
+  double guess_rotation_deg = 3.0;  // cam_from_lidar_guess = truth perturbed by this much
   double guess_translation_m = 0.05;
   bool write_guess = true;
   double surface_spacing_m = 0.005;  // grid of ground_truth/surface.ply

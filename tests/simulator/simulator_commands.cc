@@ -15,26 +15,20 @@ int RunSimulateDataset(int argc, char** argv) {
   colmap::OptionManager manager;
   manager.AddRequiredOption("output_path", &options.output_path);
   manager.AddDefaultOption(
-      "scene",
-      &options.scene,
-      "t_specimen | square_pillar | cylinder_pillar | bridge_pier");
+      "scene", &options.scene, "t_specimen | square_pillar | cylinder_pillar | bridge_pier");
   manager.AddDefaultOption("num_stations", &options.num_stations);
+  manager.AddDefaultOption("motion", &options.motion, "two_axes | one_axis | fixed_rotation");
   manager.AddDefaultOption(
-      "motion", &options.motion, "two_axes | one_axis | fixed_rotation");
-  manager.AddDefaultOption("image_scale",
-                           &options.image_scale,
-                           "1 = 1028x752 per camera, 4 = 4112x3008");
-  manager.AddDefaultOption(
-      "lidar_points", &lidar_points, "LiDAR rays per station");
+      "image_scale", &options.image_scale, "1 = 1028x752 per camera, 4 = 4112x3008");
+  manager.AddDefaultOption("lidar_points", &lidar_points, "LiDAR rays per station");
   manager.AddDefaultOption("range_noise_m", &options.range_noise_m);
   manager.AddDefaultOption("pixel_noise", &options.pixel_noise, "grey levels");
   manager.AddDefaultOption("vignetting", &options.vignetting);
   manager.AddDefaultOption("mixed_edge_points", &options.mixed_edge_points);
   manager.AddDefaultOption("guess_rotation_deg", &options.guess_rotation_deg);
   manager.AddDefaultOption("guess_translation_m", &options.guess_translation_m);
-  manager.AddDefaultOption("write_guess",
-                           &options.write_guess,
-                           "write cam_from_lidar_guess into rig.json");
+  manager.AddDefaultOption(
+      "write_guess", &options.write_guess, "write cam_from_lidar_guess into rig.json");
   manager.AddDefaultOption("surface_spacing_m", &options.surface_spacing_m);
   manager.AddDefaultOption("seed", &seed);
   manager.AddDefaultOption("overwrite", &options.overwrite);
@@ -42,11 +36,10 @@ int RunSimulateDataset(int argc, char** argv) {
   options.seed = static_cast<uint64_t>(seed);
   options.lidar_points = static_cast<size_t>(std::max(0, lidar_points));
   const sim::SimulationResult result = sim::SimulateDataset(options);
-  std::cout << "simulate_dataset: wrote " << result.num_stations
-            << " stations of scene " << options.scene << " to "
-            << options.output_path << " (" << result.num_lidar_points
-            << " LiDAR points, " << result.num_surface_points
-            << " surface samples) in " << result.seconds << " s" << std::endl;
+  std::cout << "simulate_dataset: wrote " << result.num_stations << " stations of scene "
+            << options.scene << " to " << options.output_path << " (" << result.num_lidar_points
+            << " LiDAR points, " << result.num_surface_points << " surface samples) in "
+            << result.seconds << " s" << std::endl;
   return EXIT_SUCCESS;
 }
 

@@ -23,28 +23,22 @@ namespace {
 
 double Median(std::vector<double> values) {
   if (values.empty()) return std::nan("");
-  std::nth_element(
-      values.begin(), values.begin() + values.size() / 2, values.end());
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
   return values[values.size() / 2];
 }
 
 double Bilinear(const cv::Mat& image, double x, double y) {
   // (x, y) in COLMAP's convention: pixel centres at +0.5.
   const double u = x - 0.5, v = y - 0.5;
-  const int u0 = static_cast<int>(std::floor(u)),
-            v0 = static_cast<int>(std::floor(v));
-  if (u0 < 0 || v0 < 0 || u0 + 1 >= image.cols || v0 + 1 >= image.rows)
-    return -1;
+  const int u0 = static_cast<int>(std::floor(u)), v0 = static_cast<int>(std::floor(v));
+  if (u0 < 0 || v0 < 0 || u0 + 1 >= image.cols || v0 + 1 >= image.rows) return -1;
   const double a = u - u0, b = v - v0;
-  auto at = [&](int r, int c) {
-    return static_cast<double>(image.at<uint8_t>(r, c));
-  };
+  auto at = [&](int r, int c) { return static_cast<double>(image.at<uint8_t>(r, c)); };
   return (1 - a) * (1 - b) * at(v0, u0) + a * (1 - b) * at(v0, u0 + 1) +
          (1 - a) * b * at(v0 + 1, u0) + a * b * at(v0 + 1, u0 + 1);
 }
 
-sim::SimulationOptions NoiseFreeOptions(const std::string& scene,
-                                        const std::string& output_path) {
+sim::SimulationOptions NoiseFreeOptions(const std::string& scene, const std::string& output_path) {
   sim::SimulationOptions options;
   options.scene = scene;
   options.output_path = output_path;
@@ -67,12 +61,10 @@ TEST_P(SimulatorSceneTest, LidarPointsLandOnTheTrueSurface) {
   EXPECT_EQ(result.num_stations, 3);
   const StationDataset dataset = ReadStationDataset(root);
   ASSERT_EQ(dataset.stations.size(), 3u);
-  const auto cam_from_world =
-      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
   const colmap::Rigid3d cam_from_lidar =
       ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
-  const PointCloud surface =
-      ReadPointCloud(dataset.GroundTruthPath("surface.ply"));
+  const PointCloud surface = ReadPointCloud(dataset.GroundTruthPath("surface.ply"));
   ASSERT_TRUE(surface.HasNormals());
   const KdTree3 tree(surface.points);
   const sim::Scene scene = sim::Scene::Create(GetParam());
@@ -81,22 +73,19 @@ TEST_P(SimulatorSceneTest, LidarPointsLandOnTheTrueSurface) {
     const PointCloud cloud = ReadPointCloud(dataset.cloud_paths[i]);
     // world_from_lidar = inverse(cam_from_world) * cam_from_lidar
     const colmap::Rigid3d world_from_lidar =
-        colmap::Inverse(cam_from_world.at(dataset.stations[i])) *
-        cam_from_lidar;
+        colmap::Inverse(cam_from_world.at(dataset.stations[i])) * cam_from_lidar;
     size_t num_on_object = 0;
     double max_distance = 0;
     for (const Eigen::Vector3d& point_in_lidar : cloud.points) {
       const Eigen::Vector3d point_in_world = world_from_lidar * point_in_lidar;
       // Near the structure but not on the ground around its base (surface.ply has no ground).
-      if (!scene.InsideObject(point_in_world, 0.01) ||
-          point_in_world.z() < 0.01) {
+      if (!scene.InsideObject(point_in_world, 0.01) || point_in_world.z() < 0.01) {
         continue;
       }
       ++num_on_object;
       max_distance = std::max(
           max_distance,
-          DistanceToSampledSurface(
-              surface, tree, options.surface_spacing_m, point_in_world));
+          DistanceToSampledSurface(surface, tree, options.surface_spacing_m, point_in_world));
     }
     EXPECT_GT(num_on_object, 200u) << "station " << i;
     // Float32 storage of the clouds (~1e-6 m) is the only error left with noise off: sub-mm.
@@ -104,16 +93,13 @@ TEST_P(SimulatorSceneTest, LidarPointsLandOnTheTrueSurface) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllScenes,
-                         SimulatorSceneTest,
-                         ::testing::ValuesIn(sim::Scene::Names()));
+INSTANTIATE_TEST_SUITE_P(AllScenes, SimulatorSceneTest, ::testing::ValuesIn(sim::Scene::Names()));
 
 // Full-resolution, noise-free images of two stations of each scene (the texture is not aliased there).
 class SimulatorImageTest : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
-    sim::SimulationOptions options =
-        NoiseFreeOptions(GetParam(), dir_.File("d"));
+    sim::SimulationOptions options = NoiseFreeOptions(GetParam(), dir_.File("d"));
     options.num_stations = 2;
     options.lidar_points = 2000;
     options.image_scale = 1.0;
@@ -126,19 +112,15 @@ class SimulatorImageTest : public ::testing::TestWithParam<std::string> {
 };
 
 TEST_P(SimulatorImageTest, ProjectedSurfacePointsShowTheirTextureAndDepth) {
-  const auto cam_from_world =
-      ReadNamedPoses(dataset_.GroundTruthPath("cam_from_world.txt"));
-  const PointCloud surface =
-      ReadPointCloud(dataset_.GroundTruthPath("surface.ply"));
+  const auto cam_from_world = ReadNamedPoses(dataset_.GroundTruthPath("cam_from_world.txt"));
+  const PointCloud surface = ReadPointCloud(dataset_.GroundTruthPath("surface.ply"));
   const sim::Scene scene = sim::Scene::Create(GetParam());
   const colmap::Camera& camera = dataset_.rig.left;
   for (size_t i = 0; i < dataset_.stations.size(); ++i) {
-    const cv::Mat image =
-        cv::imread(dataset_.LeftImagePath(i), cv::IMREAD_GRAYSCALE);
+    const cv::Mat image = cv::imread(dataset_.LeftImagePath(i), cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(image.empty());
     colmap::mvs::DepthMap depth;
-    depth.Read(
-        dataset_.GroundTruthPath("depth/" + dataset_.stations[i] + ".bin"));
+    depth.Read(dataset_.GroundTruthPath("depth/" + dataset_.stations[i] + ".bin"));
     ASSERT_EQ(depth.GetWidth(), camera.width);
     const colmap::Rigid3d& pose = cam_from_world.at(dataset_.stations[i]);
     // A pose 5 mm off, as a control: the same comparison must then fail clearly.
@@ -151,8 +133,7 @@ TEST_P(SimulatorImageTest, ProjectedSurfacePointsShowTheirTextureAndDepth) {
       const Eigen::Vector3d point_in_cam = pose * point;
       if (point_in_cam.z() < 0.1) continue;
       const Eigen::Vector2d xy = camera.ImgFromCam(point_in_cam.hnormalized());
-      if (xy.x() < 2 || xy.y() < 2 || xy.x() > camera.width - 2 ||
-          xy.y() > camera.height - 2) {
+      if (xy.x() < 2 || xy.y() < 2 || xy.x() > camera.width - 2 || xy.y() > camera.height - 2) {
         continue;
       }
       // Visible: the first hit from the camera centre towards the point is the point itself.
@@ -165,38 +146,30 @@ TEST_P(SimulatorImageTest, ProjectedSurfacePointsShowTheirTextureAndDepth) {
       // Away from silhouettes, where a pixel sees two surfaces.
       if (std::abs(surface.normals[k].dot(ray)) < 0.3) continue;
       const double expected = scene.Shade(point, hit.normal, hit.primitive);
-      texture_errors.push_back(
-          std::abs(Bilinear(image, xy.x(), xy.y()) - expected));
-      const Eigen::Vector2d xy_shifted =
-          camera.ImgFromCam((shifted * point).hnormalized());
+      texture_errors.push_back(std::abs(Bilinear(image, xy.x(), xy.y()) - expected));
+      const Eigen::Vector2d xy_shifted = camera.ImgFromCam((shifted * point).hnormalized());
       shifted_errors.push_back(
           std::abs(Bilinear(image, xy_shifted.x(), xy_shifted.y()) - expected));
-      const float z =
-          depth.Get(static_cast<size_t>(xy.y()), static_cast<size_t>(xy.x()));
+      const float z = depth.Get(static_cast<size_t>(xy.y()), static_cast<size_t>(xy.x()));
       depth_errors.push_back(std::abs(z - point_in_cam.z()));
     }
     ASSERT_GT(texture_errors.size(), 1000u) << "station " << i;
     // Bilinear interpolation of a texture with 1 cm detail at ~2 mm pixels: a few grey levels.
     EXPECT_LT(Median(texture_errors), 4.0) << "station " << i;
-    EXPECT_GT(Median(shifted_errors), 2.5 * Median(texture_errors))
-        << "station " << i;
+    EXPECT_GT(Median(shifted_errors), 2.5 * Median(texture_errors)) << "station " << i;
     // Nearest-pixel depth on a slanted face: within a pixel footprint (~2 mm at 2.5 m).
     EXPECT_LT(Median(depth_errors), 0.002) << "station " << i;
   }
 }
 
-TEST_P(SimulatorImageTest,
-       LeftAndRightImagesAgreeThroughTheTrueDepthAndBaseline) {
+TEST_P(SimulatorImageTest, LeftAndRightImagesAgreeThroughTheTrueDepthAndBaseline) {
   const StationRig& rig = dataset_.rig;
   EXPECT_NEAR(rig.BaselineMeters(), 0.38, 1e-9);
   for (size_t i = 0; i < dataset_.stations.size(); ++i) {
-    const cv::Mat left =
-        cv::imread(dataset_.LeftImagePath(i), cv::IMREAD_GRAYSCALE);
-    const cv::Mat right =
-        cv::imread(dataset_.RightImagePath(i), cv::IMREAD_GRAYSCALE);
+    const cv::Mat left = cv::imread(dataset_.LeftImagePath(i), cv::IMREAD_GRAYSCALE);
+    const cv::Mat right = cv::imread(dataset_.RightImagePath(i), cv::IMREAD_GRAYSCALE);
     colmap::mvs::DepthMap depth;
-    depth.Read(
-        dataset_.GroundTruthPath("depth/" + dataset_.stations[i] + ".bin"));
+    depth.Read(dataset_.GroundTruthPath("depth/" + dataset_.stations[i] + ".bin"));
     colmap::Rigid3d wrong_baseline = rig.right_from_left;
     wrong_baseline.translation *= 0.4 / 0.38;
     std::vector<double> errors, wrong_errors;
@@ -205,16 +178,14 @@ TEST_P(SimulatorImageTest,
         const double z = depth.Get(row, col);
         if (z <= 0 || z > 6) continue;  // the structure and the ground near it
         const Eigen::Vector3d point_in_left =
-            z * rig.left.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5))
-                    .homogeneous();
+            z * rig.left.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5)).homogeneous();
         const double value = left.at<uint8_t>(row, col);
-        const Eigen::Vector2d in_right = rig.right.ImgFromCam(
-            (rig.right_from_left * point_in_left).hnormalized());
-        const Eigen::Vector2d in_right_wrong = rig.right.ImgFromCam(
-            (wrong_baseline * point_in_left).hnormalized());
+        const Eigen::Vector2d in_right =
+            rig.right.ImgFromCam((rig.right_from_left * point_in_left).hnormalized());
+        const Eigen::Vector2d in_right_wrong =
+            rig.right.ImgFromCam((wrong_baseline * point_in_left).hnormalized());
         const double r = Bilinear(right, in_right.x(), in_right.y());
-        const double w =
-            Bilinear(right, in_right_wrong.x(), in_right_wrong.y());
+        const double w = Bilinear(right, in_right_wrong.x(), in_right_wrong.y());
         if (r < 0 || w < 0) continue;
         errors.push_back(std::abs(r - value));
         wrong_errors.push_back(std::abs(w - value));
@@ -226,9 +197,7 @@ TEST_P(SimulatorImageTest,
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllScenes,
-                         SimulatorImageTest,
-                         ::testing::ValuesIn(sim::Scene::Names()));
+INSTANTIATE_TEST_SUITE_P(AllScenes, SimulatorImageTest, ::testing::ValuesIn(sim::Scene::Names()));
 
 std::string FileBytes(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
@@ -237,8 +206,7 @@ std::string FileBytes(const std::string& path) {
 
 TEST(SimulatorTest, DeterministicForAGivenSeed) {
   testing::ScopedTempDir dir;
-  sim::SimulationOptions options =
-      NoiseFreeOptions("cylinder_pillar", dir.File("a"));
+  sim::SimulationOptions options = NoiseFreeOptions("cylinder_pillar", dir.File("a"));
   options.range_noise_m = 0.01;
   options.pixel_noise = 1.0;
   options.num_stations = 2;
@@ -248,26 +216,21 @@ TEST(SimulatorTest, DeterministicForAGivenSeed) {
   options.output_path = dir.File("c");
   options.seed = 1;
   sim::SimulateDataset(options);
-  for (const char* file :
-       {"/lidar/001.pcd", "/images/left/001.png", "/rig.json"}) {
-    EXPECT_EQ(FileBytes(dir.File("a") + file), FileBytes(dir.File("b") + file))
-        << file;
-    EXPECT_NE(FileBytes(dir.File("a") + file), FileBytes(dir.File("c") + file))
-        << file;
+  for (const char* file : {"/lidar/001.pcd", "/images/left/001.png", "/rig.json"}) {
+    EXPECT_EQ(FileBytes(dir.File("a") + file), FileBytes(dir.File("b") + file)) << file;
+    EXPECT_NE(FileBytes(dir.File("a") + file), FileBytes(dir.File("c") + file)) << file;
   }
 }
 
 TEST(SimulatorTest, MixedEdgePointsFloatBetweenSurfaces) {
   testing::ScopedTempDir dir;
-  sim::SimulationOptions options =
-      NoiseFreeOptions("square_pillar", dir.File("d"));
+  sim::SimulationOptions options = NoiseFreeOptions("square_pillar", dir.File("d"));
   options.num_stations = 2;
   options.lidar_points = 60000;
   options.mixed_edge_points = true;
   sim::SimulateDataset(options);
   const StationDataset dataset = ReadStationDataset(dir.File("d"));
-  const auto cam_from_world =
-      ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
   const colmap::Rigid3d cam_from_lidar =
       ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
   const sim::Scene scene = sim::Scene::Create("square_pillar");
@@ -278,8 +241,7 @@ TEST(SimulatorTest, MixedEdgePointsFloatBetweenSurfaces) {
   // or behind the first surface along its ray by more than a few centimetres.
   size_t num_mixed = 0;
   for (const Eigen::Vector3d& point_in_lidar : cloud.points) {
-    const Eigen::Vector3d ray =
-        world_from_lidar.rotation * point_in_lidar.normalized();
+    const Eigen::Vector3d ray = world_from_lidar.rotation * point_in_lidar.normalized();
     sim::RayHit hit;
     if (scene.Intersect(world_from_lidar.translation, ray, 200, &hit) &&
         std::abs(hit.t - point_in_lidar.norm()) > 0.05) {
@@ -292,8 +254,7 @@ TEST(SimulatorTest, MixedEdgePointsFloatBetweenSurfaces) {
 
 TEST(SimulatorTest, RefusesToOverwriteAndLeavesNoPartialOutput) {
   testing::ScopedTempDir dir;
-  sim::SimulationOptions options =
-      NoiseFreeOptions("square_pillar", dir.File("d"));
+  sim::SimulationOptions options = NoiseFreeOptions("square_pillar", dir.File("d"));
   options.num_stations = 2;
   sim::SimulateDataset(options);
   EXPECT_THROW(sim::SimulateDataset(options), std::runtime_error);
@@ -307,17 +268,14 @@ TEST(SimulatorTest, RefusesToOverwriteAndLeavesNoPartialOutput) {
 
 TEST(SimulatorTest, GuessIsTheTruthPerturbedByTheDocumentedAmount) {
   testing::ScopedTempDir dir;
-  sim::SimulationOptions options =
-      NoiseFreeOptions("t_specimen", dir.File("d"));
+  sim::SimulationOptions options = NoiseFreeOptions("t_specimen", dir.File("d"));
   options.num_stations = 2;
   sim::SimulateDataset(options);
   const StationDataset dataset = ReadStationDataset(dir.File("d"));
   ASSERT_TRUE(dataset.rig.cam_from_lidar_guess.has_value());
-  const colmap::Rigid3d truth =
-      ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  const colmap::Rigid3d truth = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
   const colmap::Rigid3d& guess = *dataset.rig.cam_from_lidar_guess;
-  EXPECT_NEAR(
-      guess.rotation.angularDistance(truth.rotation) * 180 / M_PI, 3.0, 1e-6);
+  EXPECT_NEAR(guess.rotation.angularDistance(truth.rotation) * 180 / M_PI, 3.0, 1e-6);
   EXPECT_NEAR((guess.translation - truth.translation).norm(), 0.05, 1e-9);
 }
 

@@ -38,9 +38,7 @@ inline void SampleBox(const Eigen::Vector3d& lo,
 }
 
 // A 12 x 9 x 4 m room with three boxes in it: enough structure to constrain all six DoF of ICP.
-inline PointCloud SyntheticRoom(double density,
-                                uint32_t seed,
-                                double noise = 0) {
+inline PointCloud SyntheticRoom(double density, uint32_t seed, double noise = 0) {
   std::mt19937 rng(seed);
   PointCloud cloud;
   SampleBox({-6, -4.5, 0}, {6, 4.5, 4}, density, true, &rng, &cloud);
@@ -49,8 +47,7 @@ inline PointCloud SyntheticRoom(double density,
   SampleBox({-1, 2.5, 0}, {0.5, 3.5, 0.8}, density, false, &rng, &cloud);
   if (noise > 0) {
     std::normal_distribution<double> gaussian(0, noise);
-    for (size_t i = 0; i < cloud.Size(); ++i)
-      cloud.points[i] += gaussian(rng) * cloud.normals[i];
+    for (size_t i = 0; i < cloud.Size(); ++i) cloud.points[i] += gaussian(rng) * cloud.normals[i];
   }
   return cloud;
 }
