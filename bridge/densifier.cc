@@ -2,6 +2,7 @@
 
 #include "colmap_ext/camera_undistortion.h"
 #include "colmap_ext/dense_workspace.h"
+#include "colmap_ext/logging.h"
 #include "colmap_ext/stereo_depth.h"
 #include "lidar/cloud_io.h"
 #include "lidar/pinhole_depth_image.h"
@@ -348,23 +349,16 @@ nlohmann::json StationReport(const StationDensification& station) {
 }  // namespace
 
 bool DensifierOptions::Check() const {
-  surface.Check();
-  refinement.Check();
-  auto fail = [](const std::string& what) {
-    throw std::invalid_argument("DensifierOptions: " + what);
-  };
-  if (!(min_depth_m > 0) || !(max_depth_m > min_depth_m)) {
-    fail("need 0 < min_depth_m < max_depth_m");
-  }
-  if (min_consistent_views < 0 || max_neighbor_views < min_consistent_views) {
-    fail("need 0 <= min_consistent_views <= max_neighbor_views");
-  }
-  if (!(consistency_abs_m >= 0) || !(consistency_rel >= 0)) {
-    fail("consistency_abs_m and consistency_rel must be >= 0");
-  }
-  if (!(fused_voxel_size_m > 0) || !(lidar_map_voxel_size_m > 0)) {
-    fail("voxel sizes must be > 0");
-  }
+  CHECK_OPTION(surface.Check());
+  CHECK_OPTION(refinement.Check());
+  CHECK_OPTION_GT(min_depth_m, 0);
+  CHECK_OPTION_GT(max_depth_m, min_depth_m);
+  CHECK_OPTION_GE(min_consistent_views, 0);
+  CHECK_OPTION_GE(max_neighbor_views, min_consistent_views);
+  CHECK_OPTION_GE(consistency_abs_m, 0);
+  CHECK_OPTION_GE(consistency_rel, 0);
+  CHECK_OPTION_GT(fused_voxel_size_m, 0);
+  CHECK_OPTION_GT(lidar_map_voxel_size_m, 0);
   return true;
 }
 
@@ -374,7 +368,7 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
                          const std::string& depth_path,
                          const std::string& output_path,
                          const DensifierOptions& options) {
-  options.Check();
+  THROW_CHECK(options.Check());
   const auto start = std::chrono::steady_clock::now();
   const std::vector<StationView> views = StationViews(input_model, dataset);
   // Everything below works in undistorted pinhole cameras: distorted ones are replaced by COLMAP's

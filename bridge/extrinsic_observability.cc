@@ -17,6 +17,8 @@ namespace colmap_lidar {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
+// Degrees of rotation per unit of the quaternion manifold's tangent.
+constexpr double kTangentToRotationDeg = 2.0 * kRadToDeg;
 
 std::string DescribeAxis(const Eigen::Vector3d& axis) {
   const Eigen::Vector3d a = axis.normalized();
@@ -109,77 +111,96 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
   return analysis;
 }
 
-ExtrinsicUncertainty ComputeExtrinsicUncertainty(
-    ceres::Problem* problem,
-    double* cam_from_lidar_rotation,
-    double* cam_from_lidar_translation,
-    const std::array<bool, 3>& held_translation,
-    const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
-    const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
-    const MotionAnalysis& motion,
-    const ObservabilityOptions& options) {
-  ExtrinsicUncertainty result;
-  const bool rotation_free = problem->HasParameterBlock(cam_from_lidar_rotation) &&
-                             !problem->IsParameterBlockConstant(cam_from_lidar_rotation);
-  const bool translation_free = problem->HasParameterBlock(cam_from_lidar_translation) &&
-                                !problem->IsParameterBlockConstant(cam_from_lidar_translation);
-  if (!rotation_free && !translation_free) {
-    result.message = "cam_from_lidar is held constant in this mode";
-    return result;
-  }
-  // Variable blocks, T_e last.
+namespace {
+
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+
+// Reported variances are capped here (sigma 10 m or 10^4 deg): a direction without information gets
+// this instead of infinity, and the cap keeps the other directions' digits in a 6x6 eigensolve.
+constexpr double kMaxVariance = 1e8;
+// A direction whose nominal variance (whitened residuals, variance factor 1) from the data alone exceeds
+// this (sigma 1 m or 1000 deg) is unobservable, whatever any prior says.
+constexpr double kUnobservableVariance = 1e6;
+
+// The variable parameter blocks in Jacobian column order, T_e last, and where T_e's tangent columns go
+// in the 6-vector (rotation 0..2, translation 3..5).
+struct ColumnLayout {
+  std::vector<double*> blocks;
+  int num_other = 0;
+  std::vector<int> extrinsic_index;
+};
+
+ColumnLayout MakeColumnLayout(ceres::Problem* problem,
+                              double* rotation,
+                              double* translation,
+                              bool rotation_free,
+                              bool translation_free,
+                              const std::array<bool, 3>& held_translation) {
+  ColumnLayout layout;
   std::vector<double*> blocks;
   problem->GetParameterBlocks(&blocks);
-  std::vector<double*> ordered;
-  int num_other = 0;
   for (double* block : blocks) {
-    if (block == cam_from_lidar_rotation || block == cam_from_lidar_translation ||
-        problem->IsParameterBlockConstant(block)) {
+    if (block == rotation || block == translation || problem->IsParameterBlockConstant(block)) {
       continue;
     }
-    ordered.push_back(block);
-    num_other += problem->ParameterBlockTangentSize(block);
+    layout.blocks.push_back(block);
+    layout.num_other += problem->ParameterBlockTangentSize(block);
   }
-  // Tangent index -> 6-vector index (rotation 0..2, translation 3..5).
-  std::vector<int> extrinsic_index;
   if (rotation_free) {
-    ordered.push_back(cam_from_lidar_rotation);
-    extrinsic_index.insert(extrinsic_index.end(), {0, 1, 2});
+    layout.blocks.push_back(rotation);
+    layout.extrinsic_index.insert(layout.extrinsic_index.end(), {0, 1, 2});
   }
   if (translation_free) {
-    ordered.push_back(cam_from_lidar_translation);
+    layout.blocks.push_back(translation);
     for (int i = 0; i < 3; ++i) {
-      if (!held_translation[i]) extrinsic_index.push_back(3 + i);
+      if (!held_translation[i]) layout.extrinsic_index.push_back(3 + i);
     }
   }
-  const int num_extrinsic = static_cast<int>(extrinsic_index.size());
+  return layout;
+}
 
-  // Rows in cluster order.
+// The Jacobian of the data residuals (cluster order) and of the regularisers (last rows).
+struct JacobianRows {
+  Eigen::SparseMatrix<double> jacobian;
+  std::vector<double> residuals;
+  // Per row: its cluster (-1 for a regulariser) and d(residual)/d(stereo scale).
+  std::vector<int> cluster;
+  std::vector<double> scale_derivative;
+  int num_data_rows = 0;
+};
+
+JacobianRows EvaluateRows(
+    ceres::Problem* problem,
+    const ColumnLayout& layout,
+    const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
+    const std::vector<ceres::ResidualBlockId>& regularizers,
+    const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative) {
+  JacobianRows rows;
   std::vector<ceres::ResidualBlockId> residual_blocks;
-  std::vector<int> row_cluster;
-  std::vector<double> row_scale_derivative;
+  const auto add = [&](ceres::ResidualBlockId id, int cluster) {
+    residual_blocks.push_back(id);
+    const int num_residuals = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+    rows.cluster.insert(rows.cluster.end(), num_residuals, cluster);
+    const auto derivative = depth_scale_derivative.find(id);
+    rows.scale_derivative.insert(
+        rows.scale_derivative.end(),
+        num_residuals,
+        derivative == depth_scale_derivative.end() ? 0.0 : derivative->second);
+  };
   for (size_t c = 0; c < clusters.size(); ++c) {
-    for (const ceres::ResidualBlockId id : clusters[c]) {
-      residual_blocks.push_back(id);
-      const int num_residuals = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
-      row_cluster.insert(row_cluster.end(), num_residuals, static_cast<int>(c));
-      const auto derivative = depth_scale_derivative.find(id);
-      row_scale_derivative.insert(
-          row_scale_derivative.end(),
-          num_residuals,
-          derivative == depth_scale_derivative.end() ? 0.0 : derivative->second);
-    }
+    for (const ceres::ResidualBlockId id : clusters[c]) add(id, static_cast<int>(c));
   }
+  rows.num_data_rows = static_cast<int>(rows.cluster.size());
+  for (const ceres::ResidualBlockId id : regularizers) add(id, -1);
   ceres::Problem::EvaluateOptions evaluate_options;
-  evaluate_options.parameter_blocks = ordered;
+  evaluate_options.parameter_blocks = layout.blocks;
   evaluate_options.residual_blocks = residual_blocks;
   evaluate_options.num_threads = 2;
   double cost = 0;
-  std::vector<double> residuals;
   ceres::CRSMatrix crs;
-  problem->Evaluate(evaluate_options, &cost, &residuals, nullptr, &crs);
-  THROW_CHECK_EQ(static_cast<size_t>(crs.num_rows), row_cluster.size());
-  THROW_CHECK_EQ(crs.num_cols, num_other + num_extrinsic);
+  problem->Evaluate(evaluate_options, &cost, &rows.residuals, nullptr, &crs);
+  THROW_CHECK_EQ(static_cast<size_t>(crs.num_rows), rows.cluster.size());
+  THROW_CHECK_EQ(crs.num_cols, layout.num_other + static_cast<int>(layout.extrinsic_index.size()));
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(crs.values.size());
   for (int row = 0; row < crs.num_rows; ++row) {
@@ -187,109 +208,99 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
       triplets.emplace_back(row, crs.cols[k], crs.values[k]);
     }
   }
-  Eigen::SparseMatrix<double> jacobian(crs.num_rows, crs.num_cols);
-  jacobian.setFromTriplets(triplets.begin(), triplets.end());
-  const Eigen::SparseMatrix<double> information = (jacobian.transpose() * jacobian).pruned();
+  rows.jacobian.resize(crs.num_rows, crs.num_cols);
+  rows.jacobian.setFromTriplets(triplets.begin(), triplets.end());
+  return rows;
+}
 
-  // Schur complement: information of T_e with every other block marginalised.
+// Information of T_e's free tangent with every other block marginalised (Schur complement); false if
+// the other blocks are singular on their own.
+bool MarginalInformation(const Eigen::SparseMatrix<double>& information,
+                         int num_other,
+                         Eigen::MatrixXd* marginal) {
+  const int num_extrinsic = static_cast<int>(information.cols()) - num_other;
   Eigen::SparseMatrix<double> other = information.topLeftCorner(num_other, num_other);
   for (int i = 0; i < num_other; ++i) other.coeffRef(i, i) += 1e-12;
   const Eigen::MatrixXd coupling =
       Eigen::MatrixXd(information.bottomLeftCorner(num_extrinsic, num_other));
-  const Eigen::MatrixXd extrinsic =
-      Eigen::MatrixXd(information.bottomRightCorner(num_extrinsic, num_extrinsic));
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(other);
-  if (ldlt.info() != Eigen::Success) {
-    result.message =
-        "the joint problem's information matrix is singular "
-        "without T_e (a gauge freedom besides T_e)";
-    return result;
-  }
-  const Eigen::MatrixXd marginal =
-      extrinsic - coupling * ldlt.solve(Eigen::MatrixXd(coupling.transpose()));
+  if (ldlt.info() != Eigen::Success) return false;
+  *marginal = Eigen::MatrixXd(information.bottomRightCorner(num_extrinsic, num_extrinsic)) -
+              coupling * ldlt.solve(Eigen::MatrixXd(coupling.transpose()));
+  return true;
+}
 
-  // In (deg, mm) units; held components are known exactly (huge information).
-  Eigen::Matrix<double, 6, 6> info = Eigen::Matrix<double, 6, 6>::Zero();
-  for (int i = 0; i < 6; ++i) info(i, i) = 1e30;
-  const auto unit = [](int index) { return index < 3 ? kRadToDeg : 1000.0; };
-  for (int a = 0; a < num_extrinsic; ++a) {
-    for (int b = 0; b < num_extrinsic; ++b) {
-      info(extrinsic_index[a], extrinsic_index[b]) =
-          marginal(a, b) / (unit(extrinsic_index[a]) * unit(extrinsic_index[b]));
+// Tangent -> reported units. Ceres' EigenQuaternionManifold tangent delta rotates by 2|delta|
+// (q_delta = (cos|delta|, sin|delta| delta/|delta|)): the rotation vector is 2 delta.
+double ReportedUnit(int index) { return index < 3 ? kTangentToRotationDeg : 1000.0; }
+
+// A tangent-space matrix (free components) scattered into the 6x6 reported units; `power` -1 for an
+// information matrix, +1 for a covariance. Held components get `fill` on the diagonal.
+Matrix6 ToReportedUnits(const Eigen::MatrixXd& matrix,
+                        const std::vector<int>& extrinsic_index,
+                        int power,
+                        double fill) {
+  Matrix6 result = Matrix6::Zero();
+  for (int i = 0; i < 6; ++i) result(i, i) = fill;
+  for (size_t a = 0; a < extrinsic_index.size(); ++a) {
+    for (size_t b = 0; b < extrinsic_index.size(); ++b) {
+      const int i = extrinsic_index[a], j = extrinsic_index[b];
+      result(i, j) = matrix(a, b) * std::pow(ReportedUnit(i) * ReportedUnit(j), power);
     }
   }
-  const int redundancy = crs.num_rows - crs.num_cols;
-  result.variance_factor = redundancy > 0 ? 2 * cost / redundancy : 1.0;
-  // Formal covariance: the pseudo-inverse of the marginal information (unobservable -> huge).
-  const auto covariance_from_information = [](const Eigen::Matrix<double, 6, 6>& information,
-                                              double factor) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(information);
-    Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
-    for (int k = 0; k < 6; ++k) {
-      const double lambda = std::max(eigen.eigenvalues()[k], 1e-30);
-      covariance +=
-          factor / lambda * eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose();
-    }
-    return covariance;
-  };
-  result.formal_covariance = covariance_from_information(info, result.variance_factor);
-  result.covariance = result.formal_covariance;
+  return result;
+}
 
-  // Cluster-robust (sandwich) covariance: X = H^-1 E (E selects T_e), v_c = (J_c X)^T r_c.
+// The pseudo-inverse of an information matrix (whitened residuals) times the variance factor. A
+// direction whose nominal variance 1/lambda exceeds kUnobservableVariance has no information from the
+// data and gets the cap, whatever the factor (exact data has a factor near 0).
+Matrix6 CovarianceFromInformation(const Matrix6& information, double factor) {
+  Eigen::SelfAdjointEigenSolver<Matrix6> eigen(information);
+  Matrix6 covariance = Matrix6::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const double lambda = eigen.eigenvalues()[k];
+    const double variance =
+        lambda * kUnobservableVariance > 1 ? std::min(factor / lambda, kMaxVariance) : kMaxVariance;
+    covariance += variance * eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).transpose();
+  }
+  return covariance;
+}
+
+// Cluster-robust (sandwich) covariance of T_e's free tangent, X = H^-1 E (E selects T_e),
+// v_c = (J_c X)^T r_c over the data rows, and T_e's response to a common stereo scale error
+// dx = -H^-1 J^T dr/ds. H includes the regularisers (they keep it invertible); their rows add no score.
+bool ClusterRobust(const JacobianRows& rows,
+                   const Eigen::SparseMatrix<double>& information,
+                   int num_other,
+                   size_t num_clusters,
+                   Eigen::MatrixXd* sandwich,
+                   Eigen::VectorXd* scale_sensitivity) {
+  const int num_cols = static_cast<int>(information.cols());
+  const int num_extrinsic = num_cols - num_other;
   Eigen::SparseMatrix<double> regularised = information;
-  for (int i = 0; i < regularised.rows(); ++i) regularised.coeffRef(i, i) += 1e-12;
+  for (int i = 0; i < num_cols; ++i) regularised.coeffRef(i, i) += 1e-12;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> full(regularised);
-  if (full.info() == Eigen::Success && clusters.size() > 1) {
-    Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(crs.num_cols, num_extrinsic);
-    for (int a = 0; a < num_extrinsic; ++a) selector(num_other + a, a) = 1;
-    const Eigen::MatrixXd x = full.solve(selector);
-    const Eigen::MatrixXd y = jacobian * x;
-    std::vector<Eigen::VectorXd> scores(clusters.size(), Eigen::VectorXd::Zero(num_extrinsic));
-    Eigen::VectorXd scale_sensitivity = Eigen::VectorXd::Zero(num_extrinsic);
-    for (int row = 0; row < crs.num_rows; ++row) {
-      scores[row_cluster[row]] += y.row(row).transpose() * residuals[row];
-      // dx = -H^-1 J^T dr/ds: T_e's response to a common stereo scale error.
-      scale_sensitivity -= y.row(row).transpose() * row_scale_derivative[row];
-    }
-    for (int a = 0; a < num_extrinsic; ++a) {
-      result.stereo_scale_sensitivity[extrinsic_index[a]] =
-          scale_sensitivity[a] * unit(extrinsic_index[a]);
-    }
-    const double num_clusters = static_cast<double>(clusters.size());
-    Eigen::MatrixXd sandwich = Eigen::MatrixXd::Zero(num_extrinsic, num_extrinsic);
-    for (const Eigen::VectorXd& score : scores) sandwich += score * score.transpose();
-    sandwich *= num_clusters / (num_clusters - 1);
-    if (sandwich.allFinite()) {
-      Eigen::Matrix<double, 6, 6> robust = Eigen::Matrix<double, 6, 6>::Zero();
-      for (int a = 0; a < num_extrinsic; ++a) {
-        for (int b = 0; b < num_extrinsic; ++b) {
-          robust(extrinsic_index[a], extrinsic_index[b]) =
-              sandwich(a, b) * unit(extrinsic_index[a]) * unit(extrinsic_index[b]);
-        }
-      }
-      // Directions the formal information calls unobservable stay unobservable.
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> formal(result.formal_covariance);
-      for (int k = 0; k < 6; ++k) {
-        if (formal.eigenvalues()[k] > 1e6) {
-          robust += formal.eigenvalues()[k] * formal.eigenvectors().col(k) *
-                    formal.eigenvectors().col(k).transpose();
-        }
-      }
-      result.covariance = robust + options.stereo_scale_sigma * options.stereo_scale_sigma *
-                                       result.stereo_scale_sensitivity *
-                                       result.stereo_scale_sensitivity.transpose();
-      result.cluster_robust = true;
-      result.num_clusters = static_cast<int>(clusters.size());
-    }
+  if (full.info() != Eigen::Success || num_clusters < 2) return false;
+  Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(num_cols, num_extrinsic);
+  for (int a = 0; a < num_extrinsic; ++a) selector(num_other + a, a) = 1;
+  const Eigen::MatrixXd y = rows.jacobian * full.solve(selector);
+  std::vector<Eigen::VectorXd> scores(num_clusters, Eigen::VectorXd::Zero(num_extrinsic));
+  *scale_sensitivity = Eigen::VectorXd::Zero(num_extrinsic);
+  for (int row = 0; row < rows.num_data_rows; ++row) {
+    scores[rows.cluster[row]] += y.row(row).transpose() * rows.residuals[row];
+    *scale_sensitivity -= y.row(row).transpose() * rows.scale_derivative[row];
   }
+  *sandwich = Eigen::MatrixXd::Zero(num_extrinsic, num_extrinsic);
+  for (const Eigen::VectorXd& score : scores) *sandwich += score * score.transpose();
+  *sandwich *= static_cast<double>(num_clusters) / (num_clusters - 1.0);
+  return sandwich->allFinite();
+}
 
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(result.covariance);
-  for (int k = 0; k < 6; ++k) {  // eigen values ascending: store std devs ascending
-    result.eigenvalues[k] = std::sqrt(std::max(eigen.eigenvalues()[k], 0.0));
-    result.eigenvectors.col(k) = eigen.eigenvectors().col(k);
-  }
-  result.computed = true;
-
+// One sentence per direction whose standard deviation exceeds the thresholds.
+std::vector<std::string> NameUnobservable(const ExtrinsicUncertainty& result,
+                                          const MotionAnalysis& motion,
+                                          const ObservabilityOptions& options) {
+  std::vector<std::string> sentences;
   int num_unobservable_translation = 0;
   for (int k = 5; k >= 0; --k) {
     const Eigen::Matrix<double, 6, 1> v = result.eigenvectors.col(k);
@@ -309,13 +320,97 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
                << sigma << " deg): ";
     }
     sentence << Advice(motion);
-    result.unobservable.push_back(sentence.str());
+    sentences.push_back(sentence.str());
   }
   if (num_unobservable_translation == 3) {
-    result.unobservable.insert(
-        result.unobservable.begin(),
-        "all translation of cam_from_lidar is unobservable: " + Advice(motion));
+    sentences.insert(sentences.begin(),
+                     "all translation of cam_from_lidar is unobservable: " + Advice(motion));
   }
+  return sentences;
+}
+
+}  // namespace
+
+ExtrinsicUncertainty ComputeExtrinsicUncertainty(
+    ceres::Problem* problem,
+    double* cam_from_lidar_rotation,
+    double* cam_from_lidar_translation,
+    const std::array<bool, 3>& held_translation,
+    const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
+    const std::vector<ceres::ResidualBlockId>& regularizers,
+    const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
+    const MotionAnalysis& motion,
+    const ObservabilityOptions& options) {
+  ExtrinsicUncertainty result;
+  const bool rotation_free = problem->HasParameterBlock(cam_from_lidar_rotation) &&
+                             !problem->IsParameterBlockConstant(cam_from_lidar_rotation);
+  const bool translation_free = problem->HasParameterBlock(cam_from_lidar_translation) &&
+                                !problem->IsParameterBlockConstant(cam_from_lidar_translation);
+  if (!rotation_free && !translation_free) {
+    result.message = "cam_from_lidar is held constant in this mode";
+    return result;
+  }
+  const ColumnLayout layout = MakeColumnLayout(problem,
+                                               cam_from_lidar_rotation,
+                                               cam_from_lidar_translation,
+                                               rotation_free,
+                                               translation_free,
+                                               held_translation);
+  const JacobianRows rows =
+      EvaluateRows(problem, layout, clusters, regularizers, depth_scale_derivative);
+  const Eigen::SparseMatrix<double> data_jacobian = rows.jacobian.topRows(rows.num_data_rows);
+  const Eigen::SparseMatrix<double> data_information =
+      (data_jacobian.transpose() * data_jacobian).pruned();
+  const Eigen::SparseMatrix<double> information =
+      (rows.jacobian.transpose() * rows.jacobian).pruned();
+  Eigen::MatrixXd marginal;
+  if (!MarginalInformation(data_information, layout.num_other, &marginal)) {
+    result.message =
+        "the joint problem's information matrix is singular without T_e (a gauge freedom besides "
+        "T_e)";
+    return result;
+  }
+  // Formal covariance from the data alone (no prior): held components are known exactly.
+  double squared_norm = 0;
+  for (int row = 0; row < rows.num_data_rows; ++row)
+    squared_norm += rows.residuals[row] * rows.residuals[row];
+  const int redundancy = rows.num_data_rows - static_cast<int>(information.cols());
+  result.variance_factor = redundancy > 0 ? squared_norm / redundancy : 1.0;
+  result.formal_covariance = CovarianceFromInformation(
+      ToReportedUnits(marginal, layout.extrinsic_index, -1, 1e30), result.variance_factor);
+  result.covariance = result.formal_covariance;
+
+  Eigen::MatrixXd sandwich;
+  Eigen::VectorXd scale_sensitivity;
+  if (ClusterRobust(
+          rows, information, layout.num_other, clusters.size(), &sandwich, &scale_sensitivity)) {
+    for (size_t a = 0; a < layout.extrinsic_index.size(); ++a) {
+      result.stereo_scale_sensitivity[layout.extrinsic_index[a]] =
+          scale_sensitivity[a] * ReportedUnit(layout.extrinsic_index[a]);
+    }
+    Matrix6 robust = ToReportedUnits(sandwich, layout.extrinsic_index, 1, 0.0);
+    // Directions the data leaves undetermined keep the formal (capped) variance.
+    Eigen::SelfAdjointEigenSolver<Matrix6> formal(result.formal_covariance);
+    for (int k = 0; k < 6; ++k) {
+      if (formal.eigenvalues()[k] > kUnobservableVariance) {
+        robust += formal.eigenvalues()[k] * formal.eigenvectors().col(k) *
+                  formal.eigenvectors().col(k).transpose();
+      }
+    }
+    result.covariance = robust + options.stereo_scale_sigma * options.stereo_scale_sigma *
+                                     result.stereo_scale_sensitivity *
+                                     result.stereo_scale_sensitivity.transpose();
+    result.cluster_robust = true;
+    result.num_clusters = static_cast<int>(clusters.size());
+  }
+
+  Eigen::SelfAdjointEigenSolver<Matrix6> eigen(result.covariance);
+  for (int k = 0; k < 6; ++k) {  // ascending: standard deviations ascending
+    result.eigenvalues[k] = std::sqrt(std::max(eigen.eigenvalues()[k], 0.0));
+    result.eigenvectors.col(k) = eigen.eigenvectors().col(k);
+  }
+  result.computed = true;
+  result.unobservable = NameUnobservable(result, motion, options);
   return result;
 }
 

@@ -8,8 +8,9 @@
 //   standard deviation exceeds a threshold are named in words;
 // - the seed's uniqueness test on the relative motions: T_e is unique only with >= 3 stations whose
 //   relative rotation axes are not all parallel (hand-eye calibration, AX = XB).
-// Units: rotation as a rotation vector about the camera axes in degrees (Ceres' EigenQuaternionManifold
-// tangent, left-multiplied), translation in millimetres along the camera axes.
+// Units: rotation as a rotation vector about the camera axes in degrees (twice Ceres'
+// EigenQuaternionManifold tangent, which is left-multiplied and rotates by 2|delta|), translation in
+// millimetres along the camera axes.
 #pragma once
 
 #include "colmap/scene/reconstruction.h"
@@ -74,7 +75,9 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
 // with a quaternion manifold of tangent size 3, the translation possibly with a subset manifold).
 // `motion` turns unobservable directions into advice.
 // `depth_scale_derivative`: d(residual)/d(stereo scale) of each depth-prior block (-d / sigma_d).
-// `clusters`: every residual block of the problem, grouped (see above).
+// `clusters`: every data residual block of the problem, grouped (see above).
+// `regularizers`: residual blocks that are not data (the weak extrinsic prior): they keep the
+// information invertible for the sandwich but never decide what is observable.
 // `held_translation`: translation components held constant by a subset manifold (known exactly).
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     ceres::Problem* problem,
@@ -82,6 +85,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     double* cam_from_lidar_translation,
     const std::array<bool, 3>& held_translation,
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
+    const std::vector<ceres::ResidualBlockId>& regularizers,
     const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
     const MotionAnalysis& motion,
     const ObservabilityOptions& options);

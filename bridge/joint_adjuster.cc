@@ -1,6 +1,7 @@
 #include "bridge/joint_adjuster.h"
 
 #include "bridge/extrinsic_prior_cost.h"
+#include "bridge/lidar_pair_cost.h"
 #include "bridge/lidar_point_to_plane_cost.h"
 #include "colmap_ext/depth_prior_cost.h"
 #include "colmap_ext/logging.h"
@@ -23,16 +24,36 @@ namespace colmap_lidar {
 namespace {
 
 using ImagePoint = std::pair<colmap::image_t, colmap::point2D_t>;
+using ImagePair = std::pair<colmap::image_t, colmap::image_t>;
+
+// A LiDAR observation of the directed pair (target i, source j).
+struct LidarObservation {
+  colmap::image_t target = 0, source = 0;
+  PointToPlaneObservation data;
+  bool outlier = false;
+};
 
 double TermCost(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& ids) {
   if (ids.empty()) return 0;
   ceres::Problem::EvaluateOptions options;
   options.residual_blocks = ids;
-  options.num_threads = 2;
+  options.num_threads = omp_get_max_threads();
   double cost = 0;
   problem->Evaluate(options, &cost, nullptr, nullptr, nullptr);
   return cost;
 }
+
+}  // namespace
+
+double MeanIterationSeconds(const ceres::Solver::Summary& summary) {
+  double seconds = 0;
+  for (size_t k = 1; k < summary.iterations.size(); ++k) {
+    seconds += summary.iterations[k].iteration_time_in_seconds;
+  }
+  return summary.iterations.size() > 1 ? seconds / (summary.iterations.size() - 1) : 0.0;
+}
+
+namespace {
 
 Eigen::Isometry3d ToIsometry(const colmap::Rigid3d& transform) {
   Eigen::Isometry3d isometry = Eigen::Isometry3d::Identity();
@@ -55,32 +76,478 @@ std::unique_ptr<ceres::LossFunction> MakeLoss(const std::string& name, double sc
   return nullptr;
 }
 
-// The joint problem of one solve: COLMAP's bundle adjuster with our blocks injected.
-struct JointProblem {
-  std::unique_ptr<colmap::BundleAdjuster> adjuster;
-  std::shared_ptr<ceres::Problem> problem;
-  std::vector<ceres::ResidualBlockId> reprojection_ids;
-  std::vector<ceres::ResidualBlockId> depth_ids;
-  std::vector<ceres::ResidualBlockId> lidar_ids;
-  std::vector<colmap::image_t> depth_images;    // parallel to depth_ids
-  std::vector<double> depth_scale_derivatives;  // -d / sigma, parallel to depth_ids
-  std::vector<ceres::ResidualBlockId> prior_ids;
-  std::vector<std::pair<colmap::image_t, colmap::image_t>> lidar_pairs;  // parallel to lidar_ids
-  colmap::BundleAdjustmentOptions ba_options;
-};
-
-// The depth prior of a landmark observation, unless it has none or was found an outlier.
+// The depth prior of a landmark observation, or null.
 const DepthPrior* FindDepthPrior(const JointProblemData& data,
-                                 const std::set<ImagePoint>& outliers,
                                  const colmap::TrackElement& element) {
   const auto image_priors = data.depth_priors.find(element.image_id);
   if (image_priors == data.depth_priors.end()) return nullptr;
   const auto prior = image_priors->second.find(element.point2D_idx);
-  if (prior == image_priors->second.end() ||
-      outliers.count({element.image_id, element.point2D_idx})) {
-    return nullptr;
+  return prior == image_priors->second.end() ? nullptr : &prior->second;
+}
+
+// The joint problem of one solve: COLMAP's bundle adjuster with our blocks injected.
+struct JointProblem {
+  std::unique_ptr<colmap::BundleAdjuster> adjuster;
+  std::shared_ptr<ceres::Problem> problem;
+  colmap::BundleAdjustmentOptions ba_options;
+  std::vector<ceres::ResidualBlockId> reprojection_ids;
+  std::vector<ceres::ResidualBlockId> depth_ids;
+  // Parallel to depth_ids: the image, and d(residual)/d(stereo scale) = -d / sigma.
+  std::vector<colmap::image_t> depth_images;
+  std::vector<double> depth_scale_derivatives;
+  std::vector<ceres::ResidualBlockId> lidar_ids;
+  std::vector<ImagePair> lidar_pairs;  // parallel to lidar_ids
+  size_t num_lidar_residuals = 0;
+  std::vector<ceres::ResidualBlockId> prior_ids;
+};
+
+// Everything one Run() works on.
+struct RunState {
+  const JointAdjusterOptions& options;
+  const JointProblemData& data;
+  colmap::Reconstruction* reconstruction;
+  colmap::Rigid3d* cam_from_lidar;
+  colmap::BundleAdjustmentConfig config;
+  Eigen::Vector3d initial_translation;
+  // Owned here: COLMAP's problem does not take ownership of loss functions.
+  std::unique_ptr<ceres::LossFunction> loss;
+  bool use_lidar = false;
+  bool refine_extrinsic = false;
+  std::set<ImagePoint> depth_outliers;
+  size_t num_reprojection_outliers = 0;
+  size_t num_lidar_outliers = 0;
+
+  double* ExtrinsicRotation() const { return cam_from_lidar->rotation.coeffs().data(); }
+  double* ExtrinsicTranslation() const { return cam_from_lidar->translation.data(); }
+};
+
+colmap::BundleAdjustmentOptions JointBundleAdjustmentOptions(const JointAdjusterOptions& options) {
+  colmap::BundleAdjustmentOptions ba;
+  ba.refine_focal_length = false;  // the rig is calibrated
+  ba.refine_principal_point = false;
+  ba.refine_extra_params = false;
+  ba.print_summary = false;
+  ba.solver_options.max_num_iterations = options.max_num_iterations;
+  ba.solver_options.function_tolerance = 1e-12;
+  ba.solver_options.gradient_tolerance = 1e-14;
+  ba.solver_options.parameter_tolerance = 1e-12;
+  ba.solver_options.num_threads = omp_get_max_threads();
+  return ba;
+}
+
+// The pose blocks of an image; added (constant where COLMAP holds the pose constant) if COLMAP's
+// problem does not have them (an image with no landmark).
+std::pair<double*, double*> PoseBlocks(const RunState& state,
+                                       ceres::Problem* problem,
+                                       colmap::image_t image_id) {
+  colmap::Rigid3d& pose = state.reconstruction->Image(image_id).CamFromWorld();
+  double* rotation = pose.rotation.coeffs().data();
+  double* translation = pose.translation.data();
+  if (!problem->HasParameterBlock(rotation)) {
+    problem->AddParameterBlock(rotation, 4);
+    colmap::SetQuaternionManifold(problem, rotation);
+    problem->AddParameterBlock(translation, 3);
+    if (state.config.HasConstantCamPose(image_id)) {
+      problem->SetParameterBlockConstant(rotation);
+      problem->SetParameterBlockConstant(translation);
+    }
   }
-  return &prior->second;
+  return {rotation, translation};
+}
+
+// E_d, the paper's depth-prior residual, for every landmark observation with a prior in force.
+void AddDepthPriorBlocks(const RunState& state, JointProblem* joint) {
+  if (state.options.depth_weight <= 0) return;
+  ceres::Problem* problem = joint->problem.get();
+  const double weight_scale = 1.0 / std::sqrt(state.options.depth_weight);
+  for (const auto& [point3D_id, point3D] : state.reconstruction->Points3D()) {
+    double* xyz = state.reconstruction->Point3D(point3D_id).xyz.data();
+    for (const colmap::TrackElement& element : point3D.track.Elements()) {
+      const DepthPrior* prior = FindDepthPrior(state.data, element);
+      if (prior == nullptr || state.depth_outliers.count({element.image_id, element.point2D_idx})) {
+        continue;
+      }
+      const double sigma = prior->sigma * weight_scale;
+      joint->depth_images.push_back(element.image_id);
+      joint->depth_scale_derivatives.push_back(-prior->depth / sigma);
+      if (state.config.HasConstantCamPose(element.image_id)) {
+        joint->depth_ids.push_back(problem->AddResidualBlock(
+            DepthPriorConstantPoseCostFunctor::Create(
+                state.reconstruction->Image(element.image_id).CamFromWorld(), prior->depth, sigma),
+            state.loss.get(),
+            xyz));
+      } else {
+        const auto [rotation, translation] = PoseBlocks(state, problem, element.image_id);
+        joint->depth_ids.push_back(
+            problem->AddResidualBlock(DepthPriorCostFunctor::Create(prior->depth, sigma),
+                                      state.loss.get(),
+                                      rotation,
+                                      translation,
+                                      xyz));
+      }
+    }
+  }
+}
+
+// The shared T_e blocks, the degrees of freedom held, and the weak translation prior.
+void AddExtrinsicBlocks(const RunState& state, JointProblem* joint) {
+  ceres::Problem* problem = joint->problem.get();
+  double* rotation = state.ExtrinsicRotation();
+  double* translation = state.ExtrinsicTranslation();
+  problem->AddParameterBlock(rotation, 4);
+  colmap::SetQuaternionManifold(problem, rotation);
+  problem->AddParameterBlock(translation, 3);
+  if (!state.refine_extrinsic || state.options.hold_rotation) {
+    problem->SetParameterBlockConstant(rotation);
+  }
+  std::vector<int> held;
+  for (int i = 0; i < 3; ++i) {
+    if (state.options.hold_translation[i]) held.push_back(i);
+  }
+  if (!state.refine_extrinsic || held.size() == 3) {
+    problem->SetParameterBlockConstant(translation);
+  } else if (!held.empty()) {
+    colmap::SetSubsetManifold(3, held, problem, translation);
+  }
+  if (state.refine_extrinsic && held.size() < 3 && state.options.extrinsic_prior_sigma_m > 0) {
+    joint->prior_ids.push_back(problem->AddResidualBlock(
+        ExtrinsicTranslationPriorCostFunctor::Create(state.initial_translation,
+                                                     state.options.extrinsic_prior_sigma_m),
+        nullptr,
+        translation));
+  }
+}
+
+// E_l with the shared extrinsic: one analytic block per directed pair (observations of a pair are
+// contiguous, see Associate), or one per observation when a robust loss must act per observation.
+void AddLidarBlocks(const RunState& state,
+                    const std::vector<LidarObservation>& observations,
+                    JointProblem* joint) {
+  ceres::Problem* problem = joint->problem.get();
+  const double sigma = state.options.sigma_lidar_m / std::sqrt(state.options.lidar_weight);
+  const bool block_per_observation = state.loss != nullptr;
+  std::vector<PointToPlaneObservation> group;
+  for (size_t k = 0; k < observations.size(); ++k) {
+    const LidarObservation& observation = observations[k];
+    if (!observation.outlier) group.push_back(observation.data);
+    const bool pair_ends = k + 1 == observations.size() ||
+                           observations[k + 1].target != observation.target ||
+                           observations[k + 1].source != observation.source;
+    if (group.empty() || (!pair_ends && !block_per_observation)) continue;
+    const auto [target_rotation, target_translation] =
+        PoseBlocks(state, problem, observation.target);
+    const auto [source_rotation, source_translation] =
+        PoseBlocks(state, problem, observation.source);
+    joint->num_lidar_residuals += group.size();
+    joint->lidar_pairs.emplace_back(observation.target, observation.source);
+    joint->lidar_ids.push_back(
+        problem->AddResidualBlock(LidarPairPointToPlaneCost::Create(std::move(group), sigma),
+                                  state.loss.get(),
+                                  {target_rotation,
+                                   target_translation,
+                                   source_rotation,
+                                   source_translation,
+                                   state.ExtrinsicRotation(),
+                                   state.ExtrinsicTranslation()}));
+    group.clear();
+  }
+}
+
+std::unique_ptr<JointProblem> BuildProblem(const RunState& state,
+                                           const std::vector<LidarObservation>& observations) {
+  auto joint = std::make_unique<JointProblem>();
+  joint->ba_options = JointBundleAdjustmentOptions(state.options);
+  joint->adjuster = std::make_unique<colmap::BundleAdjuster>(joint->ba_options, state.config);
+  joint->adjuster->SetUpProblem(state.reconstruction, state.loss.get());
+  joint->problem = joint->adjuster->Problem();
+  std::vector<ceres::ResidualBlockId> all_ids;
+  joint->problem->GetResidualBlocks(&all_ids);
+  joint->reprojection_ids = all_ids;  // everything COLMAP added
+  AddDepthPriorBlocks(state, joint.get());
+  if (state.use_lidar) {
+    AddExtrinsicBlocks(state, joint.get());
+    AddLidarBlocks(state, observations, joint.get());
+  }
+  return joint;
+}
+
+SolveStats Solve(JointProblem* joint) {
+  ceres::Problem* problem = joint->problem.get();
+  SolveStats stats;
+  stats.reprojection.num_observations = joint->reprojection_ids.size();
+  stats.depth.num_observations = joint->depth_ids.size();
+  stats.lidar.num_observations = joint->num_lidar_residuals;
+  stats.reprojection.cost_before = TermCost(problem, joint->reprojection_ids);
+  stats.depth.cost_before = TermCost(problem, joint->depth_ids);
+  stats.lidar.cost_before = TermCost(problem, joint->lidar_ids);
+  const ceres::Solver::Options solver_options =
+      joint->adjuster->SetUpSolverOptions(*problem, joint->ba_options.solver_options);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, problem, &summary);
+  stats.reprojection.cost_after = TermCost(problem, joint->reprojection_ids);
+  stats.depth.cost_after = TermCost(problem, joint->depth_ids);
+  stats.lidar.cost_after = TermCost(problem, joint->lidar_ids);
+  stats.num_iterations = static_cast<int>(summary.iterations.size());
+  stats.seconds_per_iteration = MeanIterationSeconds(summary);
+  stats.residual_blocks = static_cast<size_t>(summary.num_residual_blocks);
+  stats.residuals = static_cast<size_t>(summary.num_residuals);
+  stats.termination = ceres::TerminationTypeToString(summary.termination_type);
+  return stats;
+}
+
+// Reprojection outliers (> max px) leave the reconstruction, as in COLMAP's filtering; returns how many.
+size_t RemoveReprojectionOutliers(RunState* state) {
+  colmap::Reconstruction& reconstruction = *state->reconstruction;
+  const double max_squared =
+      state->options.max_reprojection_error_px * state->options.max_reprojection_error_px;
+  std::vector<ImagePoint> bad;
+  for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
+    for (const colmap::TrackElement& element : point3D.track.Elements()) {
+      const colmap::Image& image = reconstruction.Image(element.image_id);
+      if (colmap::CalculateSquaredReprojectionError(image.Point2D(element.point2D_idx).xy,
+                                                    point3D.xyz,
+                                                    image.CamFromWorld(),
+                                                    reconstruction.Camera(image.CameraId())) >
+          max_squared) {
+        bad.emplace_back(element.image_id, element.point2D_idx);
+      }
+    }
+  }
+  size_t removed = 0;
+  for (const ImagePoint& observation : bad) {
+    // Deleting an observation deletes the whole landmark when its track drops below two.
+    if (reconstruction.Image(observation.first).Point2D(observation.second).HasPoint3D()) {
+      reconstruction.DeleteObservation(observation.first, observation.second);
+      ++removed;
+    }
+  }
+  state->num_reprojection_outliers += removed;
+  return removed;
+}
+
+// Depth priors: the outlier set recomputed from the current state (a prior that fits again comes
+// back). Returns the number of priors whose status changed.
+size_t UpdateDepthOutliers(RunState* state, DepthOutlierStats* stats) {
+  const JointAdjusterOptions& options = state->options;
+  std::set<ImagePoint> outliers;
+  size_t changed = 0;
+  for (const auto& [point3D_id, point3D] : state->reconstruction->Points3D()) {
+    for (const colmap::TrackElement& element : point3D.track.Elements()) {
+      const DepthPrior* prior = FindDepthPrior(state->data, element);
+      if (prior == nullptr) continue;
+      const colmap::Image& image = state->reconstruction->Image(element.image_id);
+      const double error = std::abs((image.CamFromWorld() * point3D.xyz).z() - prior->depth);
+      const bool beyond_sigma = error > options.max_depth_error_sigmas * prior->sigma;
+      const bool beyond_absolute =
+          options.max_depth_error_m > 0 && error > options.max_depth_error_m;
+      const ImagePoint key(element.image_id, element.point2D_idx);
+      const bool was_outlier = state->depth_outliers.count(key) > 0;
+      if (beyond_sigma || beyond_absolute) {
+        outliers.insert(key);
+        stats->beyond_sigma += beyond_sigma;
+        stats->beyond_absolute += !beyond_sigma;
+        changed += !was_outlier;
+      } else if (was_outlier) {
+        ++stats->restored;
+        ++changed;
+      }
+    }
+  }
+  state->depth_outliers = std::move(outliers);
+  return changed;
+}
+
+// LiDAR observations beyond max_point_to_plane_m get zero weight; returns how many new.
+size_t FlagLidarOutliers(RunState* state, std::vector<LidarObservation>* observations) {
+  size_t flagged = 0;
+  for (LidarObservation& observation : *observations) {
+    if (observation.outlier) continue;
+    const colmap::Rigid3d target_from_source =
+        LidarIFromLidarJ(state->reconstruction->Image(observation.target).CamFromWorld(),
+                         state->reconstruction->Image(observation.source).CamFromWorld(),
+                         *state->cam_from_lidar);
+    const double distance = observation.data.normal_in_target.dot(
+        target_from_source * observation.data.point_in_source - observation.data.point_in_target);
+    if (std::abs(distance) > state->options.max_point_to_plane_m) {
+      observation.outlier = true;
+      ++flagged;
+    }
+  }
+  state->num_lidar_outliers += flagged;
+  return flagged;
+}
+
+// Point-to-plane observations of every directed pair of the pose graph, contiguous per pair.
+std::vector<LidarObservation> Associate(const RunState& state, double max_distance) {
+  const colmap::Reconstruction& reconstruction = *state.reconstruction;
+  std::vector<ImagePair> directed;
+  for (const auto& [a, b] : state.data.pairs) {
+    if (!reconstruction.ExistsImage(a) || !reconstruction.ExistsImage(b) ||
+        !reconstruction.Image(a).IsRegistered() || !reconstruction.Image(b).IsRegistered() ||
+        !state.data.clouds.count(a) || !state.data.clouds.count(b)) {
+      continue;
+    }
+    directed.emplace_back(a, b);
+    directed.emplace_back(b, a);
+  }
+  std::vector<std::vector<LidarObservation>> per_pair(directed.size());
+#pragma omp parallel for schedule(dynamic)
+  for (int k = 0; k < static_cast<int>(directed.size()); ++k) {
+    const auto [target, source] = directed[k];
+    const StationCloud& target_cloud = *state.data.clouds.at(target);
+    AssociationOptions association = state.options.association;
+    association.max_distance = max_distance;
+    association.seed = state.options.association.seed + 7919 * k;
+    const colmap::Rigid3d target_from_source =
+        LidarIFromLidarJ(reconstruction.Image(target).CamFromWorld(),
+                         reconstruction.Image(source).CamFromWorld(),
+                         *state.cam_from_lidar);
+    for (const PointToPlaneObservation& observation :
+         AssociatePointToPlane(state.data.clouds.at(source)->cloud,
+                               target_cloud.cloud,
+                               *target_cloud.tree,
+                               ToIsometry(target_from_source),
+                               association,
+                               &target_cloud.curvature,
+                               &state.data.clouds.at(source)->curvature)) {
+      per_pair[k].push_back({target, source, observation, false});
+    }
+  }
+  std::vector<LidarObservation> observations;
+  for (auto& pair : per_pair) observations.insert(observations.end(), pair.begin(), pair.end());
+  return observations;
+}
+
+void PrintSolve(const SolveStats& stats, size_t changes) {
+  std::cout << std::defaultfloat << std::setprecision(4) << "  solve " << stats.round << "."
+            << stats.outlier_iteration << ": cost reprojection " << stats.reprojection.cost_before
+            << " -> " << stats.reprojection.cost_after << ", depth " << stats.depth.cost_before
+            << " -> " << stats.depth.cost_after << ", lidar " << stats.lidar.cost_before << " -> "
+            << stats.lidar.cost_after << "; " << stats.num_iterations << " iterations, " << changes
+            << " outlier changes (depth priors out: " << stats.depth_outliers.beyond_sigma
+            << " beyond sigma, " << stats.depth_outliers.beyond_absolute << " beyond the cap, "
+            << stats.depth_outliers.restored << " back) (" << std::setprecision(2) << stats.seconds
+            << " s)" << std::endl;
+}
+
+// Solves until no outlier status changes (or the cap); `observations` keeps its outlier flags.
+void SolveWithOutliers(int round,
+                       RunState* state,
+                       std::vector<LidarObservation>* observations,
+                       JointAdjustmentSummary* summary) {
+  for (int iteration = 0; iteration < state->options.max_outlier_iterations; ++iteration) {
+    const auto start = std::chrono::steady_clock::now();
+    std::unique_ptr<JointProblem> joint = BuildProblem(*state, *observations);
+    SolveStats stats = Solve(joint.get());
+    joint.reset();  // before the reconstruction changes under it
+    stats.round = round + 1;
+    stats.outlier_iteration = iteration + 1;
+    size_t changes = RemoveReprojectionOutliers(state);
+    changes += UpdateDepthOutliers(state, &stats.depth_outliers);
+    changes += FlagLidarOutliers(state, observations);
+    stats.reprojection.num_outliers = state->num_reprojection_outliers;
+    stats.depth.num_outliers = state->depth_outliers.size();
+    stats.lidar.num_outliers = state->num_lidar_outliers;
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    PrintSolve(stats, changes);
+    summary->solves.push_back(stats);
+    if (changes == 0) break;
+  }
+}
+
+// Clusters of residuals that share errors: a landmark's reprojections, an image's depth priors, a
+// directed LiDAR station pair. The weak extrinsic prior is not data and is left out.
+std::vector<std::vector<ceres::ResidualBlockId>> ResidualClusters(
+    const colmap::Reconstruction& reconstruction, const JointProblem& joint) {
+  std::unordered_map<const double*, size_t> landmark_cluster;
+  for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
+    landmark_cluster.emplace(point3D.xyz.data(), landmark_cluster.size());
+  }
+  std::vector<std::vector<ceres::ResidualBlockId>> clusters(landmark_cluster.size());
+  std::vector<double*> blocks;
+  for (const ceres::ResidualBlockId id : joint.reprojection_ids) {
+    joint.problem->GetParameterBlocksForResidualBlock(id, &blocks);
+    for (const double* block : blocks) {
+      const auto it = landmark_cluster.find(block);
+      if (it != landmark_cluster.end()) {
+        clusters[it->second].push_back(id);
+        break;
+      }
+    }
+  }
+  std::map<colmap::image_t, std::vector<ceres::ResidualBlockId>> per_image;
+  for (size_t k = 0; k < joint.depth_ids.size(); ++k) {
+    per_image[joint.depth_images[k]].push_back(joint.depth_ids[k]);
+  }
+  std::map<ImagePair, std::vector<ceres::ResidualBlockId>> per_pair;
+  for (size_t k = 0; k < joint.lidar_ids.size(); ++k) {
+    per_pair[joint.lidar_pairs[k]].push_back(joint.lidar_ids[k]);
+  }
+  for (auto& [image_id, ids] : per_image) clusters.push_back(std::move(ids));
+  for (auto& [pair, ids] : per_pair) clusters.push_back(std::move(ids));
+  clusters.erase(
+      std::remove_if(clusters.begin(), clusters.end(), [](const auto& ids) { return ids.empty(); }),
+      clusters.end());
+  return clusters;
+}
+
+ExtrinsicUncertainty Uncertainty(const RunState& state,
+                                 const JointProblem& joint,
+                                 const MotionAnalysis& motion) {
+  std::unordered_map<ceres::ResidualBlockId, double> depth_scale_derivative;
+  for (size_t k = 0; k < joint.depth_ids.size(); ++k) {
+    depth_scale_derivative[joint.depth_ids[k]] = joint.depth_scale_derivatives[k];
+  }
+  ExtrinsicUncertainty uncertainty =
+      ComputeExtrinsicUncertainty(joint.problem.get(),
+                                  state.ExtrinsicRotation(),
+                                  state.ExtrinsicTranslation(),
+                                  state.options.hold_translation,
+                                  ResidualClusters(*state.reconstruction, joint),
+                                  joint.prior_ids,
+                                  depth_scale_derivative,
+                                  motion,
+                                  state.options.observability);
+  if (joint.reprojection_ids.empty() && joint.depth_ids.empty()) {
+    uncertainty.unobservable.insert(
+        uncertainty.unobservable.begin(),
+        "cam_from_lidar cannot be calibrated: no image landmark ties the cameras together, so the "
+        "LiDAR fixes only the LiDAR poses and cam_from_lidar keeps its initial value; add "
+        "overlapping images (more stations, or closer spacing)");
+  }
+  return uncertainty;
+}
+
+// The paper's perturbation curves: only E_l depends on T_e, so the total is the rest (constant) plus
+// the LiDAR term at the perturbed T_e. Offsets are true rotation angles about the camera axes.
+std::vector<PerturbationCurve> PerturbationCurves(const RunState& state, JointProblem* joint) {
+  ceres::Problem* problem = joint->problem.get();
+  const double rest =
+      TermCost(problem, joint->reprojection_ids) + TermCost(problem, joint->depth_ids);
+  colmap::Rigid3d& cam_from_lidar = *state.cam_from_lidar;
+  const colmap::Rigid3d optimum = cam_from_lidar;
+  static const char* kNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+  std::vector<PerturbationCurve> curves;
+  for (int dof = 0; dof < 6; ++dof) {
+    PerturbationCurve curve;
+    curve.parameter = kNames[dof];
+    for (int step = -10; step <= 10; ++step) {
+      const double offset = step * (dof < 3 ? 2.0 : 0.1);  // +-20 mm, +-1 deg
+      cam_from_lidar = optimum;
+      if (dof < 3) {
+        cam_from_lidar.translation[dof] += offset / 1000.0;
+      } else {
+        cam_from_lidar.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(
+                                      offset * M_PI / 180, Eigen::Vector3d::Unit(dof - 3))) *
+                                  optimum.rotation;
+      }
+      curve.offsets.push_back(offset);
+      curve.costs.push_back(rest + TermCost(problem, joint->lidar_ids));
+    }
+    curves.push_back(curve);
+  }
+  cam_from_lidar = optimum;
+  return curves;
 }
 
 }  // namespace
@@ -111,394 +578,65 @@ bool JointAdjusterOptions::Check() const {
   CHECK_OPTION(loss == "none" || loss == "huber" || loss == "cauchy");
   CHECK_OPTION_GT(loss_scale, 0);
   CHECK_OPTION_GT(max_reprojection_error_px, 0);
-  CHECK_OPTION_GT(max_depth_error_m, 0);
+  CHECK_OPTION_GT(max_depth_error_sigmas, 0);
+  CHECK_OPTION_GE(max_depth_error_m, 0);
   CHECK_OPTION_GT(max_point_to_plane_m, 0);
   CHECK_OPTION_GE(max_outlier_iterations, 1);
   CHECK_OPTION_GE(num_association_rounds, 1);
   CHECK_OPTION_GE(initial_association_distance_m, association.max_distance);
   CHECK_OPTION_GT(max_num_iterations, 0);
   CHECK_OPTION_GE(extrinsic_prior_sigma_m, 0);
-  association.Check();
-  observability.Check();
+  CHECK_OPTION(association.Check());
+  CHECK_OPTION(observability.Check());
   return true;
 }
 
-JointAdjuster::JointAdjuster(const JointAdjusterOptions& options, const JointProblemData& data)
-    : options_(options), data_(data) {
+JointAdjuster::JointAdjuster(const JointAdjusterOptions& options) : options_(options) {
   THROW_CHECK(options_.Check());
 }
 
-std::vector<JointAdjuster::Observation> JointAdjuster::Associate(
-    const colmap::Reconstruction& reconstruction,
-    const colmap::Rigid3d& cam_from_lidar,
-    double max_distance) const {
-  std::vector<std::pair<colmap::image_t, colmap::image_t>> directed;
-  for (const auto& [a, b] : data_.pairs) {
-    if (!reconstruction.ExistsImage(a) || !reconstruction.ExistsImage(b) ||
-        !reconstruction.Image(a).IsRegistered() || !reconstruction.Image(b).IsRegistered() ||
-        !data_.clouds.count(a) || !data_.clouds.count(b)) {
-      continue;
-    }
-    directed.emplace_back(a, b);
-    directed.emplace_back(b, a);
-  }
-  std::vector<std::vector<Observation>> per_pair(directed.size());
-#pragma omp parallel for schedule(dynamic)
-  for (int k = 0; k < static_cast<int>(directed.size()); ++k) {
-    const auto [target, source] = directed[k];
-    const StationCloud& target_cloud = *data_.clouds.at(target);
-    const StationCloud& source_cloud = *data_.clouds.at(source);
-    AssociationOptions association = options_.association;
-    association.max_distance = max_distance;
-    association.seed = options_.association.seed + 7919 * k;
-    const colmap::Rigid3d target_from_source =
-        LidarIFromLidarJ(reconstruction.Image(target).CamFromWorld(),
-                         reconstruction.Image(source).CamFromWorld(),
-                         cam_from_lidar);
-    for (const PointToPlaneObservation& observation :
-         AssociatePointToPlane(source_cloud.cloud,
-                               target_cloud.cloud,
-                               *target_cloud.tree,
-                               ToIsometry(target_from_source),
-                               association,
-                               &target_cloud.curvature)) {
-      per_pair[k].push_back({target, source, observation, false});
-    }
-  }
-  std::vector<Observation> observations;
-  for (auto& pair : per_pair) {
-    observations.insert(observations.end(), pair.begin(), pair.end());
-  }
-  return observations;
-}
-
-JointAdjustmentSummary JointAdjuster::Run(colmap::Reconstruction* reconstruction,
-                                          colmap::Rigid3d* cam_from_lidar) {
+JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
+                                          colmap::Reconstruction* reconstruction,
+                                          colmap::Rigid3d* cam_from_lidar) const {
   THROW_CHECK_NOTNULL(reconstruction);
   THROW_CHECK_NOTNULL(cam_from_lidar);
   std::vector<colmap::image_t> image_ids = reconstruction->RegImageIds();
-  THROW_CHECK_GE(image_ids.size(), 2) << "the joint problem needs at least 2 "
-                                         "registered images";
+  THROW_CHECK_GE(image_ids.size(), 2) << "the joint problem needs at least 2 registered images";
   std::sort(image_ids.begin(), image_ids.end());
-  const bool use_lidar = options_.mode != JointMode::kStereoOnly && options_.lidar_weight > 0;
-  const bool refine_extrinsic = options_.mode == JointMode::kJoint;
-  double* extrinsic_rotation = cam_from_lidar->rotation.coeffs().data();
-  double* extrinsic_translation = cam_from_lidar->translation.data();
-  const Eigen::Vector3d initial_translation = cam_from_lidar->translation;
-
-  // Losses are owned here (COLMAP's problem does not take ownership).
-  const std::unique_ptr<ceres::LossFunction> loss = MakeLoss(options_.loss, options_.loss_scale);
-
-  colmap::BundleAdjustmentConfig config;
-  for (const colmap::image_t image_id : image_ids) config.AddImage(image_id);
-  config.SetConstantCamPose(image_ids.front());  // the gauge
+  RunState state{options_, data, reconstruction, cam_from_lidar};
+  for (const colmap::image_t image_id : image_ids) state.config.AddImage(image_id);
+  state.config.SetConstantCamPose(image_ids.front());  // the gauge
+  state.initial_translation = cam_from_lidar->translation;
+  state.loss = MakeLoss(options_.loss, options_.loss_scale);
+  state.use_lidar = options_.mode != JointMode::kStereoOnly && options_.lidar_weight > 0;
+  state.refine_extrinsic = options_.mode == JointMode::kJoint;
 
   JointAdjustmentSummary summary;
-  std::set<ImagePoint> depth_outliers;
-  size_t num_reprojection_outliers = 0;
-  std::unique_ptr<JointProblem> last;
-
-  const auto build = [&](const std::vector<Observation>& observations) {
-    auto joint = std::make_unique<JointProblem>();
-    colmap::BundleAdjustmentOptions& ba = joint->ba_options;
-    ba.refine_focal_length = false;  // the rig is calibrated
-    ba.refine_principal_point = false;
-    ba.refine_extra_params = false;
-    ba.print_summary = false;
-    ba.solver_options.max_num_iterations = options_.max_num_iterations;
-    ba.solver_options.function_tolerance = 1e-12;
-    ba.solver_options.gradient_tolerance = 1e-14;
-    ba.solver_options.parameter_tolerance = 1e-12;
-    ba.solver_options.num_threads = omp_get_max_threads();
-    joint->adjuster = std::make_unique<colmap::BundleAdjuster>(ba, config);
-    joint->adjuster->SetUpProblem(reconstruction, loss.get());
-    joint->problem = joint->adjuster->Problem();
-    ceres::Problem* problem = joint->problem.get();
-    problem->GetResidualBlocks(&joint->reprojection_ids);
-
-    // Pose blocks that COLMAP did not add (constant poses are folded into its cost functions).
-    const auto pose_blocks = [&](colmap::image_t image_id) {
-      colmap::Rigid3d& pose = reconstruction->Image(image_id).CamFromWorld();
-      double* rotation = pose.rotation.coeffs().data();
-      double* translation = pose.translation.data();
-      if (!problem->HasParameterBlock(rotation)) {
-        problem->AddParameterBlock(rotation, 4);
-        colmap::SetQuaternionManifold(problem, rotation);
-        problem->AddParameterBlock(translation, 3);
-        if (config.HasConstantCamPose(image_id)) {
-          problem->SetParameterBlockConstant(rotation);
-          problem->SetParameterBlockConstant(translation);
-        }
-      }
-      return std::make_pair(rotation, translation);
-    };
-
-    // E_d: the seed's depth-prior residual, for every observation of every landmark with a prior.
-    const double depth_scale = 1.0 / std::sqrt(std::max(options_.depth_weight, 1e-300));
-    if (options_.depth_weight > 0) {
-      for (const auto& [point3D_id, point3D] : reconstruction->Points3D()) {
-        double* xyz = reconstruction->Point3D(point3D_id).xyz.data();
-        for (const colmap::TrackElement& element : point3D.track.Elements()) {
-          const DepthPrior* prior = FindDepthPrior(data_, depth_outliers, element);
-          if (prior == nullptr) continue;
-          const double sigma = prior->sigma * depth_scale;
-          if (config.HasConstantCamPose(element.image_id)) {
-            joint->depth_images.push_back(element.image_id);
-            joint->depth_scale_derivatives.push_back(-prior->depth / sigma);
-            joint->depth_ids.push_back(problem->AddResidualBlock(
-                DepthPriorConstantPoseCostFunctor::Create(
-                    reconstruction->Image(element.image_id).CamFromWorld(), prior->depth, sigma),
-                loss.get(),
-                xyz));
-          } else {
-            const auto [rotation, translation] = pose_blocks(element.image_id);
-            joint->depth_images.push_back(element.image_id);
-            joint->depth_scale_derivatives.push_back(-prior->depth / sigma);
-            joint->depth_ids.push_back(
-                problem->AddResidualBlock(DepthPriorCostFunctor::Create(prior->depth, sigma),
-                                          loss.get(),
-                                          rotation,
-                                          translation,
-                                          xyz));
-          }
-        }
-      }
-    }
-
-    // E_l with the shared extrinsic block.
-    if (use_lidar) {
-      problem->AddParameterBlock(extrinsic_rotation, 4);
-      colmap::SetQuaternionManifold(problem, extrinsic_rotation);
-      problem->AddParameterBlock(extrinsic_translation, 3);
-      if (!refine_extrinsic || options_.hold_rotation) {
-        problem->SetParameterBlockConstant(extrinsic_rotation);
-      }
-      std::vector<int> held;
-      for (int i = 0; i < 3; ++i) {
-        if (options_.hold_translation[i]) held.push_back(i);
-      }
-      if (!refine_extrinsic || held.size() == 3) {
-        problem->SetParameterBlockConstant(extrinsic_translation);
-      } else if (!held.empty()) {
-        colmap::SetSubsetManifold(3, held, problem, extrinsic_translation);
-      }
-      if (refine_extrinsic && held.size() < 3 && options_.extrinsic_prior_sigma_m > 0) {
-        joint->prior_ids.push_back(
-            problem->AddResidualBlock(ExtrinsicTranslationPriorCostFunctor::Create(
-                                          initial_translation, options_.extrinsic_prior_sigma_m),
-                                      nullptr,
-                                      extrinsic_translation));
-      }
-      const double sigma = options_.sigma_lidar_m / std::sqrt(options_.lidar_weight);
-      for (const Observation& observation : observations) {
-        if (observation.outlier) continue;
-        const auto [target_rotation, target_translation] = pose_blocks(observation.target);
-        const auto [source_rotation, source_translation] = pose_blocks(observation.source);
-        joint->lidar_pairs.emplace_back(observation.target, observation.source);
-        joint->lidar_ids.push_back(problem->AddResidualBlock(
-            LidarPointToPlaneCostFunctor::Create(observation.data.point_in_source,
-                                                 observation.data.point_in_target,
-                                                 observation.data.normal_in_target,
-                                                 sigma),
-            loss.get(),
-            target_rotation,
-            target_translation,
-            source_rotation,
-            source_translation,
-            extrinsic_rotation,
-            extrinsic_translation));
-      }
-    }
-    return joint;
-  };
-
-  const int num_rounds = use_lidar ? options_.num_association_rounds : 1;
+  std::vector<LidarObservation> observations;
+  const int num_rounds = state.use_lidar ? options_.num_association_rounds : 1;
   for (int round = 0; round < num_rounds; ++round) {
-    std::vector<Observation> observations;
-    if (use_lidar) {
+    if (state.use_lidar) {
       const double gate = std::max(options_.association.max_distance,
                                    options_.initial_association_distance_m * std::pow(0.5, round));
-      observations = Associate(*reconstruction, *cam_from_lidar, gate);
+      observations = Associate(state, gate);
+      state.num_lidar_outliers = 0;
       std::cout << "Round " << round + 1 << "/" << num_rounds << ": " << observations.size()
                 << " LiDAR point-to-plane observations (gate " << gate << " m)" << std::endl;
     }
-    size_t num_lidar_outliers = 0;
-    for (int iteration = 0; iteration < options_.max_outlier_iterations; ++iteration) {
-      const auto start = std::chrono::steady_clock::now();
-      last = build(observations);
-      ceres::Problem* problem = last->problem.get();
-      SolveStats stats;
-      stats.round = round + 1;
-      stats.outlier_iteration = iteration + 1;
-      stats.reprojection.num_observations = last->reprojection_ids.size();
-      stats.depth.num_observations = last->depth_ids.size();
-      stats.lidar.num_observations = last->lidar_ids.size();
-      stats.reprojection.cost_before = TermCost(problem, last->reprojection_ids);
-      stats.depth.cost_before = TermCost(problem, last->depth_ids);
-      stats.lidar.cost_before = TermCost(problem, last->lidar_ids);
-      const ceres::Solver::Options solver_options =
-          last->adjuster->SetUpSolverOptions(*problem, last->ba_options.solver_options);
-      ceres::Solver::Summary solver_summary;
-      ceres::Solve(solver_options, problem, &solver_summary);
-      stats.reprojection.cost_after = TermCost(problem, last->reprojection_ids);
-      stats.depth.cost_after = TermCost(problem, last->depth_ids);
-      stats.lidar.cost_after = TermCost(problem, last->lidar_ids);
-      stats.num_iterations = static_cast<int>(solver_summary.iterations.size());
-      stats.termination = ceres::TerminationTypeToString(solver_summary.termination_type);
-
-      // Outliers get weight zero: reprojection -> the observation leaves the reconstruction (as in
-      // COLMAP's filtering); depth and LiDAR -> left out of the next build.
-      size_t new_outliers = 0;
-      const double max_squared_reprojection =
-          options_.max_reprojection_error_px * options_.max_reprojection_error_px;
-      std::vector<ImagePoint> bad_observations;
-      for (const auto& [point3D_id, point3D] : reconstruction->Points3D()) {
-        for (const colmap::TrackElement& element : point3D.track.Elements()) {
-          const colmap::Image& image = reconstruction->Image(element.image_id);
-          const double squared_error =
-              colmap::CalculateSquaredReprojectionError(image.Point2D(element.point2D_idx).xy,
-                                                        point3D.xyz,
-                                                        image.CamFromWorld(),
-                                                        reconstruction->Camera(image.CameraId()));
-          if (squared_error > max_squared_reprojection) {
-            bad_observations.emplace_back(element.image_id, element.point2D_idx);
-            continue;
-          }
-          const DepthPrior* prior = FindDepthPrior(data_, depth_outliers, element);
-          if (prior == nullptr) continue;
-          const double depth = (image.CamFromWorld() * point3D.xyz).z();
-          if (std::abs(depth - prior->depth) > options_.max_depth_error_m) {
-            depth_outliers.insert({element.image_id, element.point2D_idx});
-            ++new_outliers;
-          }
-        }
-      }
-      for (const ImagePoint& bad : bad_observations) {
-        if (reconstruction->Image(bad.first).Point2D(bad.second).HasPoint3D()) {
-          reconstruction->DeleteObservation(bad.first, bad.second);
-          ++num_reprojection_outliers;
-          ++new_outliers;
-        }
-      }
-      for (Observation& observation : observations) {
-        if (observation.outlier) continue;
-        const colmap::Rigid3d target_from_source =
-            LidarIFromLidarJ(reconstruction->Image(observation.target).CamFromWorld(),
-                             reconstruction->Image(observation.source).CamFromWorld(),
-                             *cam_from_lidar);
-        const double distance = observation.data.normal_in_target.dot(
-            target_from_source * observation.data.point_in_source -
-            observation.data.point_in_target);
-        if (std::abs(distance) > options_.max_point_to_plane_m) {
-          observation.outlier = true;
-          ++num_lidar_outliers;
-          ++new_outliers;
-        }
-      }
-      stats.reprojection.num_outliers = num_reprojection_outliers;
-      stats.depth.num_outliers = depth_outliers.size();
-      stats.lidar.num_outliers = num_lidar_outliers;
-      stats.seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::cout << std::defaultfloat << std::setprecision(4) << "  solve " << stats.round << "."
-                << stats.outlier_iteration << ": cost reprojection "
-                << stats.reprojection.cost_before << " -> " << stats.reprojection.cost_after
-                << ", depth " << stats.depth.cost_before << " -> " << stats.depth.cost_after
-                << ", lidar " << stats.lidar.cost_before << " -> " << stats.lidar.cost_after << "; "
-                << stats.num_iterations << " iterations, " << new_outliers << " new outliers ("
-                << std::setprecision(2) << stats.seconds << " s)" << std::endl;
-      summary.solves.push_back(stats);
-      if (new_outliers == 0) break;
-    }
+    SolveWithOutliers(round, &state, &observations, &summary);
   }
 
-  // Rebuild without the last outliers, evaluate uncertainty and the perturbation curves there.
+  // The uncertainty and the perturbation curves are evaluated on a problem rebuilt from the final
+  // state: the last solve's problem may hold residuals of observations (even landmarks) removed after
+  // it.
   summary.motion = AnalyseMotion(*reconstruction, options_.observability);
-  if (use_lidar) {
-    ceres::Problem* problem = last->problem.get();
-    // Clusters of residuals that share errors: a landmark's reprojections, an image's depth priors, a
-    // directed LiDAR station pair.
-    std::vector<std::vector<ceres::ResidualBlockId>> clusters;
-    {
-      std::unordered_map<const double*, size_t> landmark_cluster;
-      for (const auto& [point3D_id, point3D] : reconstruction->Points3D()) {
-        landmark_cluster.emplace(point3D.xyz.data(), landmark_cluster.size());
-      }
-      clusters.resize(landmark_cluster.size());
-      std::vector<double*> blocks;
-      for (const ceres::ResidualBlockId id : last->reprojection_ids) {
-        problem->GetParameterBlocksForResidualBlock(id, &blocks);
-        for (const double* block : blocks) {
-          const auto it = landmark_cluster.find(block);
-          if (it != landmark_cluster.end()) {
-            clusters[it->second].push_back(id);
-            break;
-          }
-        }
-      }
-      std::map<colmap::image_t, std::vector<ceres::ResidualBlockId>> per_image;
-      for (size_t k = 0; k < last->depth_ids.size(); ++k) {
-        per_image[last->depth_images[k]].push_back(last->depth_ids[k]);
-      }
-      std::map<std::pair<colmap::image_t, colmap::image_t>, std::vector<ceres::ResidualBlockId>>
-          per_pair;
-      for (size_t k = 0; k < last->lidar_ids.size(); ++k) {
-        per_pair[last->lidar_pairs[k]].push_back(last->lidar_ids[k]);
-      }
-      for (auto& [image_id, ids] : per_image) clusters.push_back(std::move(ids));
-      for (auto& [pair, ids] : per_pair) clusters.push_back(std::move(ids));
-      clusters.push_back(last->prior_ids);
-      clusters.erase(
-          std::remove_if(
-              clusters.begin(), clusters.end(), [](const auto& ids) { return ids.empty(); }),
-          clusters.end());
-    }
-    std::unordered_map<ceres::ResidualBlockId, double> depth_scale_derivative;
-    for (size_t k = 0; k < last->depth_ids.size(); ++k) {
-      depth_scale_derivative[last->depth_ids[k]] = last->depth_scale_derivatives[k];
-    }
-    summary.uncertainty = ComputeExtrinsicUncertainty(problem,
-                                                      extrinsic_rotation,
-                                                      extrinsic_translation,
-                                                      options_.hold_translation,
-                                                      clusters,
-                                                      depth_scale_derivative,
-                                                      summary.motion,
-                                                      options_.observability);
-    if (last->reprojection_ids.empty() && last->depth_ids.empty()) {
-      summary.uncertainty.unobservable.insert(
-          summary.uncertainty.unobservable.begin(),
-          "cam_from_lidar cannot be calibrated: no image landmark ties the "
-          "cameras together, so the LiDAR fixes only the LiDAR poses and "
-          "cam_from_lidar keeps its initial value; add overlapping images "
-          "(more stations, or closer spacing)");
-    }
-
-    // The seed's perturbation curves: only E_l depends on T_e, so the total is the rest (constant) plus
-    // the LiDAR term at the perturbed T_e.
-    const double rest =
-        TermCost(problem, last->reprojection_ids) + TermCost(problem, last->depth_ids);
-    const colmap::Rigid3d optimum = *cam_from_lidar;
-    static const char* kNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
-    for (int dof = 0; dof < 6; ++dof) {
-      PerturbationCurve curve;
-      curve.parameter = kNames[dof];
-      for (int step = -10; step <= 10; ++step) {
-        const double offset = step * (dof < 3 ? 2.0 : 0.1);  // +-20 mm, +-1 deg
-        *cam_from_lidar = optimum;
-        if (dof < 3) {
-          cam_from_lidar->translation[dof] += offset / 1000.0;
-        } else {
-          const Eigen::Vector3d axis = Eigen::Vector3d::Unit(dof - 3);
-          cam_from_lidar->rotation =
-              Eigen::Quaterniond(Eigen::AngleAxisd(offset * M_PI / 180, axis)) * optimum.rotation;
-        }
-        curve.offsets.push_back(offset);
-        curve.costs.push_back(rest + TermCost(problem, last->lidar_ids));
-      }
-      summary.perturbation.push_back(curve);
-    }
-    *cam_from_lidar = optimum;
+  const std::unique_ptr<JointProblem> final_problem = BuildProblem(state, observations);
+  summary.final_reprojection_residuals = final_problem->reprojection_ids.size();
+  summary.final_depth_residuals = final_problem->depth_ids.size();
+  summary.final_lidar_residuals = final_problem->num_lidar_residuals;
+  if (state.use_lidar) {
+    summary.uncertainty = Uncertainty(state, *final_problem, summary.motion);
+    summary.perturbation = PerturbationCurves(state, final_problem.get());
   }
   return summary;
 }

@@ -30,6 +30,8 @@
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/reconstruction.h"
 
+#include <ceres/solver.h>
+
 #include <array>
 #include <map>
 #include <string>
@@ -50,28 +52,40 @@ std::string JointModeName(JointMode mode);
 
 struct JointAdjusterOptions {
   JointMode mode = JointMode::kJoint;
-  // Weights: sigma_p = 1 px is COLMAP's; sigma_d comes with each depth prior.
-  double sigma_lidar_m = 0.02;  // seed: 0.02 - 0.1 m
-  double depth_weight = 1.0;    // w_c of E_d (E_f keeps weight 1)
-  double lidar_weight = 1.0;    // w_l
-  std::string loss = "none";    // none | huber | cauchy (on every term; off in the seed)
-  double loss_scale = 1.0;      // in units of the whitened residual
-  // Outliers (zero weight until none remain).
+  // Standard deviation of a LiDAR point-to-plane distance (the paper uses 0.02 - 0.1 m). sigma_p = 1 px
+  // is COLMAP's reprojection weight; sigma_d comes with each depth prior.
+  double sigma_lidar_m = 0.02;
+  // w_c of E_d (E_f keeps weight 1).
+  double depth_weight = 1.0;
+  // w_l of E_l.
+  double lidar_weight = 1.0;
+  // Robust loss on every term: none | huber | cauchy (none in the paper). With a loss, each LiDAR
+  // observation is its own residual block (the loss applies per observation); without, one block per
+  // directed station pair.
+  std::string loss = "none";
+  // Scale of the loss in units of the whitened residual.
+  double loss_scale = 1.0;
+  // Outliers get zero weight until none remain (the paper's 3 px / 0.01 m / 0.1 m). A depth prior is an
+  // outlier beyond `max_depth_error_sigmas` of its own sigma_d = d^2/(b f) sigma_p, and, if
+  // `max_depth_error_m` > 0, beyond that absolute cap; it comes back when it fits again after a solve.
   double max_reprojection_error_px = 3.0;
-  double max_depth_error_m = 0.01;
+  double max_depth_error_sigmas = 3.0;
+  double max_depth_error_m = 0.0;
   double max_point_to_plane_m = 0.1;
   int max_outlier_iterations = 10;
-  // ICP-like re-association of the LiDAR observations.
+  // ICP-like re-association of the LiDAR observations (the paper: 4 rounds).
   int num_association_rounds = 4;
-  AssociationOptions association;  // num_samples per directed pair; max_distance = final gate
-  double initial_association_distance_m =
-      0.5;  // gate of round 0, halved per round down to max_distance
+  // num_samples per directed pair; max_distance is the final gate.
+  AssociationOptions association;
+  // Gate of round 0, halved per round down to association.max_distance.
+  double initial_association_distance_m = 0.5;
   // Extrinsic degrees of freedom held constant in joint mode (users ask for it): rotation as a whole,
   // translation per camera axis.
   bool hold_rotation = false;
   std::array<bool, 3> hold_translation = {false, false, false};
   // Weak prior on T_e's translation at its initial value (bridge/extrinsic_prior_cost.h): keeps an
-  // unobservable direction where it started instead of letting it drift; 0 = off.
+  // unobservable direction where it started instead of letting it drift; 0 = off. It is left out of the
+  // uncertainty, so an unobservable direction is named whatever this sigma.
   double extrinsic_prior_sigma_m = 1.0;
   int max_num_iterations = 100;
   ObservabilityOptions observability;
@@ -79,7 +93,8 @@ struct JointAdjusterOptions {
   bool Check() const;
 };
 
-// What the joint problem needs besides COLMAP's reconstruction.
+// What the joint problem needs besides COLMAP's reconstruction. Borrowed by JointAdjuster::Run for the
+// duration of the call only.
 struct JointProblemData {
   // Depth priors per image, keyed by point2D_idx.
   std::unordered_map<colmap::image_t, std::unordered_map<colmap::point2D_t, DepthPrior>>
@@ -91,54 +106,74 @@ struct JointProblemData {
 };
 
 struct TermStats {
+  // Residuals in the problem of this solve.
   size_t num_observations = 0;
-  size_t num_outliers = 0;  // given weight zero so far
-  double cost_before = 0;   // 1/2 sum of squared whitened residuals
+  // Given weight zero so far (in force after this solve).
+  size_t num_outliers = 0;
+  // 1/2 sum of squared whitened residuals.
+  double cost_before = 0;
   double cost_after = 0;
+};
+
+// Depth priors set aside after a solve, by the rule that removed them (a prior over both counts once,
+// as `beyond_sigma`), and those that fit again and came back.
+struct DepthOutlierStats {
+  size_t beyond_sigma = 0;
+  size_t beyond_absolute = 0;
+  size_t restored = 0;
 };
 
 struct SolveStats {
   int round = 0;
   int outlier_iteration = 0;
   TermStats reprojection, depth, lidar;
+  DepthOutlierStats depth_outliers;
   int num_iterations = 0;
+  // Size of the problem as Ceres saw it.
+  size_t residual_blocks = 0;
+  size_t residuals = 0;
+  // Wall time of the whole solve (building the problem, solving, the outlier check), and Ceres' mean
+  // time per iteration.
   double seconds = 0;
+  double seconds_per_iteration = 0;
   std::string termination;
 };
 
 struct PerturbationCurve {
-  std::string parameter;  // x y z [mm] or roll pitch yaw [deg] (about the camera x, y, z axes)
+  // x y z [mm] or roll pitch yaw [deg] (about the camera x, y, z axes).
+  std::string parameter;
   std::vector<double> offsets;
-  std::vector<double> costs;  // total cost, everything else at the optimum
+  // Total cost, everything else at the optimum.
+  std::vector<double> costs;
 };
 
 struct JointAdjustmentSummary {
   std::vector<SolveStats> solves;
+  // Residual blocks of the problem rebuilt from the final state, on which the uncertainty and the
+  // perturbation curves are evaluated.
+  size_t final_reprojection_residuals = 0;
+  size_t final_depth_residuals = 0;
+  size_t final_lidar_residuals = 0;
   ExtrinsicUncertainty uncertainty;
   MotionAnalysis motion;
   std::vector<PerturbationCurve> perturbation;
 };
 
+// Ceres' mean time per iteration (iteration 0, the initial evaluation, left out); 0 without iterations.
+double MeanIterationSeconds(const ceres::Solver::Summary& summary);
+
 class JointAdjuster {
  public:
-  JointAdjuster(const JointAdjusterOptions& options, const JointProblemData& data);
+  explicit JointAdjuster(const JointAdjusterOptions& options);
 
-  // Refines `reconstruction` (poses, landmarks) and `cam_from_lidar` in place. Prints a line per solve.
-  JointAdjustmentSummary Run(colmap::Reconstruction* reconstruction,
-                             colmap::Rigid3d* cam_from_lidar);
+  // Refines `reconstruction` (poses, landmarks) and `cam_from_lidar` in place; `data` is read during the
+  // call only. Prints a line per solve.
+  JointAdjustmentSummary Run(const JointProblemData& data,
+                             colmap::Reconstruction* reconstruction,
+                             colmap::Rigid3d* cam_from_lidar) const;
 
  private:
-  struct Observation {
-    colmap::image_t target = 0, source = 0;
-    PointToPlaneObservation data;
-    bool outlier = false;
-  };
-  std::vector<Observation> Associate(const colmap::Reconstruction& reconstruction,
-                                     const colmap::Rigid3d& cam_from_lidar,
-                                     double max_distance) const;
-
   const JointAdjusterOptions options_;
-  const JointProblemData& data_;
 };
 
 }  // namespace colmap_lidar

@@ -94,11 +94,18 @@ void WriteReport(const std::string& directory,
                       {"reprojection", TermJson(solve.reprojection)},
                       {"depth", TermJson(solve.depth)},
                       {"lidar", TermJson(solve.lidar)},
+                      {"depth_outliers",
+                       {{"beyond_sigma", solve.depth_outliers.beyond_sigma},
+                        {"beyond_absolute", solve.depth_outliers.beyond_absolute},
+                        {"restored", solve.depth_outliers.restored}}},
                       {"iterations", solve.num_iterations},
                       {"termination", solve.termination},
                       {"seconds", solve.seconds}});
   }
   report["solves"] = solves;
+  report["final_problem"] = {{"reprojection_residuals", summary.final_reprojection_residuals},
+                             {"depth_residuals", summary.final_depth_residuals},
+                             {"lidar_residuals", summary.final_lidar_residuals}};
   const ExtrinsicUncertainty& u = summary.uncertainty;
   nlohmann::json uncertainty = {{"computed", u.computed}, {"message", u.message}};
   if (u.computed) {
@@ -210,11 +217,15 @@ int RunJointAdjuster(int argc, char** argv) {
   options.AddDefaultOption("loss", &adjuster.loss, "none | huber | cauchy");
   options.AddDefaultOption("loss_scale", &adjuster.loss_scale);
   options.AddDefaultOption("max_reprojection_error_px", &adjuster.max_reprojection_error_px);
-  options.AddDefaultOption("max_depth_error_m", &adjuster.max_depth_error_m);
+  options.AddDefaultOption("max_depth_error_sigmas", &adjuster.max_depth_error_sigmas);
+  options.AddDefaultOption("max_depth_error_m",
+                           &adjuster.max_depth_error_m,
+                           "absolute cap on top of the sigma gate; 0: off");
   options.AddDefaultOption("max_point_to_plane_m", &adjuster.max_point_to_plane_m);
   options.AddDefaultOption("num_association_rounds", &adjuster.num_association_rounds);
   int num_samples = static_cast<int>(adjuster.association.num_samples);
   options.AddDefaultOption("num_samples_per_pair", &num_samples);
+  options.AddDefaultOption("normal_space_sampling", &adjuster.association.normal_space_sampling);
   options.AddDefaultOption("association_max_distance_m", &adjuster.association.max_distance);
   options.AddDefaultOption("initial_association_distance_m",
                            &adjuster.initial_association_distance_m);
@@ -269,8 +280,9 @@ int RunJointAdjuster(int argc, char** argv) {
                            adjuster.mode != JointMode::kStereoOnly,
                            data_options);
 
-  JointAdjuster joint_adjuster(adjuster, loaded->data);
-  const JointAdjustmentSummary summary = joint_adjuster.Run(&reconstruction, &cam_from_lidar);
+  const JointAdjuster joint_adjuster(adjuster);
+  const JointAdjustmentSummary summary =
+      joint_adjuster.Run(loaded->data, &reconstruction, &cam_from_lidar);
 
   // Everything into OUTPUT.partial, renamed at the end: never a half-written output folder.
   const fs::path output(output_path);

@@ -58,7 +58,8 @@ TEST(LidarPointToPlaneCost, ZeroOnThePlaneAndTheSignedDistanceOffIt) {
   EXPECT_NEAR(residual, -0.5, 1e-9);
 }
 
-TEST(LidarPointToPlaneCost, AnalyticGradientsMatchNumericAtGenericPoses) {
+TEST(LidarPointToPlaneCost,
+     AutodiffJacobianMatchesNumericDifferencesInAmbientQuaternionCoordinates) {
   ThreeFrames setup;
   std::unique_ptr<ceres::CostFunction> cost(
       LidarPointToPlaneCostFunctor::Create(Eigen::Vector3d(1.3, -0.4, 0.7),

@@ -75,8 +75,8 @@ void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
 }  // namespace
 
 bool PoseInitializerOptions::Check() const {
-  image_pairs.Check();
-  hand_eye.Check();
+  CHECK_OPTION(image_pairs.Check());
+  CHECK_OPTION(hand_eye.Check());
   CHECK_OPTION_GT(sigma_rotation_deg, 0);
   CHECK_OPTION_GT(sigma_translation_m, 0);
   return true;

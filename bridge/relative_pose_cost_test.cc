@@ -12,7 +12,7 @@ colmap::Rigid3d Pose(double angle, const Eigen::Vector3d& axis, const Eigen::Vec
   return colmap::Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())), t);
 }
 
-TEST(RelativePoseCost, ZeroForTheTrueRelativePoseAndGradientsMatch) {
+TEST(RelativePoseCost, ZeroAtTheTruthTwoSigmaForOneCentimetreAndAutodiffMatchesNumeric) {
   colmap::Rigid3d cam_i_from_world = Pose(0.7, {0.2, -0.9, 0.4}, {0.3, -0.2, 1.9});
   colmap::Rigid3d cam_j_from_world = Pose(-1.2, {0.7, 0.3, -0.5}, {-0.8, 0.4, 2.4});
   const colmap::Rigid3d measured = cam_i_from_world * colmap::Inverse(cam_j_from_world);

@@ -51,7 +51,7 @@ TEST(DepthPriorCost, ZeroResidualOnExactDataForZAndRange) {
               1e-9);
 }
 
-TEST(DepthPriorCost, AnalyticGradientsMatchNumericAtAGenericPose) {
+TEST(DepthPriorCost, AutodiffJacobiansMatchNumericDifferencesForZAndRangeAtAGenericPose) {
   colmap::Rigid3d cam_from_world = GenericCamFromWorld();
   Eigen::Vector3d point = kPointInWorld;
   // The checks run in the ambient 4-vector of the quaternion: on COLMAP's quaternion manifold some

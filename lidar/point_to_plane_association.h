@@ -1,6 +1,9 @@
 // Point-to-plane associations between two station clouds (used by the joint problem's LiDAR term):
-// random source points, each paired with its nearest target point within a gate and that point's
-// normal. The target's k-d tree is built once by the caller and reused across re-associations.
+// source points drawn at random, each paired with its nearest target point within a gate and that
+// point's normal. The target's k-d tree is built once by the caller and reused across re-associations.
+// Normal-space sampling (Rusinkiewicz & Levoy, "Efficient variants of the ICP algorithm", 2001) draws
+// evenly over the source normals' directions, so that the few points on faces that constrain a
+// direction (a wall's side, a pillar's flank) are not outnumbered by the ground.
 #pragma once
 
 #include "lidar/kd_tree.h"
@@ -21,7 +24,12 @@ struct PointToPlaneObservation {
 };
 
 struct AssociationOptions {
-  size_t num_samples = 2000;    // source points drawn (without replacement)
+  // Source points drawn (without replacement).
+  size_t num_samples = 2000;
+  // Draw evenly over normal directions (needs source normals; uniform draws without them). Off by
+  // default: on the simulated structures it made the joint result worse (exact data: 0.022 deg /
+  // 1.2 mm against 0.007 deg / 0.35 mm uniform), as rare normals are mostly curved or edge surfaces.
+  bool normal_space_sampling = false;
   double max_distance = 0.1;    // gate on |T p - q| [m]
   double max_curvature = 0.05;  // only planar target neighbourhoods (if curvature is given)
   uint64_t seed = 0;
@@ -29,13 +37,15 @@ struct AssociationOptions {
   bool Check() const;  // throws std::invalid_argument
 };
 
-// `target` needs normals; `target_curvature` may be null (no planarity filter).
+// `target` needs normals; `target_curvature` may be null (no planarity filter). `source_curvature`
+// (may be null) restricts normal-space sampling to planar source points, whose normals are reliable.
 std::vector<PointToPlaneObservation> AssociatePointToPlane(
     const PointCloud& source,
     const PointCloud& target,
     const KdTree3& target_tree,
     const Eigen::Isometry3d& target_from_source,
     const AssociationOptions& options,
-    const std::vector<double>* target_curvature = nullptr);
+    const std::vector<double>* target_curvature = nullptr,
+    const std::vector<double>* source_curvature = nullptr);
 
 }  // namespace colmap_lidar

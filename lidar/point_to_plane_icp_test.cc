@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 namespace colmap_lidar {
 namespace {
 
@@ -88,6 +90,36 @@ TEST(PointToPlaneAssociationTest, ResidualsMeasureTheTransformError) {
   for (const auto& o : AssociatePointToPlane(source, target, tree, shifted, options)) {
     EXPECT_LT(std::abs(o.normal_in_target.x()), 0.5);
   }
+}
+
+// A floor of 10 m x 10 m with a 1 m x 0.5 m wall on it: uniform draws land on the wall about 1 % of
+// the time; normal-space sampling draws the two normal directions evenly.
+TEST(PointToPlaneAssociationTest, NormalSpaceSamplingBalancesNormalDirections) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> unit(0, 1);
+  PointCloud cloud;
+  for (int k = 0; k < 20000; ++k) {
+    cloud.points.emplace_back(10 * unit(rng), 10 * unit(rng), 0);
+    cloud.normals.emplace_back(0, 0, 1);
+  }
+  for (int k = 0; k < 200; ++k) {
+    cloud.points.emplace_back(5, 5 + unit(rng), 0.5 * unit(rng));
+    cloud.normals.emplace_back(-1, 0, 0);
+  }
+  const KdTree3 tree(cloud.points);
+  AssociationOptions options;
+  options.num_samples = 300;
+  const auto count_wall = [&](bool normal_space) {
+    options.normal_space_sampling = normal_space;
+    size_t wall = 0;
+    const auto observations =
+        AssociatePointToPlane(cloud, cloud, tree, Eigen::Isometry3d::Identity(), options);
+    EXPECT_EQ(observations.size(), 300u);
+    for (const auto& o : observations) wall += std::abs(o.normal_in_target.x()) > 0.9;
+    return wall;
+  };
+  EXPECT_LT(count_wall(false), 15u);
+  EXPECT_EQ(count_wall(true), 150u);
 }
 
 }  // namespace

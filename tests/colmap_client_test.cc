@@ -73,7 +73,7 @@ TEST(ColmapClientTest, ColmapKeepsUsingADatabaseWithOurTables) {
        {kColmap + " exhaustive_matcher --database_path " + database + " --SiftMatching.use_gpu 0",
         kColmap + " database_cleaner --type matches --database_path " + database}) {
     const auto result = RunCommand(command);
-    EXPECT_EQ(result.exit_code, 0) << command << "\n" << result.output;
+    ASSERT_EQ(result.exit_code, 0) << command << "\n" << result.output;
   }
   {
     ExtensionDatabase extension(database);

@@ -24,6 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::RunCommand;
+using testing::RunStep;
 
 const std::string kCli = COLMAP_LIDAR_CLI_EXE;
 const std::string kColmap = COLMAP_LIDAR_COLMAP_EXE;
@@ -76,11 +77,9 @@ nlohmann::json EvaluateCloud(const std::string& cloud,
                              const std::string& dataset,
                              const std::string& truth_from_model,
                              const std::string& output) {
-  const auto run =
-      RunCommand(kCli + " evaluate_model --model_path " + cloud + " --ground_truth_path " +
-                 dataset + "/ground_truth/surface.ply --truth_from_model " + truth_from_model +
-                 " --output_path " + output);
-  EXPECT_EQ(run.exit_code, 0) << run.output;
+  RunStep(kCli + " evaluate_model --model_path " + cloud + " --ground_truth_path " + dataset +
+          "/ground_truth/surface.ply --truth_from_model " + truth_from_model + " --output_path " +
+          output);
   return ReadJson(output + "/metrics.json");
 }
 

@@ -62,7 +62,9 @@ std::string TriangulatedTrueModel(const StationDataset& dataset,
 struct Timing {
   double seconds = 0;
   int iterations = 0;
+  double seconds_per_iteration = 0;  // Ceres' own iteration times
   size_t residual_blocks = 0;
+  size_t residuals = 0;
 };
 
 Timing PlainBundleAdjustment(colmap::Reconstruction reconstruction, int iterations) {
@@ -83,7 +85,9 @@ Timing PlainBundleAdjustment(colmap::Reconstruction reconstruction, int iteratio
   Timing timing;
   timing.seconds = Seconds(start);
   timing.iterations = static_cast<int>(adjuster.Summary().iterations.size()) - 1;
+  timing.seconds_per_iteration = MeanIterationSeconds(adjuster.Summary());
   timing.residual_blocks = adjuster.Summary().num_residual_blocks;
+  timing.residuals = adjuster.Summary().num_residuals;
   return timing;
 }
 
@@ -96,14 +100,14 @@ Timing JointSolve(colmap::Reconstruction reconstruction,
   options.max_outlier_iterations = 1;
   options.max_num_iterations = iterations;
   options.initial_association_distance_m = options.association.max_distance;
-  JointAdjuster adjuster(options, data);
-  const JointAdjustmentSummary summary = adjuster.Run(&reconstruction, &cam_from_lidar);
+  const JointAdjuster adjuster(options);
+  const JointAdjustmentSummary summary = adjuster.Run(data, &reconstruction, &cam_from_lidar);
   Timing timing;
   timing.seconds = summary.solves.front().seconds;
   timing.iterations = summary.solves.front().num_iterations - 1;
-  timing.residual_blocks = summary.solves.front().reprojection.num_observations +
-                           summary.solves.front().depth.num_observations +
-                           summary.solves.front().lidar.num_observations;
+  timing.seconds_per_iteration = summary.solves.front().seconds_per_iteration;
+  timing.residual_blocks = summary.solves.front().residual_blocks;
+  timing.residuals = summary.solves.front().residuals;
   return timing;
 }
 
@@ -129,21 +133,23 @@ int main(int argc, char** argv) {
     const double load_seconds = Seconds(load_start);
 
     std::ostringstream table;
-    table << std::fixed << std::setprecision(3)
-          << "| problem | iterations | residual blocks | time [s] | per "
-             "iteration [s] |\n"
-          << "|---|---|---|---|---|\n";
+    table << std::fixed << std::setprecision(4)
+          << "| problem | iterations | residual blocks | residuals | solve time [s] | per iteration "
+             "(Ceres) [s] |\n"
+          << "|---|---|---|---|---|---|\n";
     for (const int iterations : {1, 10}) {
       const Timing plain = PlainBundleAdjustment(reconstruction, iterations);
       const Timing joint = JointSolve(reconstruction, cam_from_lidar, loaded->data, iterations);
       const auto row = [&](const std::string& name, const Timing& t) {
         table << "| " << name << " | " << t.iterations << " | " << t.residual_blocks << " | "
-              << t.seconds << " | " << t.seconds / std::max(1, t.iterations) << " |\n";
+              << t.residuals << " | " << t.seconds << " | " << t.seconds_per_iteration << " |\n";
       };
       row("COLMAP BundleAdjuster::Solve", plain);
       row("joint (reprojection + depth + LiDAR + T_e)", joint);
-      table << "| **overhead ratio** (joint / COLMAP) | | | **" << joint.seconds / plain.seconds
-            << "** | |\n";
+      table << std::setprecision(2) << "| **ratio** (joint / COLMAP) | | | | **"
+            << joint.seconds / plain.seconds << "** | **"
+            << joint.seconds_per_iteration / plain.seconds_per_iteration << "** |\n"
+            << std::setprecision(4);
     }
     std::cout << reconstruction.NumRegImages() << " images, " << reconstruction.NumPoints3D()
               << " landmarks; loading clouds, "

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 
 namespace colmap_lidar {
@@ -26,6 +27,18 @@ inline CommandResult RunCommand(const std::string& command) {
   }
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+// For steps inside helpers that return a value (where ASSERT_* cannot stop the test): a failed step
+// throws, GoogleTest reports the exception with the command and its output, and the test stops there
+// instead of failing later in confusing ways.
+inline CommandResult RunStep(const std::string& command) {
+  CommandResult result = RunCommand(command);
+  if (result.exit_code != 0) {
+    throw std::runtime_error("step failed (exit " + std::to_string(result.exit_code) +
+                             "): " + command + "\n" + result.output);
+  }
   return result;
 }
 

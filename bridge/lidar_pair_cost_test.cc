@@ -1,0 +1,134 @@
+#include "bridge/lidar_pair_cost.h"
+
+#include "bridge/lidar_point_to_plane_cost.h"
+
+#include "colmap/geometry/rigid3.h"
+
+#include <ceres/gradient_checker.h>
+#include <ceres/manifold.h>
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+
+namespace colmap_lidar {
+namespace {
+
+colmap::Rigid3d Pose(double angle,
+                     const Eigen::Vector3d& axis,
+                     const Eigen::Vector3d& translation) {
+  return colmap::Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())),
+                         translation);
+}
+
+// Generic poses (no axis-aligned rotation) and random observations around them.
+struct PairSetup {
+  colmap::Rigid3d cam_i_from_world = Pose(0.6, {0.2, -0.9, 0.4}, {0.3, -0.2, 1.9});
+  colmap::Rigid3d cam_j_from_world = Pose(-1.1, {0.7, 0.3, -0.5}, {-0.8, 0.4, 2.4});
+  colmap::Rigid3d cam_from_lidar = Pose(2.0, {0.4, -0.5, 0.6}, {0.19, -0.25, -0.05});
+  std::vector<PointToPlaneObservation> observations;
+
+  explicit PairSetup(int num_observations) {
+    std::mt19937 rng(5);
+    std::normal_distribution<double> normal(0, 1);
+    const auto random_vector = [&]() {
+      return Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    };
+    for (int k = 0; k < num_observations; ++k) {
+      observations.push_back(
+          {2 * random_vector(), 2 * random_vector(), random_vector().normalized()});
+    }
+  }
+  std::vector<double*> Blocks() {
+    return {cam_i_from_world.rotation.coeffs().data(),
+            cam_i_from_world.translation.data(),
+            cam_j_from_world.rotation.coeffs().data(),
+            cam_j_from_world.translation.data(),
+            cam_from_lidar.rotation.coeffs().data(),
+            cam_from_lidar.translation.data()};
+  }
+};
+
+using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// Jacobians in the tangent space of Ceres' EigenQuaternionManifold (what the solver uses).
+std::vector<RowMajor> TangentJacobians(const ceres::CostFunction& cost,
+                                       const std::vector<double*>& blocks,
+                                       Eigen::VectorXd* residuals) {
+  const int rows = cost.num_residuals();
+  const std::vector<int32_t>& sizes = cost.parameter_block_sizes();
+  std::vector<RowMajor> ambient;
+  std::vector<double*> pointers;
+  for (const int size : sizes) ambient.emplace_back(rows, size);
+  for (RowMajor& jacobian : ambient) pointers.push_back(jacobian.data());
+  residuals->resize(rows);
+  EXPECT_TRUE(cost.Evaluate(blocks.data(), residuals->data(), pointers.data()));
+  std::vector<RowMajor> tangent;
+  for (size_t b = 0; b < sizes.size(); ++b) {
+    if (sizes[b] != 4) {
+      tangent.push_back(ambient[b]);
+      continue;
+    }
+    Eigen::Matrix<double, 4, 3, Eigen::RowMajor> plus;
+    ceres::EigenQuaternionManifold().PlusJacobian(blocks[b], plus.data());
+    tangent.push_back(ambient[b] * plus);
+  }
+  return tangent;
+}
+
+TEST(LidarPairCost, ResidualsAndTangentJacobiansEqualTheAutodiffFunctorPerObservation) {
+  PairSetup setup(7);
+  const double sigma = 0.02;
+  std::unique_ptr<ceres::CostFunction> pair(
+      LidarPairPointToPlaneCost::Create(setup.observations, sigma));
+  Eigen::VectorXd pair_residuals;
+  const std::vector<RowMajor> pair_jacobians =
+      TangentJacobians(*pair, setup.Blocks(), &pair_residuals);
+  for (int k = 0; k < 7; ++k) {
+    const PointToPlaneObservation& o = setup.observations[k];
+    std::unique_ptr<ceres::CostFunction> single(LidarPointToPlaneCostFunctor::Create(
+        o.point_in_source, o.point_in_target, o.normal_in_target, sigma));
+    Eigen::VectorXd residual;
+    const std::vector<RowMajor> jacobians = TangentJacobians(*single, setup.Blocks(), &residual);
+    EXPECT_NEAR(pair_residuals[k], residual[0], 1e-10 * (1 + std::abs(residual[0])));
+    for (size_t b = 0; b < jacobians.size(); ++b) {
+      EXPECT_LT((pair_jacobians[b].row(k) - jacobians[b]).norm(), 1e-9 * (1 + jacobians[b].norm()))
+          << "block " << b << ", observation " << k;
+    }
+  }
+}
+
+TEST(LidarPairCost, GradientCheckerAcceptsTheAnalyticJacobianInTheQuaternionTangentSpace) {
+  PairSetup setup(5);
+  std::unique_ptr<ceres::CostFunction> cost(
+      LidarPairPointToPlaneCost::Create(setup.observations, 0.02));
+  ceres::EigenQuaternionManifold quaternion;
+  const std::vector<const ceres::Manifold*> manifolds = {
+      &quaternion, nullptr, &quaternion, nullptr, &quaternion, nullptr};
+  ceres::NumericDiffOptions numeric_options;
+  ceres::GradientChecker checker(cost.get(), &manifolds, numeric_options);
+  ceres::GradientChecker::ProbeResults results;
+  std::vector<double*> blocks = setup.Blocks();
+  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-7, &results)) << results.error_log;
+  EXPECT_LT(results.maximum_relative_error, 1e-7);
+}
+
+TEST(LidarPairCost, ConstantBlocksGetNoJacobianAndTheOthersAreStillRight) {
+  PairSetup setup(3);
+  std::unique_ptr<ceres::CostFunction> cost(
+      LidarPairPointToPlaneCost::Create(setup.observations, 0.05));
+  Eigen::VectorXd residuals_all;
+  const std::vector<RowMajor> all = TangentJacobians(*cost, setup.Blocks(), &residuals_all);
+  // Only the extrinsic translation requested (the others null, as Ceres passes constant blocks).
+  RowMajor translation(3, 3);
+  std::vector<double*> jacobians(6, nullptr);
+  jacobians[5] = translation.data();
+  Eigen::VectorXd residuals(3);
+  std::vector<double*> blocks = setup.Blocks();
+  ASSERT_TRUE(cost->Evaluate(blocks.data(), residuals.data(), jacobians.data()));
+  EXPECT_LT((residuals - residuals_all).norm(), 1e-12);
+  EXPECT_LT((translation - all[5]).norm(), 1e-12);
+}
+
+}  // namespace
+}  // namespace colmap_lidar
