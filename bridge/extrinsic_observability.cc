@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <map>
 #include <sstream>
 
 namespace colmap_lidar {
@@ -266,12 +267,38 @@ Matrix6 CovarianceFromInformation(const Matrix6& information, double factor) {
   return covariance;
 }
 
+// Sum over groups of clusters of (sum of the group's scores)(...)^T, with the small-sample factor
+// G / (G - 1). `group[c]` < 0: cluster c is a group of its own.
+Eigen::MatrixXd GroupedSandwich(const std::vector<Eigen::VectorXd>& scores,
+                                const std::vector<int>& group) {
+  std::map<int, Eigen::VectorXd> sums;
+  int next_own = -1;
+  for (size_t c = 0; c < scores.size(); ++c) {
+    const int key = group.empty() || group[c] < 0 ? next_own-- : group[c];
+    auto it = sums.find(key);
+    if (it == sums.end()) {
+      sums.emplace(key, scores[c]);
+    } else {
+      it->second += scores[c];
+    }
+  }
+  const int n = scores.empty() ? 0 : static_cast<int>(scores.front().size());
+  Eigen::MatrixXd sandwich = Eigen::MatrixXd::Zero(n, n);
+  for (const auto& [key, sum] : sums) sandwich += sum * sum.transpose();
+  const double num_groups = static_cast<double>(sums.size());
+  return num_groups > 1 ? Eigen::MatrixXd(sandwich * num_groups / (num_groups - 1)) : sandwich;
+}
+
 // Cluster-robust (sandwich) covariance of T_e's free tangent, X = H^-1 E (E selects T_e),
 // v_c = (J_c X)^T r_c over the data rows, and T_e's response to a common stereo scale error
 // dx = -H^-1 J^T dr/ds. H includes the regularisers (they keep it invertible); their rows add no score.
+// With station groups (two-way clustering, Cameron, Gelbach & Miller 2011): V = V_A + V_B - V_AB, with A
+// the clusters merged by their first group key, B by their second, AB the clusters themselves, then
+// negative eigenvalues clipped; errors shared by every pair of one station are then covered.
 bool ClusterRobust(const JacobianRows& rows,
                    const Eigen::SparseMatrix<double>& information,
                    int num_other,
+                   const std::vector<std::array<int, 2>>& cluster_groups,
                    size_t num_clusters,
                    Eigen::MatrixXd* sandwich,
                    Eigen::VectorXd* scale_sensitivity) {
@@ -290,9 +317,19 @@ bool ClusterRobust(const JacobianRows& rows,
     scores[rows.cluster[row]] += y.row(row).transpose() * rows.residuals[row];
     *scale_sensitivity -= y.row(row).transpose() * rows.scale_derivative[row];
   }
-  *sandwich = Eigen::MatrixXd::Zero(num_extrinsic, num_extrinsic);
-  for (const Eigen::VectorXd& score : scores) *sandwich += score * score.transpose();
-  *sandwich *= static_cast<double>(num_clusters) / (num_clusters - 1.0);
+  *sandwich = GroupedSandwich(scores, {});
+  if (!cluster_groups.empty()) {
+    std::vector<int> first(num_clusters), second(num_clusters);
+    for (size_t c = 0; c < num_clusters; ++c) {
+      first[c] = cluster_groups[c][0];
+      second[c] = cluster_groups[c][1];
+    }
+    const Eigen::MatrixXd two_way =
+        GroupedSandwich(scores, first) + GroupedSandwich(scores, second) - *sandwich;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(two_way);
+    *sandwich = eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
+                eigen.eigenvectors().transpose();
+  }
   return sandwich->allFinite();
 }
 
@@ -337,6 +374,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     double* cam_from_lidar_translation,
     const std::array<bool, 3>& held_translation,
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
+    const std::vector<std::array<int, 2>>& cluster_groups,
     const std::vector<ceres::ResidualBlockId>& regularizers,
     const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
     const MotionAnalysis& motion,
@@ -382,8 +420,13 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
 
   Eigen::MatrixXd sandwich;
   Eigen::VectorXd scale_sensitivity;
-  if (ClusterRobust(
-          rows, information, layout.num_other, clusters.size(), &sandwich, &scale_sensitivity)) {
+  if (ClusterRobust(rows,
+                    information,
+                    layout.num_other,
+                    cluster_groups,
+                    clusters.size(),
+                    &sandwich,
+                    &scale_sensitivity)) {
     for (size_t a = 0; a < layout.extrinsic_index.size(); ++a) {
       result.stereo_scale_sensitivity[layout.extrinsic_index[a]] =
           scale_sensitivity[a] * ReportedUnit(layout.extrinsic_index[a]);

@@ -33,6 +33,10 @@ struct ObservabilityOptions {
   // a "consider" parameter: its effect on T_e, sigma^2 * s s^T with s = dT_e/dscale, is added to the
   // covariance (random residual scatter cannot reveal an error common to every depth prior).
   double stereo_scale_sigma = 0.001;
+  // Two-way clustering of the LiDAR term: besides each directed pair, the pairs that share a target
+  // station and those that share a source station form clusters (a station's cloud errors, e.g. its
+  // normals near edges, enter every pair it is part of).
+  bool two_way_lidar_clusters = true;
   double min_rotation_deg = 2.0;       // relative rotations below this do not count as rotating
   double max_parallel_axes_deg = 5.0;  // axes closer than this are parallel
 
@@ -76,6 +80,8 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
 // `motion` turns unobservable directions into advice.
 // `depth_scale_derivative`: d(residual)/d(stereo scale) of each depth-prior block (-d / sigma_d).
 // `clusters`: every data residual block of the problem, grouped (see above).
+// `cluster_groups`: empty, or per cluster two group keys (a LiDAR pair's target and source station; -1:
+// the cluster is a group of its own) for two-way clustering.
 // `regularizers`: residual blocks that are not data (the weak extrinsic prior): they keep the
 // information invertible for the sandwich but never decide what is observable.
 // `held_translation`: translation components held constant by a subset manifold (known exactly).
@@ -85,6 +91,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     double* cam_from_lidar_translation,
     const std::array<bool, 3>& held_translation,
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
+    const std::vector<std::array<int, 2>>& cluster_groups,
     const std::vector<ceres::ResidualBlockId>& regularizers,
     const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
     const MotionAnalysis& motion,

@@ -33,6 +33,10 @@ struct LidarObservation {
   bool outlier = false;
 };
 
+double SecondsSince(const std::chrono::steady_clock::time_point& start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 double TermCost(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& ids) {
   if (ids.empty()) return 0;
   ceres::Problem::EvaluateOptions options;
@@ -325,32 +329,53 @@ size_t RemoveReprojectionOutliers(RunState* state) {
   return removed;
 }
 
+// Robust scale of normalised errors: 1.4826 median |e|, clamped to [kMinScale, 1].
+double RobustScale(std::vector<double> normalised) {
+  constexpr double kMinScale = 0.1;
+  if (normalised.empty()) return 1.0;
+  const auto middle = normalised.begin() + normalised.size() / 2;
+  std::nth_element(normalised.begin(), middle, normalised.end());
+  return std::clamp(1.4826 * *middle, kMinScale, 1.0);
+}
+
 // Depth priors: the outlier set recomputed from the current state (a prior that fits again comes
 // back). Returns the number of priors whose status changed.
 size_t UpdateDepthOutliers(RunState* state, DepthOutlierStats* stats) {
   const JointAdjusterOptions& options = state->options;
-  std::set<ImagePoint> outliers;
-  size_t changed = 0;
+  struct Check {
+    ImagePoint key;
+    double error, sigma;
+  };
+  std::vector<Check> checks;
+  std::vector<double> normalised;
   for (const auto& [point3D_id, point3D] : state->reconstruction->Points3D()) {
     for (const colmap::TrackElement& element : point3D.track.Elements()) {
       const DepthPrior* prior = FindDepthPrior(state->data, element);
       if (prior == nullptr) continue;
       const colmap::Image& image = state->reconstruction->Image(element.image_id);
       const double error = std::abs((image.CamFromWorld() * point3D.xyz).z() - prior->depth);
-      const bool beyond_sigma = error > options.max_depth_error_sigmas * prior->sigma;
-      const bool beyond_absolute =
-          options.max_depth_error_m > 0 && error > options.max_depth_error_m;
-      const ImagePoint key(element.image_id, element.point2D_idx);
-      const bool was_outlier = state->depth_outliers.count(key) > 0;
-      if (beyond_sigma || beyond_absolute) {
-        outliers.insert(key);
-        stats->beyond_sigma += beyond_sigma;
-        stats->beyond_absolute += !beyond_sigma;
-        changed += !was_outlier;
-      } else if (was_outlier) {
-        ++stats->restored;
-        ++changed;
-      }
+      checks.push_back({{element.image_id, element.point2D_idx}, error, prior->sigma});
+      normalised.push_back(error / prior->sigma);
+    }
+  }
+  stats->residual_scale = RobustScale(std::move(normalised));
+  const double gate_sigmas = options.max_depth_error_sigmas *
+                             (options.depth_gate_from_residual_scale ? stats->residual_scale : 1.0);
+  std::set<ImagePoint> outliers;
+  size_t changed = 0;
+  for (const Check& check : checks) {
+    const bool beyond_sigma = check.error > gate_sigmas * check.sigma;
+    const bool beyond_absolute =
+        options.max_depth_error_m > 0 && check.error > options.max_depth_error_m;
+    const bool was_outlier = state->depth_outliers.count(check.key) > 0;
+    if (beyond_sigma || beyond_absolute) {
+      outliers.insert(check.key);
+      stats->beyond_sigma += beyond_sigma;
+      stats->beyond_absolute += !beyond_sigma;
+      changed += !was_outlier;
+    } else if (was_outlier) {
+      ++stats->restored;
+      ++changed;
     }
   }
   state->depth_outliers = std::move(outliers);
@@ -424,8 +449,10 @@ void PrintSolve(const SolveStats& stats, size_t changes) {
             << " -> " << stats.reprojection.cost_after << ", depth " << stats.depth.cost_before
             << " -> " << stats.depth.cost_after << ", lidar " << stats.lidar.cost_before << " -> "
             << stats.lidar.cost_after << "; " << stats.num_iterations << " iterations, " << changes
-            << " outlier changes (depth priors out: " << stats.depth_outliers.beyond_sigma
-            << " beyond sigma, " << stats.depth_outliers.beyond_absolute << " beyond the cap, "
+            << " outlier changes (depth priors: residual scale "
+            << stats.depth_outliers.residual_scale << " sigma_d, out "
+            << stats.depth_outliers.beyond_sigma << " beyond sigma, "
+            << stats.depth_outliers.beyond_absolute << " beyond the cap, "
             << stats.depth_outliers.restored << " back) (" << std::setprecision(2) << stats.seconds
             << " s)" << std::endl;
 }
@@ -456,21 +483,28 @@ void SolveWithOutliers(int round,
 }
 
 // Clusters of residuals that share errors: a landmark's reprojections, an image's depth priors, a
-// directed LiDAR station pair. The weak extrinsic prior is not data and is left out.
-std::vector<std::vector<ceres::ResidualBlockId>> ResidualClusters(
-    const colmap::Reconstruction& reconstruction, const JointProblem& joint) {
+// directed LiDAR station pair; per cluster its station group keys (target, source image) for two-way
+// clustering of the LiDAR term ({-1, -1} otherwise). The weak extrinsic prior is not data and is left
+// out.
+struct Clusters {
+  std::vector<std::vector<ceres::ResidualBlockId>> blocks;
+  std::vector<std::array<int, 2>> groups;
+};
+
+Clusters ResidualClusters(const colmap::Reconstruction& reconstruction, const JointProblem& joint) {
   std::unordered_map<const double*, size_t> landmark_cluster;
   for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
     landmark_cluster.emplace(point3D.xyz.data(), landmark_cluster.size());
   }
-  std::vector<std::vector<ceres::ResidualBlockId>> clusters(landmark_cluster.size());
+  Clusters clusters;
+  clusters.blocks.resize(landmark_cluster.size());
   std::vector<double*> blocks;
   for (const ceres::ResidualBlockId id : joint.reprojection_ids) {
     joint.problem->GetParameterBlocksForResidualBlock(id, &blocks);
     for (const double* block : blocks) {
       const auto it = landmark_cluster.find(block);
       if (it != landmark_cluster.end()) {
-        clusters[it->second].push_back(id);
+        clusters.blocks[it->second].push_back(id);
         break;
       }
     }
@@ -479,15 +513,22 @@ std::vector<std::vector<ceres::ResidualBlockId>> ResidualClusters(
   for (size_t k = 0; k < joint.depth_ids.size(); ++k) {
     per_image[joint.depth_images[k]].push_back(joint.depth_ids[k]);
   }
+  for (auto& [image_id, ids] : per_image) clusters.blocks.push_back(std::move(ids));
+  clusters.groups.assign(clusters.blocks.size(), {-1, -1});
   std::map<ImagePair, std::vector<ceres::ResidualBlockId>> per_pair;
   for (size_t k = 0; k < joint.lidar_ids.size(); ++k) {
     per_pair[joint.lidar_pairs[k]].push_back(joint.lidar_ids[k]);
   }
-  for (auto& [image_id, ids] : per_image) clusters.push_back(std::move(ids));
-  for (auto& [pair, ids] : per_pair) clusters.push_back(std::move(ids));
-  clusters.erase(
-      std::remove_if(clusters.begin(), clusters.end(), [](const auto& ids) { return ids.empty(); }),
-      clusters.end());
+  for (auto& [pair, ids] : per_pair) {
+    clusters.blocks.push_back(std::move(ids));
+    clusters.groups.push_back({static_cast<int>(pair.first), static_cast<int>(pair.second)});
+  }
+  for (size_t c = clusters.blocks.size(); c-- > 0;) {
+    if (clusters.blocks[c].empty()) {
+      clusters.blocks.erase(clusters.blocks.begin() + c);
+      clusters.groups.erase(clusters.groups.begin() + c);
+    }
+  }
   return clusters;
 }
 
@@ -498,16 +539,19 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
   for (size_t k = 0; k < joint.depth_ids.size(); ++k) {
     depth_scale_derivative[joint.depth_ids[k]] = joint.depth_scale_derivatives[k];
   }
-  ExtrinsicUncertainty uncertainty =
-      ComputeExtrinsicUncertainty(joint.problem.get(),
-                                  state.ExtrinsicRotation(),
-                                  state.ExtrinsicTranslation(),
-                                  state.options.hold_translation,
-                                  ResidualClusters(*state.reconstruction, joint),
-                                  joint.prior_ids,
-                                  depth_scale_derivative,
-                                  motion,
-                                  state.options.observability);
+  const Clusters clusters = ResidualClusters(*state.reconstruction, joint);
+  ExtrinsicUncertainty uncertainty = ComputeExtrinsicUncertainty(
+      joint.problem.get(),
+      state.ExtrinsicRotation(),
+      state.ExtrinsicTranslation(),
+      state.options.hold_translation,
+      clusters.blocks,
+      state.options.observability.two_way_lidar_clusters ? clusters.groups
+                                                         : std::vector<std::array<int, 2>>(),
+      joint.prior_ids,
+      depth_scale_derivative,
+      motion,
+      state.options.observability);
   if (joint.reprojection_ids.empty() && joint.depth_ids.empty()) {
     uncertainty.unobservable.insert(
         uncertainty.unobservable.begin(),
@@ -618,10 +662,12 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
     if (state.use_lidar) {
       const double gate = std::max(options_.association.max_distance,
                                    options_.initial_association_distance_m * std::pow(0.5, round));
+      const auto start = std::chrono::steady_clock::now();
       observations = Associate(state, gate);
       state.num_lidar_outliers = 0;
       std::cout << "Round " << round + 1 << "/" << num_rounds << ": " << observations.size()
-                << " LiDAR point-to-plane observations (gate " << gate << " m)" << std::endl;
+                << " LiDAR point-to-plane observations (gate " << gate << " m, "
+                << SecondsSince(start) << " s)" << std::endl;
     }
     SolveWithOutliers(round, &state, &observations, &summary);
   }
@@ -635,8 +681,11 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
   summary.final_depth_residuals = final_problem->depth_ids.size();
   summary.final_lidar_residuals = final_problem->num_lidar_residuals;
   if (state.use_lidar) {
+    const auto start = std::chrono::steady_clock::now();
     summary.uncertainty = Uncertainty(state, *final_problem, summary.motion);
     summary.perturbation = PerturbationCurves(state, final_problem.get());
+    std::cout << "Uncertainty and perturbation curves (" << SecondsSince(start) << " s)"
+              << std::endl;
   }
   return summary;
 }

@@ -70,6 +70,10 @@ struct JointAdjusterOptions {
   // `max_depth_error_m` > 0, beyond that absolute cap; it comes back when it fits again after a solve.
   double max_reprojection_error_px = 3.0;
   double max_depth_error_sigmas = 3.0;
+  // Scale the sigma gate by the priors' robust residual scale s = 1.4826 median |error| / sigma_d,
+  // clamped to [0.1, 1]: sigma_d with sigma_p = 1 px is several times conservative for SGBM (measured
+  // s ~ 0.16), and a gate of 3 sigma_d would then be 18 actual sigmas. With s = 1 this is 3 sigma_d.
+  bool depth_gate_from_residual_scale = true;
   double max_depth_error_m = 0.0;
   double max_point_to_plane_m = 0.1;
   int max_outlier_iterations = 10;
@@ -118,6 +122,8 @@ struct TermStats {
 // Depth priors set aside after a solve, by the rule that removed them (a prior over both counts once,
 // as `beyond_sigma`), and those that fit again and came back.
 struct DepthOutlierStats {
+  // Robust scale of |error| / sigma_d over all priors after the solve (see JointAdjusterOptions).
+  double residual_scale = 1;
   size_t beyond_sigma = 0;
   size_t beyond_absolute = 0;
   size_t restored = 0;

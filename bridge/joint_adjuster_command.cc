@@ -95,7 +95,8 @@ void WriteReport(const std::string& directory,
                       {"depth", TermJson(solve.depth)},
                       {"lidar", TermJson(solve.lidar)},
                       {"depth_outliers",
-                       {{"beyond_sigma", solve.depth_outliers.beyond_sigma},
+                       {{"residual_scale", solve.depth_outliers.residual_scale},
+                        {"beyond_sigma", solve.depth_outliers.beyond_sigma},
                         {"beyond_absolute", solve.depth_outliers.beyond_absolute},
                         {"restored", solve.depth_outliers.restored}}},
                       {"iterations", solve.num_iterations},
@@ -191,12 +192,82 @@ void WritePlots(const std::string& directory, const JointAdjustmentSummary& summ
   WriteLinePlotPng(directory + "/perturbation_rotation.png", rotation, plot);
 }
 
+// The adjuster's and the data loader's options; `num_samples` and `hold_translation` are parsed after.
+void AddJointOptions(colmap::OptionManager* options,
+                     JointAdjusterOptions* adjuster,
+                     JointDataOptions* data_options,
+                     int* num_samples,
+                     std::string* hold_translation) {
+  options->AddDefaultOption("sigma_lidar_m", &adjuster->sigma_lidar_m);
+  options->AddDefaultOption("depth_weight", &adjuster->depth_weight);
+  options->AddDefaultOption("lidar_weight", &adjuster->lidar_weight);
+  options->AddDefaultOption("loss", &adjuster->loss, "none | huber | cauchy");
+  options->AddDefaultOption("loss_scale", &adjuster->loss_scale);
+  options->AddDefaultOption("max_reprojection_error_px", &adjuster->max_reprojection_error_px);
+  options->AddDefaultOption("max_depth_error_sigmas", &adjuster->max_depth_error_sigmas);
+  options->AddDefaultOption("depth_gate_from_residual_scale",
+                            &adjuster->depth_gate_from_residual_scale);
+  options->AddDefaultOption("max_depth_error_m",
+                            &adjuster->max_depth_error_m,
+                            "absolute cap on top of the sigma gate; 0: off");
+  options->AddDefaultOption("max_point_to_plane_m", &adjuster->max_point_to_plane_m);
+  options->AddDefaultOption("max_outlier_iterations", &adjuster->max_outlier_iterations);
+  options->AddDefaultOption("num_association_rounds", &adjuster->num_association_rounds);
+  *num_samples = static_cast<int>(adjuster->association.num_samples);
+  options->AddDefaultOption("num_samples_per_pair", num_samples);
+  options->AddDefaultOption("normal_space_sampling", &adjuster->association.normal_space_sampling);
+  options->AddDefaultOption("association_max_distance_m", &adjuster->association.max_distance);
+  options->AddDefaultOption("initial_association_distance_m",
+                            &adjuster->initial_association_distance_m);
+  options->AddDefaultOption("hold_rotation", &adjuster->hold_rotation);
+  options->AddDefaultOption(
+      "hold_translation", hold_translation, "comma-separated camera axes, e.g. y or x,z");
+  options->AddDefaultOption("max_num_iterations", &adjuster->max_num_iterations);
+  options->AddDefaultOption("extrinsic_prior_sigma_m", &adjuster->extrinsic_prior_sigma_m);
+  options->AddDefaultOption("min_image_pair_inliers", &data_options->min_image_pair_inliers);
+  options->AddDefaultOption("max_lidar_neighbors", &data_options->max_lidar_neighbors);
+  options->AddDefaultOption("stereo_scale_sigma", &adjuster->observability.stereo_scale_sigma);
+  options->AddDefaultOption("two_way_lidar_clusters",
+                            &adjuster->observability.two_way_lidar_clusters);
+  options->AddDefaultOption("unobservable_translation_mm",
+                            &adjuster->observability.unobservable_translation_mm);
+  options->AddDefaultOption("unobservable_rotation_deg",
+                            &adjuster->observability.unobservable_rotation_deg);
+}
+
+// --cam_from_lidar FILE, else INPUT/cam_from_lidar.txt (pose_initializer's), else rig.json's guess.
+colmap::Rigid3d InitialCamFromLidar(const std::string& cam_from_lidar_path,
+                                    const std::string& input_path,
+                                    const StationDataset& dataset) {
+  const std::string model_extrinsic = (fs::path(input_path) / "cam_from_lidar.txt").string();
+  if (!cam_from_lidar_path.empty()) return ReadPoseFile(cam_from_lidar_path);
+  if (fs::exists(model_extrinsic)) return ReadPoseFile(model_extrinsic);
+  if (dataset.rig.cam_from_lidar_guess) return *dataset.rig.cam_from_lidar_guess;
+  throw std::runtime_error(
+      "no initial cam_from_lidar: pass --cam_from_lidar FILE or add cam_from_lidar_guess to " +
+      dataset.root + "/rig.json");
+}
+
+void PrintUncertainty(const JointAdjustmentSummary& summary) {
+  std::cout << "Motion: " << summary.motion.verdict << std::endl;
+  if (summary.uncertainty.computed) {
+    const Eigen::VectorXd sigma = summary.uncertainty.covariance.diagonal().cwiseSqrt();
+    std::cout << std::setprecision(3) << "cam_from_lidar sigma: rotation "
+              << sigma.head<3>().transpose() << " deg, translation " << sigma.tail<3>().transpose()
+              << " mm" << std::endl;
+  }
+  for (const std::string& sentence : summary.uncertainty.unobservable) {
+    std::cout << "UNOBSERVABLE: " << sentence << std::endl;
+  }
+}
+
 }  // namespace
 
 int RunJointAdjuster(int argc, char** argv) {
   std::string input_path, dataset_path, output_path, cam_from_lidar_path;
   std::string mode = "joint", hold_translation;
   bool write_text = false;
+  int num_samples = 0;
   JointAdjusterOptions adjuster;
   JointDataOptions data_options;
   colmap::OptionManager options;
@@ -207,46 +278,17 @@ int RunJointAdjuster(int argc, char** argv) {
   options.AddDefaultOption("mode", &mode, "joint | precalibrated | stereo_only");
   options.AddDefaultOption("cam_from_lidar",
                            &cam_from_lidar_path,
-                           "qw qx qy qz tx ty tz file; default: "
-                           "INPUT/cam_from_lidar.txt, else rig.json's "
-                           "cam_from_lidar_guess");
+                           "qw qx qy qz tx ty tz file; default: INPUT/cam_from_lidar.txt, else "
+                           "rig.json's cam_from_lidar_guess");
   options.AddDefaultOption("write_text", &write_text);
-  options.AddDefaultOption("sigma_lidar_m", &adjuster.sigma_lidar_m);
-  options.AddDefaultOption("depth_weight", &adjuster.depth_weight);
-  options.AddDefaultOption("lidar_weight", &adjuster.lidar_weight);
-  options.AddDefaultOption("loss", &adjuster.loss, "none | huber | cauchy");
-  options.AddDefaultOption("loss_scale", &adjuster.loss_scale);
-  options.AddDefaultOption("max_reprojection_error_px", &adjuster.max_reprojection_error_px);
-  options.AddDefaultOption("max_depth_error_sigmas", &adjuster.max_depth_error_sigmas);
-  options.AddDefaultOption("max_depth_error_m",
-                           &adjuster.max_depth_error_m,
-                           "absolute cap on top of the sigma gate; 0: off");
-  options.AddDefaultOption("max_point_to_plane_m", &adjuster.max_point_to_plane_m);
-  options.AddDefaultOption("num_association_rounds", &adjuster.num_association_rounds);
-  int num_samples = static_cast<int>(adjuster.association.num_samples);
-  options.AddDefaultOption("num_samples_per_pair", &num_samples);
-  options.AddDefaultOption("normal_space_sampling", &adjuster.association.normal_space_sampling);
-  options.AddDefaultOption("association_max_distance_m", &adjuster.association.max_distance);
-  options.AddDefaultOption("initial_association_distance_m",
-                           &adjuster.initial_association_distance_m);
-  options.AddDefaultOption("hold_rotation", &adjuster.hold_rotation);
-  options.AddDefaultOption(
-      "hold_translation", &hold_translation, "comma-separated camera axes, e.g. y or x,z");
-  options.AddDefaultOption("max_num_iterations", &adjuster.max_num_iterations);
-  options.AddDefaultOption("extrinsic_prior_sigma_m", &adjuster.extrinsic_prior_sigma_m);
-  options.AddDefaultOption("min_image_pair_inliers", &data_options.min_image_pair_inliers);
-  options.AddDefaultOption("max_lidar_neighbors", &data_options.max_lidar_neighbors);
-  options.AddDefaultOption("stereo_scale_sigma", &adjuster.observability.stereo_scale_sigma);
-  options.AddDefaultOption("unobservable_translation_mm",
-                           &adjuster.observability.unobservable_translation_mm);
-  options.AddDefaultOption("unobservable_rotation_deg",
-                           &adjuster.observability.unobservable_rotation_deg);
+  AddJointOptions(&options, &adjuster, &data_options, &num_samples, &hold_translation);
   options.Parse(argc, argv);
   adjuster.mode = JointModeFromName(mode);
   adjuster.hold_translation = ParseHeldAxes(hold_translation);
   THROW_CHECK_GT(num_samples, 0);
   adjuster.association.num_samples = static_cast<size_t>(num_samples);
   THROW_CHECK(adjuster.Check());
+  THROW_CHECK(data_options.Check());
   const auto start = std::chrono::steady_clock::now();
 
   const StationDataset dataset = ReadStationDataset(dataset_path);
@@ -255,20 +297,7 @@ int RunJointAdjuster(int argc, char** argv) {
   reconstruction.Read(input_path);
   THROW_CHECK_GE(reconstruction.NumRegImages(), 2)
       << input_path << " has fewer than 2 registered images";
-  colmap::Rigid3d cam_from_lidar;
-  const std::string model_extrinsic = (fs::path(input_path) / "cam_from_lidar.txt").string();
-  if (!cam_from_lidar_path.empty()) {
-    cam_from_lidar = ReadPoseFile(cam_from_lidar_path);
-  } else if (fs::exists(model_extrinsic)) {
-    cam_from_lidar = ReadPoseFile(model_extrinsic);  // pose_initializer's
-  } else if (dataset.rig.cam_from_lidar_guess) {
-    cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
-  } else {
-    throw std::runtime_error(
-        "no initial cam_from_lidar: pass --cam_from_lidar FILE or add "
-        "cam_from_lidar_guess to " +
-        dataset.root + "/rig.json");
-  }
+  colmap::Rigid3d cam_from_lidar = InitialCamFromLidar(cam_from_lidar_path, input_path, dataset);
   const colmap::Rigid3d initial = cam_from_lidar;
   std::cout << "Joint adjuster (" << mode << "): " << reconstruction.NumRegImages() << " images, "
             << reconstruction.NumPoints3D() << " landmarks" << std::endl;
@@ -279,10 +308,11 @@ int RunJointAdjuster(int argc, char** argv) {
                            cam_from_lidar,
                            adjuster.mode != JointMode::kStereoOnly,
                            data_options);
-
-  const JointAdjuster joint_adjuster(adjuster);
+  std::cout << "Loaded depth priors, clouds and the pose graph ("
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+            << " s)" << std::endl;
   const JointAdjustmentSummary summary =
-      joint_adjuster.Run(loaded->data, &reconstruction, &cam_from_lidar);
+      JointAdjuster(adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);
 
   // Everything into OUTPUT.partial, renamed at the end: never a half-written output folder.
   const fs::path output(output_path);
@@ -299,17 +329,7 @@ int RunJointAdjuster(int argc, char** argv) {
   WritePlots(partial.string(), summary);
   fs::remove_all(output);
   fs::rename(partial, output);
-
-  std::cout << "Motion: " << summary.motion.verdict << std::endl;
-  if (summary.uncertainty.computed) {
-    const Eigen::VectorXd sigma = summary.uncertainty.covariance.diagonal().cwiseSqrt();
-    std::cout << std::setprecision(3) << "cam_from_lidar sigma: rotation "
-              << sigma.head<3>().transpose() << " deg, translation " << sigma.tail<3>().transpose()
-              << " mm" << std::endl;
-  }
-  for (const std::string& sentence : summary.uncertainty.unobservable) {
-    std::cout << "UNOBSERVABLE: " << sentence << std::endl;
-  }
+  PrintUncertainty(summary);
   std::cout << "Wrote " << output_path << " ("
             << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
             << " s)" << std::endl;

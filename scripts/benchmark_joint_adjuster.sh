@@ -2,6 +2,10 @@
 # Joint problem vs COLMAP's plain bundle adjustment on the same reconstruction (simulated default scene):
 # time of set-up + 1 and + 10 iterations, and the overhead ratio. Writes docs/benchmarks/joint_adjuster.md.
 #   STATIONS (default 10), LIDAR_POINTS per station (default 300000)
+#   BASELINE_REV   a git revision whose benchmark also runs on the same data (built in a worktree under
+#                  build-baseline/), for a before/after table in one run
+#   BASELINE_BENCHMARK  instead of BASELINE_REV: an already built joint_adjuster_benchmark of the
+#                  baseline (its revision is read from BASELINE_REV_NAME, default "baseline")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
@@ -17,8 +21,25 @@ $cli simulate_dataset --output_path "$work/dataset" --num_stations "${STATIONS:-
 $cli stereo_depth --dataset_path "$work/dataset" --output_path "$work/stereo" >/dev/null
 $cli import_dataset --dataset_path "$work/dataset" --database_path "$work/db.db" >/dev/null 2>&1
 $cli depth_prior_extractor --database_path "$work/db.db" --depth_path "$work/stereo" >/dev/null
-table=$(build/bin/joint_adjuster_benchmark "$work/dataset" "$work/db.db" "$work" 2>/dev/null |
-        grep -v '^\(Round\|  solve\|Depth priors\|Pose graph\|  cloud\)')
+run_benchmark() {
+  "$1" "$work/dataset" "$work/db.db" "$2" 2>/dev/null |
+    grep -v '^\(Round\|  solve\|Depth priors\|Pose graph\|  cloud\)'
+}
+table=$(run_benchmark build/bin/joint_adjuster_benchmark "$work/now")
+baseline=""
+if [ -n "${BASELINE_BENCHMARK:-}" ]; then
+  rev="${BASELINE_REV_NAME:-baseline}"
+  baseline=$(run_benchmark "$BASELINE_BENCHMARK" "$work/baseline")
+elif [ -n "${BASELINE_REV:-}" ]; then
+  rev=$(git rev-parse --short "$BASELINE_REV")
+  rm -rf build-baseline && git worktree prune
+  git worktree add --detach build-baseline/src "$rev" >/dev/null 2>&1
+  cmake -S build-baseline/src -B build-baseline/build -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_PREFIX_PATH="$kColmapPrefix" >/dev/null
+  cmake --build build-baseline/build --target joint_adjuster_benchmark >/dev/null
+  baseline=$(run_benchmark build-baseline/build/bin/joint_adjuster_benchmark "$work/baseline")
+  git worktree remove --force build-baseline/src
+fi
 mkdir -p docs/benchmarks
 {
   echo "# Joint adjuster vs COLMAP's bundle adjustment"
@@ -32,5 +53,11 @@ mkdir -p docs/benchmarks
   echo "adding the blocks and the outlier check, not the (once per round) LiDAR association."
   echo
   echo "$table"
+  if [ -n "$baseline" ]; then
+    echo
+    echo "### Before: revision $rev on the same data, in the same run"
+    echo
+    echo "$baseline"
+  fi
 } > docs/benchmarks/joint_adjuster.md
 cat docs/benchmarks/joint_adjuster.md

@@ -4,7 +4,10 @@
 # run and axis the error against the truth in units of the reported sigma, then the 2-sigma coverage per
 # axis. Writes docs/benchmarks/uncertainty.md.
 #   SEEDS (default 10), SCENES (default "t_specimen bridge_pier"), STATIONS (default 8),
-#   LIDAR_POINTS per station (default 300000), BUILD_DIR (default build)
+#   LIDAR_POINTS per station (default 300000), BUILD_DIR (default build),
+#   WORK_DIR       keep the runs there (default: a temporary folder, removed); steps already done in
+#                  WORK_DIR are not run again, so that a changed joint adjuster can be re-evaluated on the
+#                  same front ends by deleting the runs' ws/joint folders
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
@@ -13,28 +16,41 @@ readonly kBuild="${BUILD_DIR:-build}"
 cmake -S . -B "$kBuild" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$kColmapPrefix" >/dev/null
 cmake --build "$kBuild" --target colmap_lidar_cli >/dev/null
 cli="$kBuild/bin/colmap-lidar"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+if [ -n "${WORK_DIR:-}" ]; then
+  work="$WORK_DIR"
+  mkdir -p "$work"
+else
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+fi
 results="$work/results.tsv"
 : > "$results"
 for scene in ${SCENES:-t_specimen bridge_pier}; do
   for seed in $(seq 1 "${SEEDS:-10}"); do
     run="$work/$scene-$seed"
     echo "[$scene seed $seed] simulating and running the pipeline ..."
-    $cli simulate_dataset --scene "$scene" --seed "$seed" --num_stations "${STATIONS:-8}" \
-      --lidar_points "${LIDAR_POINTS:-300000}" --output_path "$run/dataset" >/dev/null
     ws="$run/ws"
     mkdir -p "$ws"
-    if ! { $cli stereo_depth --dataset_path "$run/dataset" --output_path "$ws/stereo" &&
-           $cli import_dataset --dataset_path "$run/dataset" --database_path "$ws/db.db" \
+    step() {  # step OUTPUT COMMAND...: runs COMMAND unless OUTPUT exists
+      local output="$1"
+      shift
+      [ -e "$output" ] || "$@" >> "$run/log.txt" 2>&1
+    }
+    if ! { step "$run/dataset" $cli simulate_dataset --scene "$scene" --seed "$seed" \
+             --num_stations "${STATIONS:-8}" --lidar_points "${LIDAR_POINTS:-300000}" \
+             --output_path "$run/dataset" &&
+           step "$ws/stereo" $cli stereo_depth --dataset_path "$run/dataset" --output_path "$ws/stereo" &&
+           step "$ws/db.db" $cli import_dataset --dataset_path "$run/dataset" --database_path "$ws/db.db" \
              --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2 &&
-           $cli depth_prior_extractor --database_path "$ws/db.db" --depth_path "$ws/stereo" &&
-           $cli lidar_registrator --lidar_path "$run/dataset/lidar" --output_path "$ws/lidar" \
-             --max_neighbors 4 &&
-           $cli pose_initializer --database_path "$ws/db.db" --dataset_path "$run/dataset" \
-             --registration_path "$ws/lidar" --output_path "$ws/initial" --use_guess 0 &&
-           $cli joint_adjuster --database_path "$ws/db.db" --input_path "$ws/initial" \
-             --dataset_path "$run/dataset" --output_path "$ws/joint"; } > "$run/log.txt" 2>&1; then
+           step "$ws/priors.done" $cli depth_prior_extractor --database_path "$ws/db.db" \
+             --depth_path "$ws/stereo" && touch "$ws/priors.done" &&
+           step "$ws/lidar" $cli lidar_registrator --lidar_path "$run/dataset/lidar" \
+             --output_path "$ws/lidar" --max_neighbors 4 &&
+           step "$ws/initial" $cli pose_initializer --database_path "$ws/db.db" \
+             --dataset_path "$run/dataset" --registration_path "$ws/lidar" --output_path "$ws/initial" \
+             --use_guess 0 &&
+           step "$ws/joint" $cli joint_adjuster --database_path "$ws/db.db" --input_path "$ws/initial" \
+             --dataset_path "$run/dataset" --output_path "$ws/joint"; }; then
       echo "  failed (see the log below)"; tail -5 "$run/log.txt"
       printf '%s\t%s\tFAILED\n' "$scene" "$seed" >> "$results"
       continue

@@ -146,6 +146,17 @@ TEST(CliTest, HelpVersionAndErrors) {
   EXPECT_NE(missing_db.exit_code, 0);
   EXPECT_NE(missing_db.output.find(dir.File("x.db")), std::string::npos) << missing_db.output;
   EXPECT_FALSE(fs::exists(dir.File("x.db"))) << "database_info must not create a database";
+
+  // A nested option check (the observability thresholds inside the joint adjuster's options) is acted
+  // on: the value is refused before any file is read.
+  const auto bad_threshold =
+      RunCommand(cli + " joint_adjuster --database_path " + dir.File("x.db") + " --input_path " +
+                 dir.File("m") + " --dataset_path " + dir.File("d") + " --output_path " +
+                 dir.File("o") + " --unobservable_translation_mm -1");
+  EXPECT_NE(bad_threshold.exit_code, 0);
+  EXPECT_NE(bad_threshold.output.find("unobservable_translation_mm > 0"), std::string::npos)
+      << bad_threshold.output;
+  EXPECT_FALSE(fs::exists(dir.File("o")));
 }
 
 TEST(CliTest, OptionsFromAProjectIniFile) {
