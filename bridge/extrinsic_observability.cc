@@ -376,6 +376,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
     const std::vector<std::array<int, 2>>& cluster_groups,
     const std::vector<ceres::ResidualBlockId>& regularizers,
+    size_t hidden_residuals,
     const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
     const MotionAnalysis& motion,
     const ObservabilityOptions& options) {
@@ -412,7 +413,8 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
   double squared_norm = 0;
   for (int row = 0; row < rows.num_data_rows; ++row)
     squared_norm += rows.residuals[row] * rows.residuals[row];
-  const int redundancy = rows.num_data_rows - static_cast<int>(information.cols());
+  const int redundancy = rows.num_data_rows + static_cast<int>(hidden_residuals) -
+                         static_cast<int>(information.cols());
   result.variance_factor = redundancy > 0 ? squared_norm / redundancy : 1.0;
   result.formal_covariance = CovarianceFromInformation(
       ToReportedUnits(marginal, layout.extrinsic_index, -1, 1e30), result.variance_factor);

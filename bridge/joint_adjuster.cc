@@ -102,6 +102,8 @@ struct JointProblem {
   std::vector<ceres::ResidualBlockId> lidar_ids;
   std::vector<ImagePair> lidar_pairs;  // parallel to lidar_ids
   size_t num_lidar_residuals = 0;
+  // Residuals that compressed LiDAR blocks stand for beyond the rows they have.
+  size_t num_hidden_residuals = 0;
   std::vector<ceres::ResidualBlockId> prior_ids;
 };
 
@@ -243,9 +245,14 @@ void AddLidarBlocks(const RunState& state,
     const auto [source_rotation, source_translation] =
         PoseBlocks(state, problem, observation.source);
     joint->num_lidar_residuals += group.size();
+    if (state.options.compress_lidar_blocks &&
+        group.size() > static_cast<size_t>(LidarPairPointToPlaneCost::kCompressedResiduals)) {
+      joint->num_hidden_residuals += group.size() - LidarPairPointToPlaneCost::kCompressedResiduals;
+    }
     joint->lidar_pairs.emplace_back(observation.target, observation.source);
     joint->lidar_ids.push_back(
-        problem->AddResidualBlock(LidarPairPointToPlaneCost::Create(std::move(group), sigma),
+        problem->AddResidualBlock(LidarPairPointToPlaneCost::Create(
+                                      std::move(group), sigma, state.options.compress_lidar_blocks),
                                   state.loss.get(),
                                   {target_rotation,
                                    target_translation,
@@ -549,6 +556,7 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
       state.options.observability.two_way_lidar_clusters ? clusters.groups
                                                          : std::vector<std::array<int, 2>>(),
       joint.prior_ids,
+      joint.num_hidden_residuals,
       depth_scale_derivative,
       motion,
       state.options.observability);

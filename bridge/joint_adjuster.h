@@ -63,6 +63,9 @@ struct JointAdjusterOptions {
   // observation is its own residual block (the loss applies per observation); without, one block per
   // directed station pair.
   std::string loss = "none";
+  // Each LiDAR pair block in its compressed form (bridge/lidar_pair_cost.h): the same cost, gradient
+  // and Gauss-Newton model in 19 rows instead of one per observation.
+  bool compress_lidar_blocks = true;
   // Scale of the loss in units of the whitened residual.
   double loss_scale = 1.0;
   // Outliers get zero weight until none remain (the paper's 3 px / 0.01 m / 0.1 m). A depth prior is an

@@ -203,6 +203,7 @@ void AddJointOptions(colmap::OptionManager* options,
   options->AddDefaultOption("lidar_weight", &adjuster->lidar_weight);
   options->AddDefaultOption("loss", &adjuster->loss, "none | huber | cauchy");
   options->AddDefaultOption("loss_scale", &adjuster->loss_scale);
+  options->AddDefaultOption("compress_lidar_blocks", &adjuster->compress_lidar_blocks);
   options->AddDefaultOption("max_reprojection_error_px", &adjuster->max_reprojection_error_px);
   options->AddDefaultOption("max_depth_error_sigmas", &adjuster->max_depth_error_sigmas);
   options->AddDefaultOption("depth_gate_from_residual_scale",

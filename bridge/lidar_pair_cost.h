@@ -15,10 +15,18 @@
 // sets): J_ambient = J_tangent P^T with P = PlusJacobian (P^T P = I for a unit quaternion), so that
 // J_ambient P = J_tangent. The manifold's tangent delta rotates by 2|delta| (q_delta = (cos|delta|,
 // sin|delta| delta/|delta|)), hence J_tangent = 2 J_rotation_vector.
+//
+// Compressed (the default for more than 19 observations): the block returns 18 + 1 residuals whose
+// Jacobian R and values r' satisfy R^T R = J^T J, R^T r' = J^T r and |r'|^2 + e^2 = |r|^2 (see the .cc):
+// Ceres sees the same cost, gradient and Gauss-Newton model, but forms its normal equations from 19 rows
+// per pair instead of thousands. Such residuals are not a smooth function of the parameters (only their
+// linearisation at the evaluation point is), so GradientChecker applies to the plain form only; the
+// tests compare the two forms' cost, J^T J and J^T r.
 #pragma once
 
 #include "lidar/point_to_plane_association.h"
 
+#include <Eigen/Core>
 #include <ceres/cost_function.h>
 
 #include <vector>
@@ -27,11 +35,25 @@ namespace colmap_lidar {
 
 class LidarPairPointToPlaneCost : public ceres::CostFunction {
  public:
+  static constexpr int kCompressedResiduals = 19;
+  using TangentJacobian = Eigen::Matrix<double, Eigen::Dynamic, 18, Eigen::RowMajor>;
+
   // `observations`: p in lidar_j, q and unit n in lidar_i; at least one.
-  LidarPairPointToPlaneCost(std::vector<PointToPlaneObservation> observations, double sigma);
+  LidarPairPointToPlaneCost(std::vector<PointToPlaneObservation> observations,
+                            double sigma,
+                            bool compress);
 
   static ceres::CostFunction* Create(std::vector<PointToPlaneObservation> observations,
-                                     double sigma);
+                                     double sigma,
+                                     bool compress = true);
+
+  // The plain residuals (one per observation) and, if asked, their Jacobian in the tangent space of the
+  // six blocks (3 columns each, quaternion tangents as Ceres' manifold defines them).
+  void Linearize(double const* const* parameters,
+                 Eigen::VectorXd* residuals,
+                 TangentJacobian* jacobian) const;
+
+  int NumObservations() const { return static_cast<int>(observations_.size()); }
 
   bool Evaluate(double const* const* parameters,
                 double* residuals,
@@ -40,6 +62,7 @@ class LidarPairPointToPlaneCost : public ceres::CostFunction {
  private:
   const std::vector<PointToPlaneObservation> observations_;
   const double inverse_sigma_;
+  const bool compressed_;
 };
 
 }  // namespace colmap_lidar

@@ -130,5 +130,46 @@ TEST(LidarPairCost, ConstantBlocksGetNoJacobianAndTheOthersAreStillRight) {
   EXPECT_LT((translation - all[5]).norm(), 1e-12);
 }
 
+// The compressed block (19 rows for 200 observations) gives Ceres the same cost, the same J^T J and
+// the same J^T r as the plain block, in the manifold's tangent space, also with constant blocks.
+TEST(LidarPairCost, CompressedBlockHasThePlainCostGradientAndNormalEquations) {
+  PairSetup setup(200);
+  // Off the optimum: residuals of a few centimetres.
+  for (PointToPlaneObservation& o : setup.observations)
+    o.point_in_target += 0.03 * o.normal_in_target;
+  std::unique_ptr<ceres::CostFunction> plain(
+      LidarPairPointToPlaneCost::Create(setup.observations, 0.02, /*compress=*/false));
+  std::unique_ptr<ceres::CostFunction> compressed(
+      LidarPairPointToPlaneCost::Create(setup.observations, 0.02, /*compress=*/true));
+  ASSERT_EQ(plain->num_residuals(), 200);
+  ASSERT_EQ(compressed->num_residuals(), LidarPairPointToPlaneCost::kCompressedResiduals);
+  Eigen::VectorXd r_plain, r_compressed;
+  const std::vector<RowMajor> j_plain = TangentJacobians(*plain, setup.Blocks(), &r_plain);
+  const std::vector<RowMajor> j_compressed =
+      TangentJacobians(*compressed, setup.Blocks(), &r_compressed);
+  EXPECT_NEAR(r_compressed.squaredNorm(), r_plain.squaredNorm(), 1e-9 * r_plain.squaredNorm());
+  const auto stack = [](const std::vector<RowMajor>& blocks) {
+    RowMajor all(blocks[0].rows(), 18);
+    for (int b = 0; b < 6; ++b) all.middleCols(3 * b, 3) = blocks[b];
+    return all;
+  };
+  const RowMajor a = stack(j_plain), b = stack(j_compressed);
+  const Eigen::MatrixXd normal_plain = a.transpose() * a;
+  EXPECT_LT((b.transpose() * b - normal_plain).norm(), 1e-9 * normal_plain.norm());
+  const Eigen::VectorXd gradient_plain = a.transpose() * r_plain;
+  EXPECT_LT((b.transpose() * r_compressed - gradient_plain).norm(), 1e-9 * gradient_plain.norm());
+  // Cost-only evaluation: the same cost.
+  Eigen::VectorXd cost_only(LidarPairPointToPlaneCost::kCompressedResiduals);
+  std::vector<double*> blocks = setup.Blocks();
+  ASSERT_TRUE(compressed->Evaluate(blocks.data(), cost_only.data(), nullptr));
+  EXPECT_NEAR(cost_only.squaredNorm(), r_plain.squaredNorm(), 1e-9 * r_plain.squaredNorm());
+  // Few observations: the plain form.
+  std::unique_ptr<ceres::CostFunction> small(LidarPairPointToPlaneCost::Create(
+      std::vector<PointToPlaneObservation>(setup.observations.begin(),
+                                           setup.observations.begin() + 10),
+      0.02));
+  EXPECT_EQ(small->num_residuals(), 10);
+}
+
 }  // namespace
 }  // namespace colmap_lidar

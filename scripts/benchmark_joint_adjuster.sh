@@ -50,7 +50,9 @@ mkdir -p docs/benchmarks
   echo "poses, landmarks from \`colmap point_triangulator\`) with intrinsics fixed and the first pose"
   echo "constant. COLMAP: \`BundleAdjuster::Solve\`. Joint: COLMAP's \`SetUpProblem\` plus our depth-prior"
   echo "and LiDAR point-to-plane blocks and \`cam_from_lidar\`, then \`ceres::Solve\`; the time also covers"
-  echo "adding the blocks and the outlier check, not the (once per round) LiDAR association."
+  echo "adding the blocks and the outlier check, not the (once per round) LiDAR association. \"Per"
+  echo "iteration (Ceres)\" is the mean of Ceres' own iteration times (the initial evaluation left out);"
+  echo "the baseline's older benchmark divides the whole solve time by the iterations instead."
   echo
   echo "$table"
   if [ -n "$baseline" ]; then
