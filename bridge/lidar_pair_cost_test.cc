@@ -1,6 +1,7 @@
 #include "bridge/lidar_pair_cost.h"
 
 #include "bridge/lidar_point_to_plane_cost.h"
+#include "tests/testing/generic_poses.h"
 
 #include "colmap/geometry/rigid3.h"
 
@@ -14,18 +15,8 @@
 namespace colmap_lidar {
 namespace {
 
-colmap::Rigid3d Pose(double angle,
-                     const Eigen::Vector3d& axis,
-                     const Eigen::Vector3d& translation) {
-  return colmap::Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())),
-                         translation);
-}
-
-// Generic poses (no axis-aligned rotation) and random observations around them.
-struct PairSetup {
-  colmap::Rigid3d cam_i_from_world = Pose(0.6, {0.2, -0.9, 0.4}, {0.3, -0.2, 1.9});
-  colmap::Rigid3d cam_j_from_world = Pose(-1.1, {0.7, 0.3, -0.5}, {-0.8, 0.4, 2.4});
-  colmap::Rigid3d cam_from_lidar = Pose(2.0, {0.4, -0.5, 0.6}, {0.19, -0.25, -0.05});
+// Generic poses and random observations around them.
+struct PairSetup : testing::GenericStationPair {
   std::vector<PointToPlaneObservation> observations;
 
   explicit PairSetup(int num_observations) {
@@ -38,14 +29,6 @@ struct PairSetup {
       observations.push_back(
           {2 * random_vector(), 2 * random_vector(), random_vector().normalized()});
     }
-  }
-  std::vector<double*> Blocks() {
-    return {cam_i_from_world.rotation.coeffs().data(),
-            cam_i_from_world.translation.data(),
-            cam_j_from_world.rotation.coeffs().data(),
-            cam_j_from_world.translation.data(),
-            cam_from_lidar.rotation.coeffs().data(),
-            cam_from_lidar.translation.data()};
   }
 };
 

@@ -29,6 +29,21 @@ double MaxPositionErrorMm(const testing::SyntheticJointProblem& problem) {
   return max_error;
 }
 
+// 5 stations, 100 k LiDAR rays: a small problem for the outlier-loop and observability tests.
+testing::SyntheticJointOptions SmallProblem() {
+  testing::SyntheticJointOptions options;
+  options.num_stations = 5;
+  options.lidar_points = 100000;
+  return options;
+}
+
+// Runs the joint adjuster on `problem`, refining its reconstruction and cam_from_lidar in place.
+JointAdjustmentSummary RunOn(testing::SyntheticJointProblem* problem,
+                             const JointAdjusterOptions& options) {
+  return JointAdjuster(options).Run(
+      problem->data, &problem->reconstruction, &problem->cam_from_lidar);
+}
+
 size_t CountDepthPriorsOnLandmarks(const testing::SyntheticJointProblem& problem) {
   size_t count = 0;
   for (const auto& [point3D_id, point3D] : problem.reconstruction.Points3D()) {
@@ -41,15 +56,13 @@ size_t CountDepthPriorsOnLandmarks(const testing::SyntheticJointProblem& problem
 
 TEST(JointAdjusterExactTest, NoiseFreeRecoversExtrinsicAndPosesFromAFarGuess) {
   const sim::Scene scene = sim::Scene::Create("t_specimen");
-  const auto problem = testing::MakeSyntheticJointProblem(scene, {});
+  auto problem = testing::MakeSyntheticJointProblem(scene, {});
   ASSERT_GT(problem->reconstruction.NumPoints3D(), 500u);
-  colmap::Rigid3d cam_from_lidar = problem->cam_from_lidar;
   JointAdjusterOptions options;
   options.association.num_samples = 1500;
   options.association.max_curvature = 0.01;
-  const JointAdjuster adjuster(options);
-  const JointAdjustmentSummary summary =
-      adjuster.Run(problem->data, &problem->reconstruction, &cam_from_lidar);
+  const JointAdjustmentSummary summary = RunOn(problem.get(), options);
+  const colmap::Rigid3d& cam_from_lidar = problem->cam_from_lidar;
   ASSERT_FALSE(summary.solves.empty());
 
   const double rotation_error =
@@ -73,9 +86,7 @@ TEST(JointAdjusterExactTest, NoiseFreeRecoversExtrinsicAndPosesFromAFarGuess) {
 // problem rebuilt from the final state.
 TEST(JointAdjusterExactTest, CappedOutlierLoopEvaluatesTheUncertaintyOnTheFinalState) {
   const sim::Scene scene = sim::Scene::Create("t_specimen");
-  testing::SyntheticJointOptions synthetic;
-  synthetic.num_stations = 5;
-  synthetic.lidar_points = 100000;
+  testing::SyntheticJointOptions synthetic = SmallProblem();
   synthetic.pixel_noise = 0.3;
   auto problem = testing::MakeSyntheticJointProblem(scene, synthetic);
   // Gross outliers: every 10th keypoint 30 px off, so that 2-view landmarks lose their tracks.
@@ -89,10 +100,7 @@ TEST(JointAdjusterExactTest, CappedOutlierLoopEvaluatesTheUncertaintyOnTheFinalS
   JointAdjusterOptions options;
   options.max_outlier_iterations = 1;
   options.num_association_rounds = 1;
-  const JointAdjuster adjuster(options);
-  colmap::Rigid3d cam_from_lidar = problem->cam_from_lidar;
-  const JointAdjustmentSummary summary =
-      adjuster.Run(problem->data, &problem->reconstruction, &cam_from_lidar);
+  const JointAdjustmentSummary summary = RunOn(problem.get(), options);
   ASSERT_EQ(summary.solves.size(), 1u);
   // The cap was hit with outliers found after the last solve, landmarks deleted with them.
   ASSERT_GT(summary.solves.back().reprojection.num_outliers, 0u);
@@ -108,9 +116,7 @@ TEST(JointAdjusterExactTest, CappedOutlierLoopEvaluatesTheUncertaintyOnTheFinalS
 // sigma_d: beyond 3 sigma_d lie 0.27 % of them; beyond 1 cm more than half.
 TEST(JointAdjusterExactTest, DepthGateIsInUnitsOfEachPriorsSigma) {
   const sim::Scene scene = sim::Scene::Create("t_specimen");
-  testing::SyntheticJointOptions synthetic;
-  synthetic.num_stations = 5;
-  synthetic.lidar_points = 100000;
+  testing::SyntheticJointOptions synthetic = SmallProblem();
   synthetic.depth_noise_sigmas = 1.0;
   auto problem = testing::MakeSyntheticJointProblem(scene, synthetic);
   const size_t num_priors = CountDepthPriorsOnLandmarks(*problem);
@@ -125,10 +131,7 @@ TEST(JointAdjusterExactTest, DepthGateIsInUnitsOfEachPriorsSigma) {
       << "the scene must have priors with sigma_d above 1 cm";
   JointAdjusterOptions options;
   options.num_association_rounds = 1;
-  const JointAdjuster adjuster(options);
-  colmap::Rigid3d cam_from_lidar = problem->cam_from_lidar;
-  const JointAdjustmentSummary summary =
-      adjuster.Run(problem->data, &problem->reconstruction, &cam_from_lidar);
+  const JointAdjustmentSummary summary = RunOn(problem.get(), options);
   const SolveStats& last = summary.solves.back();
   const double removed = static_cast<double>(last.depth.num_outliers) / num_priors;
   std::cout << "depth priors with noise sigma_d: " << last.depth.num_outliers << " of "
@@ -139,9 +142,7 @@ TEST(JointAdjusterExactTest, DepthGateIsInUnitsOfEachPriorsSigma) {
   // The absolute cap, when asked for, removes what lies beyond it and says so.
   auto capped_problem = testing::MakeSyntheticJointProblem(scene, synthetic);
   options.max_depth_error_m = 0.01;
-  cam_from_lidar = capped_problem->cam_from_lidar;
-  const JointAdjustmentSummary capped = JointAdjuster(options).Run(
-      capped_problem->data, &capped_problem->reconstruction, &cam_from_lidar);
+  const JointAdjustmentSummary capped = RunOn(capped_problem.get(), options);
   EXPECT_GT(capped.solves.back().depth_outliers.beyond_absolute, num_priors / 10);
 }
 
@@ -150,17 +151,14 @@ TEST(JointAdjusterExactTest, DepthGateIsInUnitsOfEachPriorsSigma) {
 // removed priors fit again.
 TEST(JointAdjusterExactTest, DepthPriorsComeBackWhenTheyFitAgain) {
   const sim::Scene scene = sim::Scene::Create("t_specimen");
-  testing::SyntheticJointOptions synthetic;
+  testing::SyntheticJointOptions synthetic = SmallProblem();
   synthetic.num_stations = 4;
-  synthetic.lidar_points = 100000;
   synthetic.depth_noise_sigmas = 1.0;
   auto problem = testing::MakeSyntheticJointProblem(scene, synthetic);
   JointAdjusterOptions options;
   options.num_association_rounds = 1;
   options.max_depth_error_sigmas = 0.5;
-  colmap::Rigid3d cam_from_lidar = problem->cam_from_lidar;
-  const JointAdjustmentSummary summary =
-      JointAdjuster(options).Run(problem->data, &problem->reconstruction, &cam_from_lidar);
+  const JointAdjustmentSummary summary = RunOn(problem.get(), options);
   size_t restored = 0;
   for (const SolveStats& solve : summary.solves) restored += solve.depth_outliers.restored;
   EXPECT_GT(restored, 0u);
@@ -170,9 +168,7 @@ TEST(JointAdjusterExactTest, DepthPriorsComeBackWhenTheyFitAgain) {
 // unobservable with the default 1 m prior and with a 5 mm one alike.
 TEST(JointAdjusterExactTest, UnobservableDirectionIsNamedWhateverTheExtrinsicPriorSigma) {
   const sim::Scene scene = sim::Scene::Create("t_specimen");
-  testing::SyntheticJointOptions synthetic;
-  synthetic.num_stations = 5;
-  synthetic.lidar_points = 100000;
+  testing::SyntheticJointOptions synthetic = SmallProblem();
   synthetic.motion = sim::Motion::kOneAxis;
   synthetic.pixel_noise = 0.3;
   for (const double prior_sigma : {1.0, 0.005}) {
@@ -180,9 +176,7 @@ TEST(JointAdjusterExactTest, UnobservableDirectionIsNamedWhateverTheExtrinsicPri
     JointAdjusterOptions options;
     options.num_association_rounds = 2;
     options.extrinsic_prior_sigma_m = prior_sigma;
-    colmap::Rigid3d cam_from_lidar = problem->cam_from_lidar;
-    const JointAdjustmentSummary summary =
-        JointAdjuster(options).Run(problem->data, &problem->reconstruction, &cam_from_lidar);
+    const JointAdjustmentSummary summary = RunOn(problem.get(), options);
     ASSERT_TRUE(summary.uncertainty.computed) << summary.uncertainty.message;
     ASSERT_EQ(summary.uncertainty.unobservable.size(), 1u) << "prior sigma " << prior_sigma;
     EXPECT_NE(summary.uncertainty.unobservable[0].find("translation along the camera y axis"),
