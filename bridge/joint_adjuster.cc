@@ -109,16 +109,29 @@ struct JointProblem {
 
 // Everything one Run() works on.
 struct RunState {
+  RunState(const JointAdjusterOptions& options,
+           const JointProblemData& data,
+           colmap::Reconstruction* reconstruction,
+           colmap::Rigid3d* cam_from_lidar)
+      : options(options),
+        data(data),
+        reconstruction(reconstruction),
+        cam_from_lidar(cam_from_lidar),
+        initial_translation(cam_from_lidar->translation),
+        loss(MakeLoss(options.loss, options.loss_scale)),
+        use_lidar(options.mode != JointMode::kStereoOnly && options.lidar_weight > 0),
+        refine_extrinsic(options.mode == JointMode::kJoint) {}
+
   const JointAdjusterOptions& options;
   const JointProblemData& data;
   colmap::Reconstruction* reconstruction;
   colmap::Rigid3d* cam_from_lidar;
   colmap::BundleAdjustmentConfig config;
-  Eigen::Vector3d initial_translation;
+  const Eigen::Vector3d initial_translation;
   // Owned here: COLMAP's problem does not take ownership of loss functions.
   std::unique_ptr<ceres::LossFunction> loss;
-  bool use_lidar = false;
-  bool refine_extrinsic = false;
+  const bool use_lidar;
+  const bool refine_extrinsic;
   std::set<ImagePoint> depth_outliers;
   size_t num_reprojection_outliers = 0;
   size_t num_lidar_outliers = 0;
@@ -655,13 +668,9 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
   std::vector<colmap::image_t> image_ids = reconstruction->RegImageIds();
   THROW_CHECK_GE(image_ids.size(), 2) << "the joint problem needs at least 2 registered images";
   std::sort(image_ids.begin(), image_ids.end());
-  RunState state{options_, data, reconstruction, cam_from_lidar};
+  RunState state(options_, data, reconstruction, cam_from_lidar);
   for (const colmap::image_t image_id : image_ids) state.config.AddImage(image_id);
   state.config.SetConstantCamPose(image_ids.front());  // the gauge
-  state.initial_translation = cam_from_lidar->translation;
-  state.loss = MakeLoss(options_.loss, options_.loss_scale);
-  state.use_lidar = options_.mode != JointMode::kStereoOnly && options_.lidar_weight > 0;
-  state.refine_extrinsic = options_.mode == JointMode::kJoint;
 
   JointAdjustmentSummary summary;
   std::vector<LidarObservation> observations;
