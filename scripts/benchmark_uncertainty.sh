@@ -85,34 +85,6 @@ PY
   done
 done
 mkdir -p docs/benchmarks
-python3 - "$results" "${STATIONS:-8}" "${LIDAR_POINTS:-300000}" > docs/benchmarks/uncertainty.md <<'PY'
-import datetime, math, os, sys
-path, stations, points = sys.argv[1:]
-axes = ['rx', 'ry', 'rz', 'tx', 'ty', 'tz']
-rows = [line.rstrip('\n').split('\t') for line in open(path) if line.strip()]
-print('# Coverage of the reported cam_from_lidar uncertainty, end to end\n')
-print('Written by `scripts/benchmark_uncertainty.sh` on %s (%d cores): per scene and seed, %s stations, '
-      '%s LiDAR rays per station, full-resolution images; stereo depth, COLMAP SIFT, LiDAR '
-      'registration, hand-eye initialisation without a guess, joint adjustment with default options. '
-      'Errors are the rotation vector of estimate * inverse(truth) about the camera axes [deg] and the '
-      'translation error [mm]; z = error / reported sigma (report.json `covariance_deg_mm`).\n'
-      % (datetime.date.today().isoformat(), os.cpu_count(), stations, points))
-print('| scene | seed | ' + ' | '.join('z ' + a for a in axes) + ' | ' +
-      ' | '.join('sigma ' + a for a in axes) + ' |')
-print('|---|---|' + '---|' * 12)
-for r in rows:
-    if r[2] == 'FAILED':
-        print('| %s | %s | failed |' % (r[0], r[1]) + ' |' * 11)
-        continue
-    print('| %s | %s | ' % (r[0], r[1]) + ' | '.join(r[14:20]) + ' | ' + ' | '.join(r[8:14]) + ' |')
-print('\nSigmas: rotation in deg, translation in mm.\n')
-print('| scene | runs | ' + ' | '.join('2-sigma coverage ' + a for a in axes) + ' | rms z (all axes) |')
-print('|---|---|' + '---|' * 7)
-for scene in sorted({r[0] for r in rows}) + ['all']:
-    ok = [r for r in rows if r[2] != 'FAILED' and (scene == 'all' or r[0] == scene)]
-    if not ok: continue
-    cover = ['%.0f %%' % (100.0 * sum(abs(float(r[14 + k])) <= 2 for r in ok) / len(ok)) for k in range(6)]
-    rms = math.sqrt(sum(float(r[14 + k])**2 for r in ok for k in range(6)) / (6 * len(ok)))
-    print('| %s | %d | %s | %.2f |' % (scene, len(ok), ' | '.join(cover), rms))
-PY
+python3 scripts/uncertainty_table.py "$results" "${STATIONS:-8}" "${LIDAR_POINTS:-300000}" \
+  > docs/benchmarks/uncertainty.md
 cat docs/benchmarks/uncertainty.md
