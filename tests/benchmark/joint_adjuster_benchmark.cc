@@ -133,10 +133,11 @@ int main(int argc, char** argv) {
     const double load_seconds = Seconds(load_start);
 
     std::ostringstream table;
-    table << std::fixed << std::setprecision(4)
-          << "| problem | iterations | residual blocks | residuals | solve time [s] | per iteration "
-             "(Ceres) [s] |\n"
-          << "|---|---|---|---|---|---|\n";
+    table
+        << std::fixed << std::setprecision(4)
+        << "| problem | iterations | residual blocks | residuals | solve time [s] | per iteration "
+           "(Ceres) [s] |\n"
+        << "|---|---|---|---|---|---|\n";
     for (const int iterations : {1, 10}) {
       const Timing plain = PlainBundleAdjustment(reconstruction, iterations);
       const Timing joint = JointSolve(reconstruction, cam_from_lidar, loaded->data, iterations);
