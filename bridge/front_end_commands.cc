@@ -55,6 +55,7 @@ int RunStereoDepth(int argc, char** argv) {
   options.AddDefaultOption("mode", &stereo.mode, "sgbm | hh | 3way | hh4");
   options.AddDefaultOption("min_depth_m", &stereo.min_depth_m);
   options.AddDefaultOption("max_depth_m", &stereo.max_depth_m);
+  options.AddDefaultOption("vertically_symmetric", &stereo.vertically_symmetric);
   options.AddDefaultOption("block_size", &stereo.block_size);
   options.AddDefaultOption("p1_factor", &stereo.p1_factor);
   options.AddDefaultOption("p2_factor", &stereo.p2_factor);

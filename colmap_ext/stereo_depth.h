@@ -26,6 +26,9 @@ struct StereoDepthOptions {
   // at 1028 px width this is about 14..300 px (1.5 m .. 30 m).
   double min_depth_m = 1.5;
   double max_depth_m = 30.0;
+  // Match each pair top-down and bottom-up (vertically flipped) and average: removes the vertical
+  // shift of SGBM's one-directional path aggregation on slanted surfaces at twice the matching time.
+  bool vertically_symmetric = true;
   int block_size = 5;  // odd
   // P1 = p1_factor * block_size^2, P2 = p2_factor * block_size^2 (grey images), OpenCV's recommendation.
   int p1_factor = 8;
