@@ -29,7 +29,11 @@ std::string PairLine(const std::string& target, const std::string& source, const
        << pose.rotation.x() << " " << pose.rotation.y() << " " << pose.rotation.z() << " "
        << pose.translation.x() << " " << pose.translation.y() << " " << pose.translation.z() << " "
        << e.registration.num_inliers << " " << std::setprecision(4) << e.registration.overlap << " "
-       << e.registration.rmse;
+       << e.registration.rmse << " " << e.registration.noise_rms << " "
+       << e.registration.constraints.weakest_ratio << " "
+       << e.registration.constraints.WeakestAxisName() << " "
+       << (e.registration.degenerate ? "degenerate" : "determined") << " "
+       << (e.registration.from_identity ? "identity" : "bsc");
   return line.str();
 }
 
@@ -39,7 +43,7 @@ int RunLidarRegistrator(int argc, char** argv) {
   std::string lidar_path, output_path;
   LidarGraphOptions graph_options;
   StationCloudOptions cloud_options;
-  int max_neighbors = 0;
+  int max_neighbors = 0, sequential = 0;
   colmap::OptionManager manager;
   manager.AddRequiredOption("lidar_path", &lidar_path, "folder of station clouds (.pcd/.ply/.bin)");
   manager.AddRequiredOption("output_path", &output_path, "folder for pairs.txt, lidar_poses.txt");
@@ -48,10 +52,25 @@ int RunLidarRegistrator(int argc, char** argv) {
   manager.AddDefaultOption("bsc_support_radius", &cloud_options.bsc.support_radius);
   manager.AddDefaultOption(
       "max_neighbors", &max_neighbors, "0: all pairs; k: the k most similar stations each");
+  manager.AddDefaultOption(
+      "sequential", &sequential, "k > 0: register each frame with its k successors (sweeps)");
   manager.AddDefaultOption("min_overlap", &graph_options.pair.min_overlap);
-  manager.AddDefaultOption("max_rmse", &graph_options.pair.max_rmse);
+  manager.AddDefaultOption("max_rmse_to_noise",
+                           &graph_options.pair.max_rmse_to_noise,
+                           "ICP RMSE / the clouds' own plane noise");
+  manager.AddDefaultOption("max_rmse", &graph_options.pair.max_rmse, "absolute cap [m]; 0: none");
+  manager.AddDefaultOption("try_identity", &graph_options.pair.try_identity);
+  manager.AddDefaultOption("min_constraint_ratio", &graph_options.pair.min_constraint_ratio);
+  manager.AddDefaultOption("weak_constraint_ratio", &graph_options.pair.weak_constraint_ratio);
+  manager.AddDefaultOption("check_cycles", &graph_options.check_cycles);
+  manager.AddDefaultOption("max_cycle_translation_m", &graph_options.cycles.max_translation_m);
+  manager.AddDefaultOption("max_cycle_rotation_deg", &graph_options.cycles.max_rotation_deg);
+  manager.AddDefaultOption("robust_loss_sigmas", &graph_options.robust_loss_sigmas);
   manager.Parse(argc, argv);
-  graph_options.max_neighbors = static_cast<size_t>(std::max(0, max_neighbors));
+  THROW_CHECK_GE(max_neighbors, 0) << "--max_neighbors must be >= 0";
+  THROW_CHECK_GE(sequential, 0) << "--sequential must be >= 0";
+  graph_options.max_neighbors = static_cast<size_t>(max_neighbors);
+  graph_options.sequential = static_cast<size_t>(sequential);
   THROW_CHECK(fs::is_directory(lidar_path)) << "No such folder: " << lidar_path;
 
   std::vector<fs::path> files;
@@ -93,7 +112,8 @@ int RunLidarRegistrator(int argc, char** argv) {
   fs::create_directories(output_path);
   std::ostringstream pairs;
   pairs << "# colmap-lidar LiDAR pose graph edges (A_l).\n"
-           "# target source qw qx qy qz tx ty tz inliers overlap rmse_m\n"
+           "# target source qw qx qy qz tx ty tz inliers overlap rmse_m noise_m constraint_ratio "
+           "weakest_axis determined|degenerate bsc|identity\n"
            "# target_from_source = lidar_target_from_lidar_source, quaternion "
            "w first, metres\n";
   for (const LidarEdge& e : graph.edges)
@@ -120,6 +140,9 @@ int RunLidarRegistrator(int argc, char** argv) {
     }
     summary << "\n";
   }
+  summary << "three_cycles " << graph.num_cycles << "\nworst_cycle_translation_m "
+          << graph.worst_cycle_translation_m << "\nworst_cycle_rotation_deg "
+          << graph.worst_cycle_rotation_deg << "\n";
   summary << "pose_graph_cost_initial " << graph.refinement_initial_cost
           << "\npose_graph_cost_final " << graph.refinement_final_cost << "\nseconds " << seconds()
           << "\n";

@@ -1,9 +1,11 @@
 // All-pairs LiDAR registration and the LiDAR pose graph (the seed's A_l): register station pairs, accept
-// edges, take a maximum spanning tree for initial poses, refine all poses over all accepted edges with
-// Ceres, and report the connected components. Station poses are world_from_lidar with the first station
+// edges, remove edges inconsistent around 3-cycles, take a maximum spanning tree for initial poses,
+// refine all poses over all accepted edges with Ceres (information-weighted, robust), and report the
+// connected components. Station poses are world_from_lidar with the first station
 // of each component as its world (identity).
 #pragma once
 
+#include "lidar/cycle_consistency.h"
 #include "lidar/pair_registration.h"
 #include "lidar/station_cloud.h"
 
@@ -20,7 +22,8 @@ struct LidarEdge {
   size_t source = 0;                                                     // j
   Eigen::Isometry3d target_from_source = Eigen::Isometry3d::Identity();  // lidar_i_from_lidar_j
   PairRegistration registration;
-  double Weight() const { return registration.num_inliers * registration.overlap; }
+  // Preference in the spanning tree: overlap * sqrt(constraint ratio) / RMSE.
+  double Weight() const;
 };
 
 struct LidarGraphOptions {
@@ -28,7 +31,15 @@ struct LidarGraphOptions {
   // 0: register every pair. Otherwise each station is registered with its `max_neighbors` most
   // similar stations by a global descriptor (the histogram of its BSC bits), for large captures.
   size_t max_neighbors = 0;
+  // > 0: also register each frame with its `sequential` successors (sweeps of a moving platform);
+  // with max_neighbors = 0 only these pairs are registered.
+  size_t sequential = 0;
+  // Remove edges inconsistent around 3-cycles before the spanning tree (CheckThreeCycles).
+  bool check_cycles = true;
+  CycleConsistencyOptions cycles;
   bool refine = true;  // pose-graph refinement over all accepted edges
+  // Huber loss of the refinement, on residuals whitened by each edge's information (in sigmas).
+  double robust_loss_sigmas = 3.0;
 
   bool Check() const;  // throws std::invalid_argument
 };
@@ -40,6 +51,9 @@ struct LidarGraph {
   std::vector<int> component;  // per station, 0-based; component 0 holds station 0
   int num_components = 0;
   double refinement_initial_cost = 0, refinement_final_cost = 0;
+  // 3-cycles of the registered edges, and the worst loop error among those left after the check.
+  size_t num_cycles = 0;
+  double worst_cycle_translation_m = 0, worst_cycle_rotation_deg = 0;
 };
 
 // Progress: called after each pair with (pairs done, pairs total).

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 
 namespace colmap_lidar {
@@ -41,12 +42,164 @@ std::vector<Nearest> NearestInHamming(const std::vector<BscFeature>& from,
   return nearest;
 }
 
+// RANSAC keeps the best few *distinct* hypotheses: repetitive structure (parallel walls, symmetric
+// rooms) gives several strong ones, and ICP's overlap decides between them.
+struct Hypothesis {
+  Eigen::Isometry3d target_from_source;
+  std::vector<size_t> inliers;
+};
+
+class RansacOnMatches {
+ public:
+  RansacOnMatches(const Eigen::Matrix3Xd& source_points,
+                  const Eigen::Matrix3Xd& target_points,
+                  const PairRegistrationOptions& options)
+      : source_(source_points), target_(target_points), options_(options) {}
+
+  void Inliers(const Eigen::Isometry3d& t, std::vector<size_t>* inliers) const {
+    inliers->clear();
+    for (long k = 0; k < source_.cols(); ++k) {
+      if ((t * source_.col(k) - target_.col(k)).norm() < options_.inlier_threshold) {
+        inliers->push_back(k);
+      }
+    }
+  }
+
+  // A fixed budget, no adaptive termination: a strong wrong hypothesis (repetitive structure) would
+  // stop the search before the right one is drawn. Samples failing the edge check cost nanoseconds.
+  std::vector<Hypothesis> Run() const {
+    std::vector<Hypothesis> hypotheses;
+    std::mt19937_64 rng(options_.seed);
+    std::uniform_int_distribution<size_t> pick(0, source_.cols() - 1);
+    std::vector<size_t> inliers;
+    for (int it = 0; it < options_.ransac_iterations; ++it) {
+      const size_t a = pick(rng), b = pick(rng), c = pick(rng);
+      if (a == b || b == c || a == c || !RigidTriangle(a, b, c)) continue;
+      Eigen::Matrix3Xd s(3, 3), t(3, 3);
+      s << source_.col(a), source_.col(b), source_.col(c);
+      t << target_.col(a), target_.col(b), target_.col(c);
+      const Eigen::Isometry3d candidate = Kabsch(s, t);
+      Inliers(candidate, &inliers);
+      if (static_cast<int>(inliers.size()) < options_.min_inliers) continue;
+      Insert({candidate, inliers}, &hypotheses);
+    }
+    for (Hypothesis& h : hypotheses) Refit(&h);
+    return hypotheses;
+  }
+
+ private:
+  // Edge-length consistency: a rigid motion preserves the triangle.
+  bool RigidTriangle(size_t a, size_t b, size_t c) const {
+    for (const auto& [i, j] : {std::pair{a, b}, std::pair{b, c}, std::pair{a, c}}) {
+      const double ds = (source_.col(i) - source_.col(j)).norm();
+      const double dt = (target_.col(i) - target_.col(j)).norm();
+      if (std::abs(ds - dt) > options_.edge_tolerance || ds < 2 * options_.inlier_threshold) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  void Insert(Hypothesis candidate, std::vector<Hypothesis>* hypotheses) const {
+    const auto distinct = [](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+      const Eigen::Isometry3d d = a * b.inverse();
+      return Eigen::AngleAxisd(d.linear()).angle() > 5 * M_PI / 180 || d.translation().norm() > 0.5;
+    };
+    bool merged = false;
+    for (Hypothesis& h : *hypotheses) {
+      if (!distinct(h.target_from_source, candidate.target_from_source)) {
+        if (candidate.inliers.size() > h.inliers.size()) h = std::move(candidate);
+        merged = true;
+        break;
+      }
+    }
+    if (!merged) hypotheses->push_back(std::move(candidate));
+    std::sort(hypotheses->begin(), hypotheses->end(), [](const Hypothesis& x, const Hypothesis& y) {
+      return x.inliers.size() > y.inliers.size();
+    });
+    if (static_cast<int>(hypotheses->size()) > options_.num_hypotheses) hypotheses->pop_back();
+  }
+
+  // Refit on all inliers (twice: the refit may gain inliers).
+  void Refit(Hypothesis* h) const {
+    std::vector<size_t> inliers;
+    for (int refit = 0; refit < 2; ++refit) {
+      Eigen::Matrix3Xd s(3, h->inliers.size()), t(3, h->inliers.size());
+      for (size_t k = 0; k < h->inliers.size(); ++k) {
+        s.col(k) = source_.col(h->inliers[k]);
+        t.col(k) = target_.col(h->inliers[k]);
+      }
+      const Eigen::Isometry3d refit_pose = Kabsch(s, t);
+      Inliers(refit_pose, &inliers);
+      if (inliers.size() < h->inliers.size()) break;
+      *h = {refit_pose, inliers};
+    }
+  }
+
+  const Eigen::Matrix3Xd& source_;
+  const Eigen::Matrix3Xd& target_;
+  const PairRegistrationOptions& options_;
+};
+
+std::vector<Hypothesis> BscHypotheses(const StationCloud& source,
+                                      const StationCloud& target,
+                                      const PairRegistrationOptions& options,
+                                      Eigen::Matrix3Xd* source_points,
+                                      Eigen::Matrix3Xd* target_points,
+                                      PairRegistration* result) {
+  const auto matches =
+      MatchBscFeatures(source.features, target.features, options.max_ratio, options.mutual);
+  result->num_matches = matches.size();
+  if (static_cast<int>(matches.size()) < options.min_inliers) {
+    result->reason = "too few BSC matches (" + std::to_string(matches.size()) + ")";
+    return {};
+  }
+  source_points->resize(3, matches.size());
+  target_points->resize(3, matches.size());
+  for (size_t k = 0; k < matches.size(); ++k) {
+    source_points->col(k) = source.features[matches[k].first].position;
+    target_points->col(k) = target.features[matches[k].second].position;
+  }
+  std::vector<Hypothesis> hypotheses =
+      RansacOnMatches(*source_points, *target_points, options).Run();
+  if (hypotheses.empty()) {
+    result->reason = "too few RANSAC inliers (fewer than " + std::to_string(options.min_inliers) +
+                     " of " + std::to_string(matches.size()) + " matches)";
+  }
+  return hypotheses;
+}
+
+// The gates, in order; the first that fails names the reason.
+void Judge(const PairRegistrationOptions& options, PairRegistration* result) {
+  std::ostringstream reason;
+  const double rmse_to_noise = result->rmse / std::max(result->noise_rms, 1e-9);
+  if (!result->converged) {
+    reason << "ICP did not converge";
+  } else if (result->overlap < options.min_overlap) {
+    reason << "overlap " << result->overlap << " below " << options.min_overlap;
+  } else if (rmse_to_noise > options.max_rmse_to_noise) {
+    reason << "ICP RMSE " << result->rmse << " m is " << rmse_to_noise
+           << " x the clouds' plane noise " << result->noise_rms << " m (max "
+           << options.max_rmse_to_noise << ")";
+  } else if (options.max_rmse > 0 && result->rmse > options.max_rmse) {
+    reason << "ICP RMSE " << result->rmse << " m above " << options.max_rmse;
+  } else if (result->constraints.weakest_ratio < options.min_constraint_ratio) {
+    reason << "degenerate: direction " << result->constraints.WeakestAxisName()
+           << " unconstrained (constraint ratio " << result->constraints.weakest_ratio << ")";
+  }
+  result->reason = reason.str();
+  result->accepted = result->reason.empty();
+  result->degenerate =
+      result->accepted && result->constraints.weakest_ratio < options.weak_constraint_ratio;
+}
+
 }  // namespace
 
 bool PairRegistrationOptions::Check() const {
   if (!(max_ratio > 0) || ransac_iterations < 1 || !(inlier_threshold > 0) ||
       !(edge_tolerance > 0) || min_inliers < 3 || num_hypotheses < 1 || !(min_overlap >= 0) ||
-      !(max_rmse > 0)) {
+      !(max_rmse_to_noise > 0) || !(max_rmse >= 0) || !(min_constraint_ratio >= 0) ||
+      !(weak_constraint_ratio >= min_constraint_ratio)) {
     throw std::invalid_argument("PairRegistrationOptions: invalid value");
   }
   return icp.Check();
@@ -75,116 +228,40 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
                                        const PairRegistrationOptions& options) {
   options.Check();
   PairRegistration result;
-  const auto matches =
-      MatchBscFeatures(source.features, target.features, options.max_ratio, options.mutual);
-  result.num_matches = matches.size();
-  if (static_cast<int>(matches.size()) < options.min_inliers) {
-    result.reason = "too few BSC matches (" + std::to_string(matches.size()) + ")";
-    return result;
-  }
-  const size_t n = matches.size();
-  Eigen::Matrix3Xd source_points(3, n), target_points(3, n);
-  for (size_t k = 0; k < n; ++k) {
-    source_points.col(k) = source.features[matches[k].first].position;
-    target_points.col(k) = target.features[matches[k].second].position;
-  }
-  auto inliers_of = [&](const Eigen::Isometry3d& t, std::vector<size_t>* inliers) {
-    inliers->clear();
-    for (size_t k = 0; k < n; ++k) {
-      if ((t * source_points.col(k) - target_points.col(k)).norm() < options.inlier_threshold) {
-        inliers->push_back(k);
-      }
-    }
-  };
-  // RANSAC keeps the best few *distinct* hypotheses: repetitive structure (parallel walls, symmetric
-  // rooms) gives several strong ones, and ICP's overlap decides between them.
-  struct Hypothesis {
-    Eigen::Isometry3d target_from_source;
-    std::vector<size_t> inliers;
-  };
-  std::vector<Hypothesis> hypotheses;
-  auto distinct = [](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
-    const Eigen::Isometry3d d = a * b.inverse();
-    return Eigen::AngleAxisd(d.linear()).angle() > 5 * M_PI / 180 || d.translation().norm() > 0.5;
-  };
-  std::mt19937_64 rng(options.seed);
-  std::uniform_int_distribution<size_t> pick(0, n - 1);
-  std::vector<size_t> inliers;
-  // A fixed budget, no adaptive termination: a strong wrong hypothesis (repetitive structure) would
-  // stop the search before the right one is drawn. Samples failing the edge check cost nanoseconds.
-  for (int it = 0; it < options.ransac_iterations; ++it) {
-    const size_t a = pick(rng), b = pick(rng), c = pick(rng);
-    if (a == b || b == c || a == c) continue;
-    // Edge-length consistency: a rigid motion preserves the triangle.
-    bool consistent = true;
-    for (const auto& [i, j] : {std::pair{a, b}, std::pair{b, c}, std::pair{a, c}}) {
-      const double ds = (source_points.col(i) - source_points.col(j)).norm();
-      const double dt = (target_points.col(i) - target_points.col(j)).norm();
-      if (std::abs(ds - dt) > options.edge_tolerance || ds < 2 * options.inlier_threshold) {
-        consistent = false;
-      }
-    }
-    if (!consistent) continue;
-    Eigen::Matrix3Xd s(3, 3), t(3, 3);
-    s << source_points.col(a), source_points.col(b), source_points.col(c);
-    t << target_points.col(a), target_points.col(b), target_points.col(c);
-    const Eigen::Isometry3d candidate = Kabsch(s, t);
-    inliers_of(candidate, &inliers);
-    if (static_cast<int>(inliers.size()) < options.min_inliers) continue;
-    bool merged = false;
-    for (Hypothesis& h : hypotheses) {
-      if (!distinct(h.target_from_source, candidate)) {
-        if (inliers.size() > h.inliers.size()) h = {candidate, inliers};
-        merged = true;
-        break;
-      }
-    }
-    if (!merged) hypotheses.push_back({candidate, inliers});
-    std::sort(hypotheses.begin(), hypotheses.end(), [](const Hypothesis& x, const Hypothesis& y) {
-      return x.inliers.size() > y.inliers.size();
-    });
-    if (static_cast<int>(hypotheses.size()) > options.num_hypotheses) hypotheses.pop_back();
-  }
-  if (hypotheses.empty()) {
-    result.reason = "too few RANSAC inliers (fewer than " + std::to_string(options.min_inliers) +
-                    " of " + std::to_string(n) + " matches)";
-    return result;
-  }
+  Eigen::Matrix3Xd source_points, target_points;
+  std::vector<Hypothesis> hypotheses =
+      BscHypotheses(source, target, options, &source_points, &target_points, &result);
+  const std::string bsc_reason = result.reason;
+  if (options.try_identity) hypotheses.push_back({Eigen::Isometry3d::Identity(), {}});
+  if (hypotheses.empty()) return result;
   bool have_candidate = false;
-  for (Hypothesis& h : hypotheses) {
-    // Refit on all inliers (twice: the refit may gain inliers), then ICP.
-    for (int refit = 0; refit < 2; ++refit) {
-      Eigen::Matrix3Xd s(3, h.inliers.size()), t(3, h.inliers.size());
-      for (size_t k = 0; k < h.inliers.size(); ++k) {
-        s.col(k) = source_points.col(h.inliers[k]);
-        t.col(k) = target_points.col(h.inliers[k]);
-      }
-      const Eigen::Isometry3d refit_pose = Kabsch(s, t);
-      inliers_of(refit_pose, &inliers);
-      if (inliers.size() < h.inliers.size()) break;
-      h = {refit_pose, inliers};
-    }
+  for (const Hypothesis& h : hypotheses) {
     const IcpResult fine = PointToPlaneIcp(
         source.cloud, target.cloud, *target.tree, h.target_from_source, options.icp);
-    if (!have_candidate || fine.overlap_ratio > result.overlap) {
-      have_candidate = true;
-      result.target_from_source = fine.target_from_source;
-      result.num_inliers = h.inliers.size();
-      result.overlap = fine.overlap_ratio;
-      result.rmse = fine.rmse;
-      result.converged = fine.converged;
-    }
+    if (have_candidate && fine.overlap_ratio <= result.overlap) continue;
+    have_candidate = true;
+    result.target_from_source = fine.target_from_source;
+    result.num_inliers = h.inliers.size();
+    result.from_identity = h.inliers.empty();
+    result.overlap = fine.overlap_ratio;
+    result.rmse = fine.rmse;
+    result.converged = fine.converged;
+    result.hessian = fine.hessian;
+    result.constraints = fine.lever_arm_m > 0 ? AnalyseConstraints(fine.hessian, fine.lever_arm_m)
+                                              : ConstraintAnalysis();
   }
-  if (!result.converged) {
-    result.reason = "ICP did not converge";
-  } else if (result.overlap < options.min_overlap) {
-    result.reason = "overlap " + std::to_string(result.overlap) + " below " +
-                    std::to_string(options.min_overlap);
-  } else if (result.rmse > options.max_rmse) {
-    result.reason =
-        "ICP RMSE " + std::to_string(result.rmse) + " m above " + std::to_string(options.max_rmse);
-  } else {
-    result.accepted = true;
+  if (result.from_identity) {
+    // The BSC matches that agree with the alignment (RANSAC found too few to propose it).
+    std::vector<size_t> agreeing;
+    RansacOnMatches(source_points, target_points, options)
+        .Inliers(result.target_from_source, &agreeing);
+    result.num_inliers = agreeing.size();
+  }
+  result.noise_rms = std::sqrt(0.5 * (source.plane_noise_rms * source.plane_noise_rms +
+                                      target.plane_noise_rms * target.plane_noise_rms));
+  Judge(options, &result);
+  if (!result.accepted && result.from_identity && !bsc_reason.empty()) {
+    result.reason = bsc_reason + "; from the identity: " + result.reason;
   }
   return result;
 }

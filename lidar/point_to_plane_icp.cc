@@ -12,12 +12,14 @@ struct NormalEquations {
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
   double squared_error = 0;
+  double squared_radius = 0;  // sum of |p'|^2: the lever arm of the rotations
   size_t count = 0;
 
   void Add(const NormalEquations& other) {
     H += other.H;
     g += other.g;
     squared_error += other.squared_error;
+    squared_radius += other.squared_radius;
     count += other.count;
   }
 };
@@ -48,6 +50,7 @@ NormalEquations BuildNormalEquations(const PointCloud& source,
       local.H.noalias() += J * J.transpose();
       local.g.noalias() += J * r;
       local.squared_error += r * r;
+      local.squared_radius += p.squaredNorm();
       ++local.count;
     }
 #pragma omp critical
@@ -114,6 +117,8 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
   result.num_inliers = final_eq.count;
   result.overlap_ratio = static_cast<double>(final_eq.count) / num_used;
   result.rmse = final_eq.count ? std::sqrt(final_eq.squared_error / final_eq.count) : 0;
+  result.hessian = final_eq.H;
+  result.lever_arm_m = final_eq.count ? std::sqrt(final_eq.squared_radius / final_eq.count) : 0;
   return result;
 }
 

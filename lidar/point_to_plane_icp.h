@@ -30,6 +30,10 @@ struct IcpResult {
   size_t num_inliers = 0;    // correspondences within the final gate
   double overlap_ratio = 0;  // num_inliers / source points used
   double rmse = 0;           // point-to-plane RMSE of the inliers [m]
+  // sum J J^T over the final inliers, J = [p' x n; n]: the Gauss-Newton Hessian in [omega, t] (a left
+  // increment of target_from_source in the target frame); and the RMS |p'| of those inliers [m].
+  Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+  double lever_arm_m = 0;
 };
 
 // `target` must have normals and `target_tree` must be built over target.points.

@@ -1,5 +1,7 @@
 #include "lidar/station_cloud.h"
 
+#include "lidar/registration_quality.h"
+
 #include <stdexcept>
 
 namespace colmap_lidar {
@@ -20,6 +22,7 @@ std::unique_ptr<StationCloud> PrepareStationCloud(const PointCloud& raw,
   station->cloud.normals.clear();
   station->tree = std::make_unique<KdTree3>(station->cloud.points);
   EstimateNormals(*station->tree, options.normals, &station->cloud, &station->curvature);
+  station->plane_noise_rms = PlaneNoiseRms(station->cloud, *station->tree);
 
   if (!options.compute_features) return station;
 

@@ -33,6 +33,9 @@ struct StationCloud {
   std::vector<double> curvature;     // per point of `cloud`
   std::unique_ptr<KdTree3> tree;     // over cloud.points
   std::vector<BscFeature> features;  // positions in the lidar frame
+  // Point-to-plane residual RMS of the cloud against itself (PlaneNoiseRms) [m]: what a correct
+  // registration's ICP RMSE looks like for this sensor, range noise and spacing.
+  double plane_noise_rms = 0;
 };
 
 // Downsamples, estimates normals/curvature, detects keypoints and describes them.
