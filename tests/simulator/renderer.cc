@@ -116,5 +116,52 @@ PointCloud ScanLidar(const Scene& scene,
   return cloud;
 }
 
+colmap::Rigid3d Interpolate(const colmap::Rigid3d& a, const colmap::Rigid3d& b, double tau) {
+  return colmap::Rigid3d(a.rotation.slerp(tau, b.rotation),
+                         (1 - tau) * a.translation + tau * b.translation);
+}
+
+PointCloud ScanSweep(const Scene& scene,
+                     const std::function<colmap::Rigid3d(double)>& world_from_lidar_at,
+                     const LidarOptions& options) {
+  constexpr int kNumBeams = 64;
+  const int num_azimuths = std::max(60, static_cast<int>(options.num_points / kNumBeams));
+  std::vector<PointCloud> per_column(num_azimuths);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int a = 0; a < num_azimuths; ++a) {
+    std::mt19937_64 rng(options.seed * 7919ull + a);
+    std::normal_distribution<double> noise(0, options.range_noise_m);
+    const double tau = (a + 0.5) / num_azimuths;
+    const colmap::Rigid3d world_from_lidar = world_from_lidar_at(tau);
+    const Eigen::Matrix3d rotation = world_from_lidar.rotation.toRotationMatrix();
+    const double azimuth = M_PI + 2 * M_PI * tau;
+    for (int b = 0; b < kNumBeams; ++b) {
+      const double elevation = (2.0 - 26.8 * b / (kNumBeams - 1)) * M_PI / 180.0;
+      const Eigen::Vector3d ray_in_lidar(std::cos(elevation) * std::cos(azimuth),
+                                         std::cos(elevation) * std::sin(azimuth),
+                                         std::sin(elevation));
+      const Eigen::Vector3d ray_in_world = rotation * ray_in_lidar;
+      RayHit hit;
+      if (!scene.Intersect(world_from_lidar.translation, ray_in_world, options.max_range_m, &hit)) {
+        continue;
+      }
+      const Eigen::Vector3d point_in_world = world_from_lidar.translation + hit.t * ray_in_world;
+      double range = hit.t;
+      if (options.range_noise_m > 0) range += noise(rng);
+      per_column[a].points.push_back(range * ray_in_lidar);
+      per_column[a].intensities.push_back(
+          static_cast<float>(255.0 * scene.Albedo(point_in_world, hit.primitive) *
+                             std::abs(hit.normal.dot(ray_in_world))));
+    }
+  }
+  PointCloud cloud;
+  for (const PointCloud& column : per_column) {
+    cloud.points.insert(cloud.points.end(), column.points.begin(), column.points.end());
+    cloud.intensities.insert(
+        cloud.intensities.end(), column.intensities.begin(), column.intensities.end());
+  }
+  return cloud;
+}
+
 }  // namespace sim
 }  // namespace colmap_lidar

@@ -9,6 +9,8 @@
 
 #include <opencv2/core.hpp>
 
+#include <functional>
+
 namespace colmap_lidar {
 namespace sim {
 
@@ -41,6 +43,19 @@ struct LidarOptions {
 PointCloud ScanLidar(const Scene& scene,
                      const colmap::Rigid3d& world_from_lidar,
                      const LidarOptions& options);
+
+// One sweep of a spinning 64-beam LiDAR (HDL-64-like: elevations +2 to -24.8 deg) on a moving
+// platform, without motion compensation: the column fired at fraction tau in [0, 1] of the sweep sees
+// the scene from world_from_lidar_at(tau), and its points are returned in the LiDAR frame of that
+// instant (point_in_lidar, as a real sensor's driver writes them). The sweep starts and ends looking
+// backwards (azimuth 180 deg) and faces forward at tau = 0.5, when the camera is triggered (KITTI's
+// convention): the frame's pose is world_from_lidar_at(0.5). options.num_points rays in all.
+PointCloud ScanSweep(const Scene& scene,
+                     const std::function<colmap::Rigid3d(double)>& world_from_lidar_at,
+                     const LidarOptions& options);
+
+// Rotation slerped, translation interpolated linearly, tau in [0, 1].
+colmap::Rigid3d Interpolate(const colmap::Rigid3d& a, const colmap::Rigid3d& b, double tau);
 
 }  // namespace sim
 }  // namespace colmap_lidar

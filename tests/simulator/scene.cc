@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <stdexcept>
 
 namespace colmap_lidar {
@@ -151,7 +152,7 @@ bool IntersectGround(const Primitive& ground,
 }  // namespace
 
 std::vector<std::string> Scene::Names() {
-  return {"t_specimen", "square_pillar", "cylinder_pillar", "bridge_pier"};
+  return {"t_specimen", "square_pillar", "cylinder_pillar", "bridge_pier", "street"};
 }
 
 Scene Scene::Create(const std::string& name) {
@@ -173,6 +174,13 @@ Scene Scene::Create(const std::string& name) {
       scene.AddBox({-1.5, y - 0.03, 2.56}, {1.5, y + 0.03, 2.94}, true, 0.55);
       scene.AddBox({-1.5, y - 0.15, 2.94}, {1.5, y + 0.15, 3.0}, true, 0.55);
     }
+  } else if (name == "street") {
+    // The "structure" of a street is a bollard at the kerb (surface.ply stays small); the facades,
+    // cars and trees are background.
+    scene.AddCylinder({30, -5.2, 0}, 0.15, 1.0, true, 0.6);
+    scene.FinishObject();
+    scene.AddStreet();
+    return scene;
   } else {
     std::string known;
     for (const std::string& n : Names()) known += " " + n;
@@ -242,6 +250,59 @@ void Scene::AddBackground() {
   AddBox({3.5, -8.0, 0}, {5.0, -6.5, 1.0}, false, 0.35);
   AddCylinder({-5.0, -6.0, 0}, 0.5, 3.0, false, 0.45);
   AddCylinder({8.0, -2.0, 0}, 0.3, 2.5, false, 0.5);
+}
+
+// Facade blocks of 6-14 m along each side with setbacks of 0-1.5 m and heights of 6-15 m, parked
+// cars, poles and trees in irregular (seeded) places: straight, but not repetitive.
+void Scene::AddStreet() {
+  Primitive ground;
+  ground.type = Primitive::Type::kGround;
+  ground.half_size = Eigen::Vector3d(200, 200, 0);
+  ground.albedo = 0.35;
+  ground.texture_contrast = 0.5;
+  primitives_.push_back(ground);
+  std::mt19937_64 rng(20261130);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (const double side : {-1.0, 1.0}) {
+    for (double x = -20; x < 120;) {
+      const double length = 6 + 8 * unit(rng), setback = 1.5 * unit(rng);
+      const double y = side * (8 + setback), height = 6 + 9 * unit(rng);
+      AddBox({x, std::min(y, y + side * 6), 0},
+             {x + length, std::max(y, y + side * 6), height},
+             false,
+             0.4 + 0.25 * unit(rng));
+      x += length;
+    }
+    for (double x = -15; x < 115; x += 7 + 10 * unit(rng)) {  // parked cars
+      const double y = side * 5.6;
+      AddBox({x, y - 0.9, 0}, {x + 4.3, y + 0.9, 1.5}, false, 0.3 + 0.4 * unit(rng));
+    }
+    for (double x = -12; x < 115; x += 9 + 14 * unit(rng)) {  // poles and trees
+      if (unit(rng) < 0.5) {
+        AddCylinder({x, side * 6.8, 0}, 0.08, 5.0, false, 0.5);
+      } else {
+        AddCylinder({x, side * 7.0, 0}, 0.2, 3.0, false, 0.35);
+        AddBox({x - 1.5, side * 7.0 - 1.5, 3.0}, {x + 1.5, side * 7.0 + 1.5, 5.5}, false, 0.3);
+      }
+    }
+  }
+  // Cars driving: one ahead in our lane, one oncoming.
+  for (const auto& [start, speed] : {std::pair{Eigen::Vector3d(14, -1.8, 0.75), 6.0},
+                                     std::pair{Eigen::Vector3d(90, 1.8, 0.75), -9.0}}) {
+    AddBox(start - Eigen::Vector3d(2.2, 0.9, 0.75),
+           start + Eigen::Vector3d(2.2, 0.9, 0.75),
+           false,
+           0.5);
+    movers_.push_back({primitives_.size() - 1, start, Eigen::Vector3d(speed, 0, 0)});
+  }
+}
+
+Scene Scene::MovedTo(double time_s) const {
+  Scene moved = *this;
+  for (const Mover& m : movers_) {
+    moved.primitives_[m.primitive].center = m.center_at_zero + time_s * m.velocity;
+  }
+  return moved;
 }
 
 bool Scene::Intersect(const Eigen::Vector3d& origin,

@@ -32,7 +32,9 @@ struct RayHit {
 
 class Scene {
  public:
-  // Scenes: t_specimen, square_pillar, cylinder_pillar, bridge_pier. Throws for an unknown name.
+  // Scenes: t_specimen, square_pillar, cylinder_pillar, bridge_pier, street. Throws for an unknown
+  // name. `street` is a straight street along world x (x from -20 to 120 m) between building facades
+  // with setbacks, with parked cars, poles and trees, and cars driving along it (MovedTo).
   static Scene Create(const std::string& name);
   static std::vector<std::string> Names();
 
@@ -55,6 +57,9 @@ class Scene {
   // True if the point lies on or inside an object primitive (within `tolerance`).
   bool InsideObject(const Eigen::Vector3d& point_in_world, double tolerance) const;
 
+  // The scene at time `time_s` [s]: moving objects (the street's driving cars) at their positions.
+  Scene MovedTo(double time_s) const;
+
   const std::string& Name() const { return name_; }
   const std::vector<Primitive>& Primitives() const { return primitives_; }
   // Where the stations look: centre of the structure and its horizontal radius and height.
@@ -74,7 +79,15 @@ class Scene {
                    bool is_object,
                    double albedo);
   void AddBackground();
+  void AddStreet();
   void FinishObject();
+
+  struct Mover {
+    size_t primitive = 0;
+    Eigen::Vector3d center_at_zero = Eigen::Vector3d::Zero();
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s
+  };
+  std::vector<Mover> movers_;
 
   std::string name_;
   std::vector<Primitive> primitives_;

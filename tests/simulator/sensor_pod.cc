@@ -37,8 +37,9 @@ Motion MotionFromName(const std::string& name) {
   if (name == "two_axes") return Motion::kTwoAxes;
   if (name == "one_axis") return Motion::kOneAxis;
   if (name == "fixed_rotation") return Motion::kFixedRotation;
+  if (name == "drive") return Motion::kDrive;
   throw std::invalid_argument("Unknown --motion '" + name +
-                              "'; expected two_axes, one_axis or fixed_rotation");
+                              "'; expected two_axes, one_axis, fixed_rotation or drive");
 }
 
 StationRig MakeStereoRig(double image_scale) {
@@ -54,6 +55,21 @@ StationRig MakeStereoRig(double image_scale) {
       Eigen::AngleAxisd(0.15 * kDegToRad, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
   rig.right_from_left.translation = Eigen::Vector3d(-0.38, 0.0, 0.0);
   rig.lidar_model = "VLP-16";
+  return rig;
+}
+
+StationRig MakeDriveRig(double image_scale) {
+  const size_t width = static_cast<size_t>(std::lround(1242 * image_scale));
+  const size_t height = static_cast<size_t>(std::lround(375 * image_scale));
+  const double focal = 0.5 * width / std::tan(45 * kDegToRad);
+  StationRig rig;
+  rig.left = colmap::Camera::CreateFromModelName(
+      colmap::kInvalidCameraId, "PINHOLE", focal, width, height);
+  rig.right = rig.left;
+  rig.right_from_left.rotation = Eigen::Quaterniond(
+      Eigen::AngleAxisd(0.1 * kDegToRad, Eigen::Vector3d(0.1, 1, 0.2).normalized()));
+  rig.right_from_left.translation = Eigen::Vector3d(-0.54, 0.0, 0.0);
+  rig.lidar_model = "HDL-64";
   return rig;
 }
 
@@ -102,6 +118,20 @@ std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
   const double ring_pitch = -4 * kDegToRad;  // the same for all tripod stations
   std::vector<colmap::Rigid3d> stations;
 
+  if (motion == Motion::kDrive) {
+    // 0.5-1 m per frame; a lane change (1.6 m over ~25 m) and a swerve, heading along the path.
+    auto lateral = [](double x) {
+      return 1.6 / (1 + std::exp(-(x - 20) / 4)) - 1.8 + 0.4 * std::sin(x / 9);
+    };
+    double x = 0;
+    for (int i = 0; i < num_stations; ++i) {
+      const double slope = (lateral(x + 0.5) - lateral(x - 0.5));
+      stations.push_back(CamFromWorld(WorldFromCamRotation(std::atan(slope), 0, 0),
+                                      Eigen::Vector3d(x, lateral(x), 1.65)));
+      x += 0.5 + 0.5 * unit(rng);
+    }
+    return stations;
+  }
   if (motion == Motion::kFixedRotation) {
     // A line of stations in front of the structure, all with the same orientation.
     const double yaw = M_PI / 2;  // looking along +y from the -y side

@@ -18,8 +18,17 @@ enum class Motion {
   kTwoAxes,  // tripod rotations about the vertical, the last stations tilted about a second axis
   kOneAxis,  // every relative rotation about the vertical axis: T_e translation along it unobservable
   kFixedRotation,  // pure translations: T_e translation unobservable
+  kDrive,  // a car driving along world x, 0.5-1 m per frame (10 Hz), with a lane change and a swerve
 };
-Motion MotionFromName(const std::string& name);  // "two_axes", "one_axis", "fixed_rotation"
+// "two_axes", "one_axis", "fixed_rotation", "drive"
+Motion MotionFromName(const std::string& name);
+
+// Frame period of the driving motion [s]: one LiDAR sweep per frame.
+constexpr double kDriveFramePeriod = 0.1;
+
+// A KITTI-like forward camera, 1242x375 * image_scale, 90 deg horizontal FOV, and a second camera
+// 0.54 m to its right.
+StationRig MakeDriveRig(double image_scale);
 
 // Left and right PINHOLE cameras of width 1028*image_scale with a 48 deg horizontal FOV, 0.38 m baseline.
 StationRig MakeStereoRig(double image_scale);
@@ -35,7 +44,8 @@ colmap::Rigid3d PerturbPose(const colmap::Rigid3d& truth,
                             double translation_m,
                             uint64_t seed);
 
-// cam_from_world of the left camera of each station, 2-3 m from the structure and looking at it.
+// cam_from_world of the left camera of each station, 2-3 m from the structure and looking at it; for
+// kDrive, of the forward camera at 1.65 m above the street at each frame's mid-sweep time.
 std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
                                           int num_stations,
                                           Motion motion,

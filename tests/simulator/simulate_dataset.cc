@@ -49,6 +49,20 @@ void WriteImage(const std::string& path, const cv::Mat& image) {
   }
 }
 
+// The LiDAR's path during frame i's sweep: from halfway since the previous frame to halfway to the
+// next (extrapolated at the ends), through the frame's own pose at tau = 0.5.
+std::function<colmap::Rigid3d(double)> SweepPath(const std::vector<colmap::Rigid3d>& poses,
+                                                 size_t i) {
+  const colmap::Rigid3d previous = i > 0 ? poses[i - 1] : Interpolate(poses[i], poses[i + 1], -1.0);
+  const colmap::Rigid3d next =
+      i + 1 < poses.size() ? poses[i + 1] : Interpolate(poses[i - 1], poses[i], 2.0);
+  const colmap::Rigid3d current = poses[i];
+  return [previous, current, next](double tau) {
+    return tau < 0.5 ? Interpolate(previous, current, 0.5 + tau)
+                     : Interpolate(current, next, tau - 0.5);
+  };
+}
+
 }  // namespace
 
 bool SimulationOptions::Check() const {
@@ -80,7 +94,8 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
     fs::create_directories(partial / dir);
   }
 
-  StationRig rig = MakeStereoRig(options.image_scale);
+  const bool drive = motion == Motion::kDrive;
+  StationRig rig = drive ? MakeDriveRig(options.image_scale) : MakeStereoRig(options.image_scale);
   const colmap::Rigid3d cam_from_lidar = TrueCamFromLidar();
   if (options.write_guess) {
     rig.cam_from_lidar_guess = PerturbPose(
@@ -93,8 +108,15 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
       MakeStations(scene, options.num_stations, motion, options.seed);
   SimulationResult result;
   std::map<std::string, colmap::Rigid3d> cam_from_world;
+  // world_from_lidar of each station (of each frame's mid-sweep instant when driving).
+  std::vector<colmap::Rigid3d> world_from_lidar;
+  for (const colmap::Rigid3d& station : stations) {
+    world_from_lidar.push_back(colmap::Inverse(station) * cam_from_lidar);
+  }
   for (size_t i = 0; i < stations.size(); ++i) {
     const std::string name = StationName(static_cast<int>(i));
+    // Driving: the other cars move between frames (not during a sweep).
+    const Scene frame_scene = drive ? scene.MovedTo(i * kDriveFramePeriod) : scene;
     cam_from_world[name] = stations[i];
     ImageOptions image_options;
     image_options.pixel_noise = options.pixel_noise;
@@ -102,21 +124,22 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
     image_options.seed = options.seed * 1000 + 2 * i;
     cv::Mat depth;
     WriteImage((partial / "images/left" / (name + ".png")).string(),
-               RenderImage(scene, rig.left, stations[i], image_options, &depth));
+               RenderImage(frame_scene, rig.left, stations[i], image_options, &depth));
     WriteDepthMap((partial / "ground_truth/depth" / (name + ".bin")).string(), depth);
     image_options.seed += 1;
     WriteImage(
         (partial / "images/right" / (name + ".png")).string(),
-        RenderImage(scene, rig.right, rig.right_from_left * stations[i], image_options, nullptr));
+        RenderImage(
+            frame_scene, rig.right, rig.right_from_left * stations[i], image_options, nullptr));
 
     LidarOptions lidar_options;
     lidar_options.num_points = options.lidar_points;
     lidar_options.range_noise_m = options.range_noise_m;
     lidar_options.mixed_edge_points = options.mixed_edge_points;
     lidar_options.seed = options.seed * 1000 + i;
-    // world_from_lidar = inverse(cam_from_world) * cam_from_lidar
     const PointCloud cloud =
-        ScanLidar(scene, colmap::Inverse(stations[i]) * cam_from_lidar, lidar_options);
+        drive ? ScanSweep(frame_scene, SweepPath(world_from_lidar, i), lidar_options)
+              : ScanLidar(scene, world_from_lidar[i], lidar_options);
     WritePointCloud((partial / "lidar" / (name + ".pcd")).string(), cloud);
     result.num_lidar_points += cloud.Size();
     std::cout << "simulate_dataset: station " << name << " (" << i + 1 << "/" << stations.size()

@@ -11,9 +11,11 @@ struct SimulationOptions {
   std::string scene = "t_specimen";
   std::string output_path;
   int num_stations = 25;
-  std::string motion = "two_axes";  // two_axes | one_axis | fixed_rotation
-  double image_scale = 1.0;         // 1 = 1028x752 per camera, 4 = the seed's 4112x3008
-  size_t lidar_points = 1600000;    // LiDAR rays per station
+  // two_axes | one_axis | fixed_rotation | drive (frames of a car: MakeDriveRig, one ScanSweep per
+  // frame with the frame's pose at mid-sweep, cars moving between frames; scene "street")
+  std::string motion = "two_axes";
+  double image_scale = 1.0;       // 1 = 1028x752 per camera, 4 = the seed's 4112x3008
+  size_t lidar_points = 1600000;  // LiDAR rays per station
   double range_noise_m = 0.01;
   double pixel_noise = 1.0;  // grey levels
   bool vignetting = false;

@@ -14,10 +14,12 @@ int RunSimulateDataset(int argc, char** argv) {
   int lidar_points = static_cast<int>(options.lidar_points);
   colmap::OptionManager manager;
   manager.AddRequiredOption("output_path", &options.output_path);
-  manager.AddDefaultOption(
-      "scene", &options.scene, "t_specimen | square_pillar | cylinder_pillar | bridge_pier");
+  manager.AddDefaultOption("scene",
+                           &options.scene,
+                           "t_specimen | square_pillar | cylinder_pillar | bridge_pier | street");
   manager.AddDefaultOption("num_stations", &options.num_stations);
-  manager.AddDefaultOption("motion", &options.motion, "two_axes | one_axis | fixed_rotation");
+  manager.AddDefaultOption(
+      "motion", &options.motion, "two_axes | one_axis | fixed_rotation | drive");
   manager.AddDefaultOption(
       "image_scale", &options.image_scale, "1 = 1028x752 per camera, 4 = 4112x3008");
   manager.AddDefaultOption("lidar_points", &lidar_points, "LiDAR rays per station");
