@@ -25,15 +25,20 @@ int RunImportDataset(int argc, char** argv) {
   options.AddDatabaseOptions();
   options.AddExtractionOptions();
   options.AddExhaustiveMatchingOptions();
+  options.AddSequentialMatchingOptions();
+  DatasetImportOptions import_options;
+  options.AddDefaultOption("matcher",
+                           &import_options.matcher,
+                           "exhaustive | sequential (frames of a moving platform, by name)");
   options.Parse(argc, argv);
 
   const auto start = std::chrono::steady_clock::now();
   const StationDataset dataset = ReadStationDataset(dataset_path);
-  DatasetImportOptions import_options;
   import_options.sift_extraction = *options.sift_extraction;
   import_options.sift_matching = *options.sift_matching;
   import_options.two_view_geometry = *options.two_view_geometry;
   import_options.exhaustive_matching = *options.exhaustive_matching;
+  import_options.sequential_matching = *options.sequential_matching;
   const DatasetImportSummary summary =
       ImportDataset(dataset, *options.database_path, import_options);
   std::cout << "Imported " << dataset.root << " into " << *options.database_path << ": "

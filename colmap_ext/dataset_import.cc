@@ -74,6 +74,13 @@ colmap::camera_t LeftCameraId(const StationDataset& dataset,
 
 }  // namespace
 
+bool DatasetImportOptions::Check() const {
+  CHECK_OPTION(matcher == "exhaustive" || matcher == "sequential");
+  CHECK_OPTION(exhaustive_matching.Check());
+  CHECK_OPTION(sequential_matching.Check());
+  return true;
+}
+
 void CheckStationImages(const StationDataset& dataset) {
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
     CheckImage(dataset.stations[i], "left", dataset.LeftImagePath(i), dataset.rig.left);
@@ -87,7 +94,7 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
   THROW_CHECK(options.sift_extraction.Check());
   THROW_CHECK(options.sift_matching.Check());
   THROW_CHECK(options.two_view_geometry.Check());
-  THROW_CHECK(options.exhaustive_matching.Check());
+  THROW_CHECK(options.Check());
   THROW_CHECK(!dataset.stations.empty()) << "no stations in " << dataset.root;
   std::cout << "Checking " << dataset.stations.size() << " stereo pairs of " << dataset.root
             << std::endl;
@@ -157,9 +164,16 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
       }
     }
 
-    std::cout << "COLMAP exhaustive matching" << std::endl;
-    auto matcher = colmap::CreateExhaustiveFeatureMatcher(
-        options.exhaustive_matching, options.sift_matching, options.two_view_geometry, partial);
+    std::cout << "COLMAP " << options.matcher << " matching" << std::endl;
+    auto matcher = options.matcher == "sequential"
+                       ? colmap::CreateSequentialFeatureMatcher(options.sequential_matching,
+                                                                options.sift_matching,
+                                                                options.two_view_geometry,
+                                                                partial)
+                       : colmap::CreateExhaustiveFeatureMatcher(options.exhaustive_matching,
+                                                                options.sift_matching,
+                                                                options.two_view_geometry,
+                                                                partial);
     matcher->Start();
     matcher->Wait();
     matcher.reset();

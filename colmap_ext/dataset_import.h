@@ -25,7 +25,13 @@ struct DatasetImportOptions {
   colmap::SiftExtractionOptions sift_extraction;
   colmap::SiftMatchingOptions sift_matching;
   colmap::TwoViewGeometryOptions two_view_geometry;
+  // "exhaustive" (every image pair) or "sequential" (each image with its successors by name, for
+  // frames of a moving platform: SequentialMatchingOptions::overlap of them).
+  std::string matcher = "exhaustive";
   colmap::ExhaustiveMatchingOptions exhaustive_matching;
+  colmap::SequentialMatchingOptions sequential_matching;
+
+  bool Check() const;
 };
 
 struct DatasetImportSummary {
