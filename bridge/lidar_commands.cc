@@ -37,6 +37,56 @@ std::string PairLine(const std::string& target, const std::string& source, const
   return line.str();
 }
 
+// pairs.txt (accepted edges, refused pairs as comments with the reason) and lidar_poses.txt.
+void WritePairsAndPoses(const std::string& output_path,
+                        const std::vector<std::string>& names,
+                        const LidarGraph& graph) {
+  std::ostringstream pairs;
+  pairs << "# colmap-lidar LiDAR pose graph edges (A_l).\n"
+           "# target source qw qx qy qz tx ty tz inliers overlap rmse_m noise_m constraint_ratio "
+           "weakest_axis determined|degenerate bsc|identity\n"
+           "# target_from_source = lidar_target_from_lidar_source, quaternion "
+           "w first, metres\n";
+  for (const LidarEdge& e : graph.edges) {
+    pairs << PairLine(names[e.target], names[e.source], e) << "\n";
+  }
+  for (const LidarEdge& e : graph.refused) {
+    pairs << "# refused " << names[e.target] << " " << names[e.source] << ": "
+          << e.registration.reason << "\n";
+  }
+  WriteFileAtomically((fs::path(output_path) / "pairs.txt").string(), pairs.str());
+  std::map<std::string, colmap::Rigid3d> poses;
+  for (size_t i = 0; i < names.size(); ++i) poses[names[i]] = ToRigid3d(graph.world_from_lidar[i]);
+  WriteNamedPoses((fs::path(output_path) / "lidar_poses.txt").string(),
+                  "LiDAR station poses world_from_lidar (world = first station "
+                  "of each component)",
+                  poses);
+}
+
+// summary.txt: counts, components, 3-cycles, pose-graph cost, time.
+std::string Summary(const std::vector<std::string>& names,
+                    const LidarGraph& graph,
+                    double seconds) {
+  std::ostringstream summary;
+  summary << "stations " << names.size() << "\npairs_attempted "
+          << graph.edges.size() + graph.refused.size() << "\nedges_accepted " << graph.edges.size()
+          << "\ncomponents " << graph.num_components << "\n";
+  for (int c = 0; c < graph.num_components; ++c) {
+    summary << "component " << c << ":";
+    for (size_t i = 0; i < names.size(); ++i) {
+      if (graph.component[i] == c) summary << " " << names[i];
+    }
+    summary << "\n";
+  }
+  summary << "three_cycles " << graph.num_cycles << "\nworst_cycle_translation_m "
+          << graph.worst_cycle_translation_m << "\nworst_cycle_rotation_deg "
+          << graph.worst_cycle_rotation_deg << "\n";
+  summary << "pose_graph_cost_initial " << graph.refinement_initial_cost
+          << "\npose_graph_cost_final " << graph.refinement_final_cost << "\nseconds " << seconds
+          << "\n";
+  return summary.str();
+}
+
 }  // namespace
 
 int RunLidarRegistrator(int argc, char** argv) {
@@ -110,44 +160,10 @@ int RunLidarRegistrator(int argc, char** argv) {
       });
 
   fs::create_directories(output_path);
-  std::ostringstream pairs;
-  pairs << "# colmap-lidar LiDAR pose graph edges (A_l).\n"
-           "# target source qw qx qy qz tx ty tz inliers overlap rmse_m noise_m constraint_ratio "
-           "weakest_axis determined|degenerate bsc|identity\n"
-           "# target_from_source = lidar_target_from_lidar_source, quaternion "
-           "w first, metres\n";
-  for (const LidarEdge& e : graph.edges)
-    pairs << PairLine(names[e.target], names[e.source], e) << "\n";
-  for (const LidarEdge& e : graph.refused) {
-    pairs << "# refused " << names[e.target] << " " << names[e.source] << ": "
-          << e.registration.reason << "\n";
-  }
-  WriteFileAtomically((fs::path(output_path) / "pairs.txt").string(), pairs.str());
-  std::map<std::string, colmap::Rigid3d> poses;
-  for (size_t i = 0; i < names.size(); ++i) poses[names[i]] = ToRigid3d(graph.world_from_lidar[i]);
-  WriteNamedPoses((fs::path(output_path) / "lidar_poses.txt").string(),
-                  "LiDAR station poses world_from_lidar (world = first station "
-                  "of each component)",
-                  poses);
-  std::ostringstream summary;
-  summary << "stations " << names.size() << "\npairs_attempted "
-          << graph.edges.size() + graph.refused.size() << "\nedges_accepted " << graph.edges.size()
-          << "\ncomponents " << graph.num_components << "\n";
-  for (int c = 0; c < graph.num_components; ++c) {
-    summary << "component " << c << ":";
-    for (size_t i = 0; i < names.size(); ++i) {
-      if (graph.component[i] == c) summary << " " << names[i];
-    }
-    summary << "\n";
-  }
-  summary << "three_cycles " << graph.num_cycles << "\nworst_cycle_translation_m "
-          << graph.worst_cycle_translation_m << "\nworst_cycle_rotation_deg "
-          << graph.worst_cycle_rotation_deg << "\n";
-  summary << "pose_graph_cost_initial " << graph.refinement_initial_cost
-          << "\npose_graph_cost_final " << graph.refinement_final_cost << "\nseconds " << seconds()
-          << "\n";
-  WriteFileAtomically((fs::path(output_path) / "summary.txt").string(), summary.str());
-  std::cout << summary.str();
+  WritePairsAndPoses(output_path, names, graph);
+  const std::string summary = Summary(names, graph, seconds());
+  WriteFileAtomically((fs::path(output_path) / "summary.txt").string(), summary);
+  std::cout << summary;
   if (graph.num_components > 1) {
     std::cout << "lidar_registrator: WARNING: the stations form " << graph.num_components
               << " disconnected components (see summary.txt)" << std::endl;
