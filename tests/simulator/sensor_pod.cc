@@ -42,35 +42,46 @@ Motion MotionFromName(const std::string& name) {
                               "'; expected two_axes, one_axis, fixed_rotation or drive");
 }
 
-StationRig MakeStereoRig(double image_scale) {
-  const size_t width = static_cast<size_t>(std::lround(1028 * image_scale));
-  const size_t height = static_cast<size_t>(std::lround(752 * image_scale));
-  const double focal = 0.5 * width / std::tan(24 * kDegToRad);
+namespace {
+
+// Two identical PINHOLE cameras with the given horizontal FOV, the right one `baseline_m` to the right
+// and turned by `misalignment_deg` about a generic axis (a real bar is never perfectly parallel).
+StationRig MakePinholePair(double width_px,
+                           double height_px,
+                           double horizontal_fov_deg,
+                           double baseline_m,
+                           double misalignment_deg,
+                           const Eigen::Vector3d& misalignment_axis,
+                           const std::string& lidar_model) {
+  const size_t width = static_cast<size_t>(std::lround(width_px));
+  const size_t height = static_cast<size_t>(std::lround(height_px));
+  const double focal = 0.5 * width / std::tan(0.5 * horizontal_fov_deg * kDegToRad);
   StationRig rig;
   rig.left = colmap::Camera::CreateFromModelName(
       colmap::kInvalidCameraId, "PINHOLE", focal, width, height);
   rig.right = rig.left;
-  // The right camera sits 0.38 m to the right, with a small residual misalignment as on a real bar.
   rig.right_from_left.rotation = Eigen::Quaterniond(
-      Eigen::AngleAxisd(0.15 * kDegToRad, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
-  rig.right_from_left.translation = Eigen::Vector3d(-0.38, 0.0, 0.0);
-  rig.lidar_model = "VLP-16";
+      Eigen::AngleAxisd(misalignment_deg * kDegToRad, misalignment_axis.normalized()));
+  rig.right_from_left.translation = Eigen::Vector3d(-baseline_m, 0.0, 0.0);
+  rig.lidar_model = lidar_model;
   return rig;
 }
 
+}  // namespace
+
+StationRig MakeStereoRig(double image_scale) {
+  return MakePinholePair(1028 * image_scale,
+                         752 * image_scale,
+                         48,
+                         0.38,
+                         0.15,
+                         Eigen::Vector3d(0.2, 1, 0.1),
+                         "VLP-16");
+}
+
 StationRig MakeDriveRig(double image_scale) {
-  const size_t width = static_cast<size_t>(std::lround(1242 * image_scale));
-  const size_t height = static_cast<size_t>(std::lround(375 * image_scale));
-  const double focal = 0.5 * width / std::tan(45 * kDegToRad);
-  StationRig rig;
-  rig.left = colmap::Camera::CreateFromModelName(
-      colmap::kInvalidCameraId, "PINHOLE", focal, width, height);
-  rig.right = rig.left;
-  rig.right_from_left.rotation = Eigen::Quaterniond(
-      Eigen::AngleAxisd(0.1 * kDegToRad, Eigen::Vector3d(0.1, 1, 0.2).normalized()));
-  rig.right_from_left.translation = Eigen::Vector3d(-0.54, 0.0, 0.0);
-  rig.lidar_model = "HDL-64";
-  return rig;
+  return MakePinholePair(
+      1242 * image_scale, 375 * image_scale, 90, 0.54, 0.1, Eigen::Vector3d(0.1, 1, 0.2), "HDL-64");
 }
 
 colmap::Rigid3d TrueCamFromLidar() {
