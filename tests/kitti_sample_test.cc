@@ -8,9 +8,8 @@
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 
-#include <gtest/gtest.h>
-
 #include <Eigen/Geometry>
+#include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
@@ -40,9 +39,9 @@ TEST(KittiSampleTest, SweepsGroupByPlaceWithStandstillMotion) {
     GTEST_SKIP() << "no KITTI sample at " << kSample;
   }
   testing::ScopedTempDir dir;
-  const auto result = testing::RunCommand(std::string(COLMAP_LIDAR_CLI_EXE) +
-                                          " lidar_registrator --lidar_path " + kSample +
-                                          " --output_path " + dir.File("out"));
+  const auto result =
+      testing::RunCommand(std::string(COLMAP_LIDAR_CLI_EXE) + " lidar_registrator --lidar_path " +
+                          kSample + " --output_path " + dir.File("out"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   std::cout << result.output.substr(result.output.find("stations"));
   const auto summary = ReadSummary(dir.File("out/summary.txt"));
