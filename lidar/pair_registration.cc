@@ -179,8 +179,8 @@ void Judge(const PairRegistrationOptions& options, PairRegistration* result) {
     reason << "overlap " << result->overlap << " below " << options.min_overlap;
   } else if (rmse_to_noise > options.max_rmse_to_noise) {
     reason << "ICP RMSE " << result->rmse << " m is " << rmse_to_noise
-           << " x the clouds' plane noise " << result->noise_rms << " m (max " << options.max_rmse_to_noise
-           << ")";
+           << " x the clouds' plane noise " << result->noise_rms << " m (max "
+           << options.max_rmse_to_noise << ")";
   } else if (options.max_rmse > 0 && result->rmse > options.max_rmse) {
     reason << "ICP RMSE " << result->rmse << " m above " << options.max_rmse;
   } else if (result->constraints.weakest_ratio < options.min_constraint_ratio) {
@@ -198,8 +198,8 @@ void Judge(const PairRegistrationOptions& options, PairRegistration* result) {
 bool PairRegistrationOptions::Check() const {
   if (!(max_ratio > 0) || ransac_iterations < 1 || !(inlier_threshold > 0) ||
       !(edge_tolerance > 0) || min_inliers < 3 || num_hypotheses < 1 || !(min_overlap >= 0) ||
-      !(max_rmse_to_noise > 0) || !(max_rmse >= 0) ||
-      !(min_constraint_ratio >= 0) || !(weak_constraint_ratio >= min_constraint_ratio)) {
+      !(max_rmse_to_noise > 0) || !(max_rmse >= 0) || !(min_constraint_ratio >= 0) ||
+      !(weak_constraint_ratio >= min_constraint_ratio)) {
     throw std::invalid_argument("PairRegistrationOptions: invalid value");
   }
   return icp.Check();
