@@ -72,6 +72,70 @@ colmap::camera_t LeftCameraId(const StationDataset& dataset,
   return database->WriteCamera(camera);
 }
 
+// The image id of each station's left image after COLMAP's extraction; throws naming the station
+// when COLMAP did not import it, it has another camera, or it has no features.
+std::vector<colmap::image_t> ImportedImageIds(const StationDataset& dataset,
+                                              const std::vector<std::string>& names,
+                                              colmap::camera_t camera_id,
+                                              const std::string& database_path) {
+  std::vector<colmap::image_t> image_ids;
+  colmap::Database database(database_path);
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (!database.ExistsImageWithName(names[i])) {
+      throw std::runtime_error("station " + dataset.stations[i] + ": COLMAP did not import " +
+                               dataset.LeftImagePath(i));
+    }
+    const colmap::Image image = database.ReadImageWithName(names[i]);
+    if (image.CameraId() != camera_id) {
+      throw std::runtime_error("station " + dataset.stations[i] + ": image " + names[i] +
+                               " already exists in the database with another camera (" +
+                               std::to_string(image.CameraId()) + ")");
+    }
+    if (!database.ExistsKeypoints(image.ImageId())) {
+      throw std::runtime_error("station " + dataset.stations[i] +
+                               ": COLMAP extracted no features from " + dataset.LeftImagePath(i));
+    }
+    image_ids.push_back(image.ImageId());
+  }
+  return image_ids;
+}
+
+// COLMAP's exhaustive or sequential matcher on the database.
+void MatchFeatures(const DatasetImportOptions& options, const std::string& database_path) {
+  std::cout << "COLMAP " << options.matcher << " matching" << std::endl;
+  auto matcher = options.matcher == "sequential"
+                     ? colmap::CreateSequentialFeatureMatcher(options.sequential_matching,
+                                                              options.sift_matching,
+                                                              options.two_view_geometry,
+                                                              database_path)
+                     : colmap::CreateExhaustiveFeatureMatcher(options.exhaustive_matching,
+                                                              options.sift_matching,
+                                                              options.two_view_geometry,
+                                                              database_path);
+  matcher->Start();
+  matcher->Wait();
+}
+
+// Our tables: the stereo rig and each station's LiDAR frame.
+void WriteRigAndLidarFrames(const StationDataset& dataset,
+                            colmap::camera_t camera_id,
+                            const std::vector<colmap::image_t>& image_ids,
+                            const std::string& database_path) {
+  ExtensionDatabase extension(database_path);
+  StereoRig rig;
+  rig.left_camera_id = camera_id;
+  rig.right_camera = dataset.rig.right;
+  rig.right_from_left = dataset.rig.right_from_left;
+  extension.WriteRig(rig);
+  for (size_t i = 0; i < image_ids.size(); ++i) {
+    LidarFrame frame;
+    frame.image_id = image_ids[i];
+    frame.path = fs::relative(dataset.cloud_paths[i], dataset.root).generic_string();
+    frame.cam_from_lidar_guess = dataset.rig.cam_from_lidar_guess;
+    extension.WriteLidarFrame(frame);
+  }
+}
+
 }  // namespace
 
 bool DatasetImportOptions::Check() const {
@@ -141,58 +205,12 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
     extractor->Wait();
     extractor.reset();  // closes its database connection
 
-    std::vector<colmap::image_t> image_ids;
-    {
-      colmap::Database database(partial);
-      for (size_t i = 0; i < names.size(); ++i) {
-        if (!database.ExistsImageWithName(names[i])) {
-          throw std::runtime_error("station " + dataset.stations[i] + ": COLMAP did not import " +
-                                   dataset.LeftImagePath(i));
-        }
-        const colmap::Image image = database.ReadImageWithName(names[i]);
-        if (image.CameraId() != summary.camera_id) {
-          throw std::runtime_error("station " + dataset.stations[i] + ": image " + names[i] +
-                                   " already exists in the database with another camera (" +
-                                   std::to_string(image.CameraId()) + ")");
-        }
-        if (!database.ExistsKeypoints(image.ImageId())) {
-          throw std::runtime_error("station " + dataset.stations[i] +
-                                   ": COLMAP extracted no features from " +
-                                   dataset.LeftImagePath(i));
-        }
-        image_ids.push_back(image.ImageId());
-      }
-    }
+    const std::vector<colmap::image_t> image_ids =
+        ImportedImageIds(dataset, names, summary.camera_id, partial);
 
-    std::cout << "COLMAP " << options.matcher << " matching" << std::endl;
-    auto matcher = options.matcher == "sequential"
-                       ? colmap::CreateSequentialFeatureMatcher(options.sequential_matching,
-                                                                options.sift_matching,
-                                                                options.two_view_geometry,
-                                                                partial)
-                       : colmap::CreateExhaustiveFeatureMatcher(options.exhaustive_matching,
-                                                                options.sift_matching,
-                                                                options.two_view_geometry,
-                                                                partial);
-    matcher->Start();
-    matcher->Wait();
-    matcher.reset();
+    MatchFeatures(options, partial);
 
-    {
-      ExtensionDatabase extension(partial);
-      StereoRig rig;
-      rig.left_camera_id = summary.camera_id;
-      rig.right_camera = dataset.rig.right;
-      rig.right_from_left = dataset.rig.right_from_left;
-      extension.WriteRig(rig);
-      for (size_t i = 0; i < names.size(); ++i) {
-        LidarFrame frame;
-        frame.image_id = image_ids[i];
-        frame.path = fs::relative(dataset.cloud_paths[i], dataset.root).generic_string();
-        frame.cam_from_lidar_guess = dataset.rig.cam_from_lidar_guess;
-        extension.WriteLidarFrame(frame);
-      }
-    }
+    WriteRigAndLidarFrames(dataset, summary.camera_id, image_ids, partial);
     {
       const colmap::Database database(partial);
       summary.num_images = names.size();

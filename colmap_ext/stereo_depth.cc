@@ -88,6 +88,56 @@ cv::Mat ComputeVerticallySymmetric(cv::StereoSGBM& matcher,
   return combined;
 }
 
+// Left-right consistency: left disparities whose right match disagrees by more than max_diff_px, or
+// that lie outside the original image (mask 0), are set to 0. Returns |d_left - d_right| per kept
+// pixel, -1 elsewhere.
+cv::Mat LeftRightCheck(const cv::Mat& right_disparity,
+                       const cv::Mat& mask,
+                       double max_diff_px,
+                       cv::Mat* left_disparity) {
+  cv::Mat lr_diff(left_disparity->size(), CV_32F, cv::Scalar(-1));
+  for (int row = 0; row < left_disparity->rows; ++row) {
+    for (int col = 0; col < left_disparity->cols; ++col) {
+      float& d = left_disparity->at<float>(row, col);
+      if (d <= 0.f) continue;
+      const int right_col = static_cast<int>(std::lround(col - d));
+      const float d_right = right_col >= 0 ? right_disparity.at<float>(row, right_col) : 0.f;
+      const float diff = std::abs(d - d_right);
+      if (mask.at<uchar>(row, col) == 0 || d_right <= 0.f || diff > max_diff_px) {
+        d = 0.f;
+      } else {
+        lr_diff.at<float>(row, col) = diff;
+      }
+    }
+  }
+  return lr_diff;
+}
+
+// Confidence in the original grid: the left-right agreement of the nearest rectified pixel, at least
+// 1 where there is depth and 0 where there is none.
+cv::Mat Confidence(const StereoRectifier& rectifier,
+                   const cv::Mat& lr_diff,
+                   double max_diff_px,
+                   const cv::Mat& depth) {
+  cv::Mat confidence_rectified(lr_diff.size(), CV_8U, cv::Scalar(0));
+  for (int row = 0; row < lr_diff.rows; ++row) {
+    for (int col = 0; col < lr_diff.cols; ++col) {
+      const float diff = lr_diff.at<float>(row, col);
+      if (diff < 0.f) continue;
+      confidence_rectified.at<uchar>(row, col) =
+          static_cast<uchar>(std::lround(1 + 254 * (1.0 - diff / (max_diff_px + 1e-9))));
+    }
+  }
+  cv::Mat confidence = rectifier.ToLeftImage(confidence_rectified);
+  for (int row = 0; row < depth.rows; ++row) {
+    for (int col = 0; col < depth.cols; ++col) {
+      uchar& c = confidence.at<uchar>(row, col);
+      c = depth.at<float>(row, col) > 0.f ? std::max<uchar>(1, c) : 0;
+    }
+  }
+  return confidence;
+}
+
 void WriteAtomically(const std::string& path,
                      const std::function<void(const std::string&)>& write) {
   const std::string temporary = path + ".tmp";
@@ -177,50 +227,14 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
   cv::Mat left_disparity = ToPixels(left_fixed, min_disparity);
   const cv::Mat right_disparity = ToPixels(right_fixed, min_disparity);
 
-  // Left-right consistency; rectified pixels from outside the original image are dropped.
-  const cv::Mat& mask = rectifier.LeftRectifiedMask();
-  cv::Mat lr_diff(left_disparity.size(), CV_32F, cv::Scalar(-1));
-  for (int row = 0; row < left_disparity.rows; ++row) {
-    for (int col = 0; col < left_disparity.cols; ++col) {
-      float& d = left_disparity.at<float>(row, col);
-      if (d <= 0.f) continue;
-      const int right_col = static_cast<int>(std::lround(col - d));
-      const float d_right = right_col >= 0 ? right_disparity.at<float>(row, right_col) : 0.f;
-      const float diff = std::abs(d - d_right);
-      if (mask.at<uchar>(row, col) == 0 || d_right <= 0.f ||
-          diff > options.max_left_right_diff_px) {
-        d = 0.f;
-      } else {
-        lr_diff.at<float>(row, col) = diff;
-      }
-    }
-  }
-
+  const cv::Mat lr_diff = LeftRightCheck(right_disparity,
+                                         rectifier.LeftRectifiedMask(),
+                                         options.max_left_right_diff_px,
+                                         &left_disparity);
   StereoDepth result;
   result.depth = rectifier.DepthInLeftImage(left_disparity);
-  // Confidence in the original grid: the left-right agreement of the nearest rectified pixel.
-  cv::Mat confidence_rectified(lr_diff.size(), CV_8U, cv::Scalar(0));
-  for (int row = 0; row < lr_diff.rows; ++row) {
-    for (int col = 0; col < lr_diff.cols; ++col) {
-      const float diff = lr_diff.at<float>(row, col);
-      if (diff < 0.f) continue;
-      confidence_rectified.at<uchar>(row, col) = static_cast<uchar>(
-          std::lround(1 + 254 * (1.0 - diff / (options.max_left_right_diff_px + 1e-9))));
-    }
-  }
-  result.confidence = rectifier.ToLeftImage(confidence_rectified);
-  size_t num_valid = 0;
-  for (int row = 0; row < result.depth.rows; ++row) {
-    for (int col = 0; col < result.depth.cols; ++col) {
-      if (result.depth.at<float>(row, col) > 0.f) {
-        ++num_valid;
-        result.confidence.at<uchar>(row, col) =
-            std::max<uchar>(1, result.confidence.at<uchar>(row, col));
-      } else {
-        result.confidence.at<uchar>(row, col) = 0;
-      }
-    }
-  }
+  result.confidence = Confidence(rectifier, lr_diff, options.max_left_right_diff_px, result.depth);
+  const size_t num_valid = static_cast<size_t>(cv::countNonZero(result.depth > 0.f));
   result.valid_fraction =
       static_cast<double>(num_valid) / static_cast<double>(result.depth.total());
   return result;

@@ -220,6 +220,15 @@ void Scene::AddCylinder(const Eigen::Vector3d& base_center,
   primitives_.push_back(cyl);
 }
 
+void Scene::AddGround(double half_extent_m, double albedo) {
+  Primitive ground;
+  ground.type = Primitive::Type::kGround;
+  ground.half_size = Eigen::Vector3d(half_extent_m, half_extent_m, 0);
+  ground.albedo = albedo;
+  ground.texture_contrast = 0.5;
+  primitives_.push_back(ground);
+}
+
 void Scene::FinishObject() {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
   for (const Primitive& p : primitives_) {
@@ -232,12 +241,7 @@ void Scene::FinishObject() {
 }
 
 void Scene::AddBackground() {
-  Primitive ground;
-  ground.type = Primitive::Type::kGround;
-  ground.half_size = Eigen::Vector3d(40, 40, 0);
-  ground.albedo = 0.45;
-  ground.texture_contrast = 0.5;
-  primitives_.push_back(ground);
+  AddGround(40, 0.45);
   // A courtyard: walls 10-14 m away and 3-5 m high (deliberately not symmetric: a square courtyard
   // would make LiDAR registration ambiguous under 90 degree turns, which real sites rarely are), and
   // objects 5-9 m away, so that clouds overlap widely.
@@ -255,12 +259,7 @@ void Scene::AddBackground() {
 // Facade blocks of 6-14 m along each side with setbacks of 0-1.5 m and heights of 6-15 m, parked
 // cars, poles and trees in irregular (seeded) places: straight, but not repetitive.
 void Scene::AddStreet() {
-  Primitive ground;
-  ground.type = Primitive::Type::kGround;
-  ground.half_size = Eigen::Vector3d(200, 200, 0);
-  ground.albedo = 0.35;
-  ground.texture_contrast = 0.5;
-  primitives_.push_back(ground);
+  AddGround(200, 0.35);
   std::mt19937_64 rng(20261130);
   std::uniform_real_distribution<double> unit(0, 1);
   for (const double side : {-1.0, 1.0}) {

@@ -78,6 +78,8 @@ class Scene {
                    double height,
                    bool is_object,
                    double albedo);
+  // The ground plane z = 0 over [-half_extent_m, half_extent_m]^2.
+  void AddGround(double half_extent_m, double albedo);
   void AddBackground();
   void AddStreet();
   void FinishObject();
