@@ -263,16 +263,20 @@ void AddLidarBlocks(const RunState& state,
       joint->num_hidden_residuals += group.size() - LidarPairPointToPlaneCost::kCompressedResiduals;
     }
     joint->lidar_pairs.emplace_back(observation.target, observation.source);
-    joint->lidar_ids.push_back(
-        problem->AddResidualBlock(LidarPairPointToPlaneCost::Create(
-                                      std::move(group), sigma, state.options.compress_lidar_blocks),
-                                  state.loss.get(),
-                                  {target_rotation,
-                                   target_translation,
-                                   source_rotation,
-                                   source_translation,
-                                   state.ExtrinsicRotation(),
-                                   state.ExtrinsicTranslation()}));
+    const colmap::Rigid3d reference =
+        LidarIFromLidarJ(state.reconstruction->Image(observation.target).CamFromWorld(),
+                         state.reconstruction->Image(observation.source).CamFromWorld(),
+                         *state.cam_from_lidar);
+    joint->lidar_ids.push_back(problem->AddResidualBlock(
+        LidarPairPointToPlaneCost::Create(
+            std::move(group), sigma, state.options.compress_lidar_blocks, reference),
+        state.loss.get(),
+        {target_rotation,
+         target_translation,
+         source_rotation,
+         source_translation,
+         state.ExtrinsicRotation(),
+         state.ExtrinsicTranslation()}));
     group.clear();
   }
 }

@@ -64,7 +64,7 @@ struct JointAdjusterOptions {
   // directed station pair.
   std::string loss = "none";
   // Each LiDAR pair block in its compressed form (bridge/lidar_pair_cost.h): the same cost, gradient
-  // and Gauss-Newton model in 19 rows instead of one per observation.
+  // and Gauss-Newton model in 13 moment rows, evaluated in O(1) instead of one row per observation.
   bool compress_lidar_blocks = true;
   // Scale of the loss in units of the whitened residual.
   double loss_scale = 1.0;

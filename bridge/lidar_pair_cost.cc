@@ -2,8 +2,9 @@
 
 #include "colmap_ext/logging.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/QR>
+#include <ceres/jet.h>
 #include <ceres/manifold.h>
 
 namespace colmap_lidar {
@@ -11,8 +12,6 @@ namespace {
 
 constexpr int kTangentSize = 18;  // 3 per parameter block
 constexpr int kAmbientSizes[6] = {4, 3, 4, 3, 4, 3};
-
-using TangentRows = Eigen::Matrix<double, Eigen::Dynamic, kTangentSize, Eigen::RowMajor>;
 
 Eigen::Matrix<double, 4, 3> PlusJacobian(const double* quaternion) {
   Eigen::Matrix<double, 4, 3, Eigen::RowMajor> jacobian;
@@ -34,10 +33,35 @@ void WriteAmbient(const Rows& tangent, int block, const double* quaternion, doub
       tangent.middleCols(3 * block, 3) * PlusJacobian(quaternion).transpose();
 }
 
+using Jet = ceres::Jet<double, kTangentSize>;
+using Matrix3J = Eigen::Matrix<Jet, 3, 3>;
+using Vector3J = Eigen::Matrix<Jet, 3, 1>;
+
+// The rotation of quaternion block `block` with the manifold's tangent as dual part: to first order
+// (I + 2 [delta]x) R, since the tangent delta rotates by 2|delta|.
+Matrix3J PerturbedRotation(const double* quaternion, int block) {
+  Vector3J w;
+  for (int i = 0; i < 3; ++i) w[i] = 2.0 * Jet(0.0, 3 * block + i);
+  Matrix3J left;
+  left << Jet(1.0), -w[2], w[1], w[2], Jet(1.0), -w[0], -w[1], w[0], Jet(1.0);
+  const Eigen::Matrix3d rotation =
+      Eigen::Map<const Eigen::Quaterniond>(quaternion).toRotationMatrix();
+  return left * rotation.cast<Jet>();
+}
+
+Vector3J PerturbedTranslation(const double* translation, int block) {
+  Vector3J t;
+  for (int i = 0; i < 3; ++i) t[i] = Jet(translation[i], 3 * block + i);
+  return t;
+}
+
 }  // namespace
 
 LidarPairPointToPlaneCost::LidarPairPointToPlaneCost(
-    std::vector<PointToPlaneObservation> observations, double sigma, bool compress)
+    std::vector<PointToPlaneObservation> observations,
+    double sigma,
+    bool compress,
+    const colmap::Rigid3d& reference)
     : observations_(std::move(observations)),
       inverse_sigma_(1.0 / sigma),
       compressed_(compress && observations_.size() > kCompressedResiduals) {
@@ -45,11 +69,44 @@ LidarPairPointToPlaneCost::LidarPairPointToPlaneCost(
   THROW_CHECK_GT(sigma, 0);
   set_num_residuals(compressed_ ? kCompressedResiduals : static_cast<int>(observations_.size()));
   *mutable_parameter_block_sizes() = {4, 3, 4, 3, 4, 3};
+  if (compressed_) BuildMoments(reference);
+}
+
+// The rows a_k = [vec(n p'^T), n, n^T (p~ - q)] / sigma (see the header) and S with S^T S = M.
+void LidarPairPointToPlaneCost::BuildMoments(const colmap::Rigid3d& reference) {
+  reference_rotation_transposed_ = reference.rotation.toRotationMatrix().transpose();
+  std::vector<Eigen::Vector3d> moved;  // p~_k = T0 p_k
+  moved.reserve(observations_.size());
+  reference_centroid_.setZero();
+  for (const PointToPlaneObservation& o : observations_) {
+    moved.push_back(reference * o.point_in_source);
+    reference_centroid_ += moved.back();
+  }
+  reference_centroid_ /= static_cast<double>(observations_.size());
+  source_centroid_ = colmap::Inverse(reference) * reference_centroid_;
+  Eigen::Matrix<double, Eigen::Dynamic, kCompressedResiduals> rows(observations_.size(),
+                                                                   kCompressedResiduals);
+  for (size_t k = 0; k < observations_.size(); ++k) {
+    const Eigen::Vector3d& n = observations_[k].normal_in_target;
+    const Eigen::Vector3d p = moved[k] - reference_centroid_;
+    auto a = rows.row(k);
+    for (int row = 0; row < 3; ++row) a.segment<3>(3 * row) = n[row] * p.transpose();
+    a.segment<3>(9) = n.transpose();
+    a[12] = n.dot(moved[k] - observations_[k].point_in_target);
+  }
+  // S from a QR decomposition of the rows (not from M = A^T A): backward stable, so the cost near T0
+  // keeps the precision of the residuals themselves.
+  const Eigen::HouseholderQR<Eigen::Matrix<double, Eigen::Dynamic, kCompressedResiduals>> qr(
+      rows * inverse_sigma_);
+  square_root_ = qr.matrixQR().topRows<kCompressedResiduals>().triangularView<Eigen::Upper>();
 }
 
 ceres::CostFunction* LidarPairPointToPlaneCost::Create(
-    std::vector<PointToPlaneObservation> observations, double sigma, bool compress) {
-  return new LidarPairPointToPlaneCost(std::move(observations), sigma, compress);
+    std::vector<PointToPlaneObservation> observations,
+    double sigma,
+    bool compress,
+    const colmap::Rigid3d& reference) {
+  return new LidarPairPointToPlaneCost(std::move(observations), sigma, compress, reference);
 }
 
 // Per residual (camera i's frame, sigma omitted): a = R_e p + t_e, u = a - t_j, b = R_i R_j^T u + t_i,
@@ -91,44 +148,52 @@ void LidarPairPointToPlaneCost::Linearize(double const* const* parameters,
   }
 }
 
-// Compressed form: with J^T J = V L V^T, the rows R = L^(1/2) V^T and residuals r' = L^(-1/2) V^T J^T r
-// (zero where L is), plus e = sqrt(|r|^2 - |r'|^2) with a zero row. Then R^T R = J^T J, R^T r' = J^T r and
-// |r'|^2 + e^2 = |r|^2: the same cost, gradient and Gauss-Newton model, in 19 rows instead of N.
 bool LidarPairPointToPlaneCost::Evaluate(double const* const* parameters,
                                          double* residuals,
                                          double** jacobians) const {
+  if (compressed_) return EvaluateCompressed(parameters, residuals, jacobians);
   Eigen::VectorXd r;
   TangentJacobian j;
   Linearize(parameters, &r, jacobians ? &j : nullptr);
-  if (!compressed_) {
-    Eigen::Map<Eigen::VectorXd>(residuals, r.size()) = r;
-    for (int block = 0; jacobians && block < 6; ++block) {
-      if (jacobians[block]) WriteAmbient(j, block, parameters[block], jacobians[block]);
-    }
-    return true;
+  Eigen::Map<Eigen::VectorXd>(residuals, r.size()) = r;
+  for (int block = 0; jacobians && block < 6; ++block) {
+    if (jacobians[block]) WriteAmbient(j, block, parameters[block], jacobians[block]);
   }
-  Eigen::Map<Eigen::VectorXd> out(residuals, kCompressedResiduals);
-  out.setZero();
-  if (!jacobians) {  // cost only
-    out[kCompressedResiduals - 1] = r.norm();
-    return true;
+  return true;
+}
+
+// Compressed form (see the header): residuals S x(theta), Jacobian S dx/dtheta, with x and its tangent
+// derivative from dual numbers (exact first order at the evaluation point).
+bool LidarPairPointToPlaneCost::EvaluateCompressed(double const* const* parameters,
+                                                   double* residuals,
+                                                   double** jacobians) const {
+  const Matrix3J rotation_i = PerturbedRotation(parameters[0], 0);
+  const Vector3J translation_i = PerturbedTranslation(parameters[1], 1);
+  const Matrix3J rotation_j = PerturbedRotation(parameters[2], 2);
+  const Vector3J translation_j = PerturbedTranslation(parameters[3], 3);
+  const Matrix3J rotation_e = PerturbedRotation(parameters[4], 4);
+  const Vector3J translation_e = PerturbedTranslation(parameters[5], 5);
+  // lidar_i_from_lidar_j = inverse(T_e) * cam_i_from_world * inverse(cam_j_from_world) * T_e.
+  const Matrix3J cam_i_from_cam_j = rotation_i * rotation_j.transpose();
+  const Matrix3J rotation = rotation_e.transpose() * cam_i_from_cam_j * rotation_e;
+  const Vector3J translation =
+      rotation_e.transpose() *
+      (cam_i_from_cam_j * (translation_e - translation_j) + translation_i - translation_e);
+  const Matrix3J change = rotation * reference_rotation_transposed_.cast<Jet>();  // R R0^T
+  const Vector3J offset =
+      rotation * source_centroid_.cast<Jet>() + translation - reference_centroid_.cast<Jet>();
+  Eigen::Matrix<double, kCompressedResiduals, 1> x;
+  TangentJacobian dx = TangentJacobian::Zero(kCompressedResiduals, kTangentSize);
+  for (int k = 0; k < 12; ++k) {
+    const Jet& entry = k < 9 ? change(k / 3, k % 3) : offset[k - 9];
+    x[k] = entry.a - (k < 9 && k % 4 == 0 ? 1.0 : 0.0);  // R R0^T - I
+    dx.row(k) = entry.v.transpose();
   }
-  Eigen::Matrix<double, kTangentSize, kTangentSize> normal =
-      Eigen::Matrix<double, kTangentSize, kTangentSize>::Zero();
-  normal.selfadjointView<Eigen::Lower>().rankUpdate(j.transpose());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kTangentSize, kTangentSize>> eigen(
-      normal.selfadjointView<Eigen::Lower>());
-  const Eigen::Matrix<double, kTangentSize, 1> gradient = j.transpose() * r;
-  TangentJacobian rows = TangentJacobian::Zero(kCompressedResiduals, kTangentSize);
-  const double tolerance = 1e-12 * std::max(eigen.eigenvalues().maxCoeff(), 1e-300);
-  for (int i = 0; i < kTangentSize; ++i) {
-    const double lambda = eigen.eigenvalues()[i];
-    if (lambda <= tolerance) continue;
-    rows.row(i) = std::sqrt(lambda) * eigen.eigenvectors().col(i).transpose();
-    out[i] = eigen.eigenvectors().col(i).dot(gradient) / std::sqrt(lambda);
-  }
-  out[kCompressedResiduals - 1] =
-      std::sqrt(std::max(0.0, r.squaredNorm() - out.head<kTangentSize>().squaredNorm()));
+  x[12] = 1;
+  Eigen::Map<Eigen::Matrix<double, kCompressedResiduals, 1>> out(residuals);
+  out = square_root_ * x;
+  if (!jacobians) return true;
+  const TangentJacobian rows = square_root_ * dx;
   for (int block = 0; block < 6; ++block) {
     if (jacobians[block]) WriteAmbient(rows, block, parameters[block], jacobians[block]);
   }

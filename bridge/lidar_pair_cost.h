@@ -16,15 +16,21 @@
 // J_ambient P = J_tangent. The manifold's tangent delta rotates by 2|delta| (q_delta = (cos|delta|,
 // sin|delta| delta/|delta|)), hence J_tangent = 2 J_rotation_vector.
 //
-// Compressed (the default for more than 19 observations): the block returns 18 + 1 residuals whose
-// Jacobian R and values r' satisfy R^T R = J^T J, R^T r' = J^T r and |r'|^2 + e^2 = |r|^2 (see the .cc):
-// Ceres sees the same cost, gradient and Gauss-Newton model, but forms its normal equations from 19 rows
-// per pair instead of thousands. Such residuals are not a smooth function of the parameters (only their
-// linearisation at the evaluation point is), so GradientChecker applies to the plain form only; the
-// tests compare the two forms' cost, J^T J and J^T r.
+// Compressed (the default for more than 13 observations): with T = (R, t) = lidar_i_from_lidar_j, a
+// reference T0 (the pair's transform when it was associated), p~_k = T0 p_k, their centroid c and
+// p'_k = p~_k - c, every residual is linear in x = [vec(R R0^T - I) (row-major), T p0 - T0 p0, 1]
+// (p0 = T0^-1 c, the source centroid):
+//   r_k = a_k^T x,  a_k = [vec(n_k p'_k^T), n_k, n_k^T (p~_k - q_k)] / sigma.
+// So sum_k r_k^2 = x^T M x with the 13x13 moment matrix M = sum_k a_k a_k^T, built once. With
+// M = S^T S (S the R factor of A's QR decomposition) the block returns the 13 residuals S x: exactly the same cost, J^T J
+// and J^T r as the N plain residuals, and a smooth function of the parameters (GradientChecker applies).
+// An evaluation costs O(1) instead of O(N). Near T0, x is [small, small, 1]: no large terms cancel, so
+// the cost keeps its precision far from the sensor.
 #pragma once
 
 #include "lidar/point_to_plane_association.h"
+
+#include "colmap/geometry/rigid3.h"
 
 #include <Eigen/Core>
 #include <ceres/cost_function.h>
@@ -35,17 +41,20 @@ namespace colmap_lidar {
 
 class LidarPairPointToPlaneCost : public ceres::CostFunction {
  public:
-  static constexpr int kCompressedResiduals = 19;
+  static constexpr int kCompressedResiduals = 13;
   using TangentJacobian = Eigen::Matrix<double, Eigen::Dynamic, 18, Eigen::RowMajor>;
 
-  // `observations`: p in lidar_j, q and unit n in lidar_i; at least one.
+  // `observations`: p in lidar_j, q and unit n in lidar_i; at least one. `reference`: the pair's
+  // lidar_i_from_lidar_j near which it is solved (any transform is exact; a near one is precise).
   LidarPairPointToPlaneCost(std::vector<PointToPlaneObservation> observations,
                             double sigma,
-                            bool compress);
+                            bool compress,
+                            const colmap::Rigid3d& reference);
 
   static ceres::CostFunction* Create(std::vector<PointToPlaneObservation> observations,
                                      double sigma,
-                                     bool compress = true);
+                                     bool compress = true,
+                                     const colmap::Rigid3d& reference = colmap::Rigid3d());
 
   // The plain residuals (one per observation) and, if asked, their Jacobian in the tangent space of the
   // six blocks (3 columns each, quaternion tangents as Ceres' manifold defines them).
@@ -60,9 +69,19 @@ class LidarPairPointToPlaneCost : public ceres::CostFunction {
                 double** jacobians) const override;
 
  private:
+  void BuildMoments(const colmap::Rigid3d& reference);
+  bool EvaluateCompressed(double const* const* parameters,
+                          double* residuals,
+                          double** jacobians) const;
+
   const std::vector<PointToPlaneObservation> observations_;
   const double inverse_sigma_;
   const bool compressed_;
+  // Compressed form: R0^T, p0, T0 p0 and S with S^T S = M (see above).
+  Eigen::Matrix3d reference_rotation_transposed_;
+  Eigen::Vector3d source_centroid_;
+  Eigen::Vector3d reference_centroid_;
+  Eigen::Matrix<double, kCompressedResiduals, kCompressedResiduals, Eigen::RowMajor> square_root_;
 };
 
 }  // namespace colmap_lidar
