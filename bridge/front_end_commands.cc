@@ -1,5 +1,6 @@
 // The front end's commands: import_dataset, stereo_depth, depth_prior_extractor.
 #include "bridge/commands.h"
+#include "bridge/lidar_registration_files.h"
 #include "colmap_ext/dataset_import.h"
 #include "colmap_ext/depth_prior_extractor.h"
 #include "colmap_ext/logging.h"
@@ -27,9 +28,17 @@ int RunImportDataset(int argc, char** argv) {
   options.AddExhaustiveMatchingOptions();
   options.AddSequentialMatchingOptions();
   DatasetImportOptions import_options;
-  options.AddDefaultOption("matcher",
-                           &import_options.matcher,
-                           "exhaustive | sequential (frames of a moving platform, by name)");
+  *options.spatial_matching = import_options.spatial_matching;
+  options.AddSpatialMatchingOptions();
+  std::string registration_path;
+  options.AddDefaultOption(
+      "matcher",
+      &import_options.matcher,
+      "exhaustive | sequential (frames of a moving platform, by name) | spatial "
+      "(stations near in --lidar_registration_path)");
+  options.AddDefaultOption("lidar_registration_path",
+                           &registration_path,
+                           "lidar_registrator's output folder, for --matcher spatial");
   options.Parse(argc, argv);
 
   const auto start = std::chrono::steady_clock::now();
@@ -39,6 +48,12 @@ int RunImportDataset(int argc, char** argv) {
   import_options.two_view_geometry = *options.two_view_geometry;
   import_options.exhaustive_matching = *options.exhaustive_matching;
   import_options.sequential_matching = *options.sequential_matching;
+  import_options.spatial_matching = *options.spatial_matching;
+  if (import_options.matcher == "spatial") {
+    THROW_CHECK(!registration_path.empty()) << "--matcher spatial needs --lidar_registration_path";
+    import_options.station_positions = StationCameraPositions(
+        registration_path, dataset.rig.cam_from_lidar_guess.value_or(colmap::Rigid3d()));
+  }
   const DatasetImportSummary summary =
       ImportDataset(dataset, *options.database_path, import_options);
   std::cout << "Imported " << dataset.root << " into " << *options.database_path << ": "

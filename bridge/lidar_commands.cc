@@ -1,4 +1,5 @@
 #include "bridge/commands.h"
+#include "bridge/lidar_registration_files.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
@@ -22,39 +23,33 @@ colmap::Rigid3d ToRigid3d(const Eigen::Isometry3d& pose) {
   return colmap::Rigid3d(Eigen::Quaterniond(pose.linear()).normalized(), pose.translation());
 }
 
-std::string PairLine(const std::string& target, const std::string& source, const LidarEdge& e) {
-  const colmap::Rigid3d pose = ToRigid3d(e.target_from_source);
-  std::ostringstream line;
-  line << target << " " << source << std::setprecision(12) << " " << pose.rotation.w() << " "
-       << pose.rotation.x() << " " << pose.rotation.y() << " " << pose.rotation.z() << " "
-       << pose.translation.x() << " " << pose.translation.y() << " " << pose.translation.z() << " "
-       << e.registration.num_inliers << " " << std::setprecision(4) << e.registration.overlap << " "
-       << e.registration.rmse << " " << e.registration.noise_rms << " "
-       << e.registration.constraints.weakest_ratio << " "
-       << e.registration.constraints.WeakestAxisName() << " "
-       << (e.registration.degenerate ? "degenerate" : "determined") << " "
-       << (e.registration.from_identity ? "identity" : "bsc");
-  return line.str();
+LidarPairRecord ToRecord(const std::vector<std::string>& names, const LidarEdge& e) {
+  LidarPairRecord record;
+  record.target = names[e.target];
+  record.source = names[e.source];
+  record.target_from_source = ToRigid3d(e.target_from_source);
+  record.num_inliers = e.registration.num_inliers;
+  record.overlap = e.registration.overlap;
+  record.rmse_m = e.registration.rmse;
+  record.noise_m = e.registration.noise_rms;
+  record.constraint_ratio = e.registration.constraints.weakest_ratio;
+  record.weakest_axis = e.registration.constraints.WeakestAxisName();
+  record.degenerate = e.registration.degenerate;
+  record.from_identity = e.registration.from_identity;
+  return record;
 }
 
 // pairs.txt (accepted edges, refused pairs as comments with the reason) and lidar_poses.txt.
 void WritePairsAndPoses(const std::string& output_path,
                         const std::vector<std::string>& names,
                         const LidarGraph& graph) {
-  std::ostringstream pairs;
-  pairs << "# colmap-lidar LiDAR pose graph edges (A_l).\n"
-           "# target source qw qx qy qz tx ty tz inliers overlap rmse_m noise_m constraint_ratio "
-           "weakest_axis determined|degenerate bsc|identity\n"
-           "# target_from_source = lidar_target_from_lidar_source, quaternion "
-           "w first, metres\n";
-  for (const LidarEdge& e : graph.edges) {
-    pairs << PairLine(names[e.target], names[e.source], e) << "\n";
-  }
+  std::vector<LidarPairRecord> accepted;
+  for (const LidarEdge& e : graph.edges) accepted.push_back(ToRecord(names, e));
+  std::vector<RefusedLidarPair> refused;
   for (const LidarEdge& e : graph.refused) {
-    pairs << "# refused " << names[e.target] << " " << names[e.source] << ": "
-          << e.registration.reason << "\n";
+    refused.push_back({names[e.target], names[e.source], e.registration.reason});
   }
-  WriteFileAtomically((fs::path(output_path) / "pairs.txt").string(), pairs.str());
+  WriteLidarPairs((fs::path(output_path) / "pairs.txt").string(), accepted, refused);
   std::map<std::string, colmap::Rigid3d> poses;
   for (size_t i = 0; i < names.size(); ++i) poses[names[i]] = ToRigid3d(graph.world_from_lidar[i]);
   WriteNamedPoses((fs::path(output_path) / "lidar_poses.txt").string(),

@@ -1,5 +1,6 @@
 #include "bridge/pose_initializer.h"
 
+#include "bridge/lidar_registration_files.h"
 #include "bridge/relative_pose_cost.h"
 #include "colmap_ext/logging.h"
 
@@ -22,33 +23,6 @@ namespace colmap_lidar {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct LidarPair {
-  std::string target, source;
-  colmap::Rigid3d target_from_source;
-  double inliers = 0;
-};
-
-std::vector<LidarPair> ReadLidarPairs(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw std::runtime_error("cannot read LiDAR pose graph " + path);
-  std::vector<LidarPair> pairs;
-  std::string line;
-  while (std::getline(file, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    LidarPair pair;
-    double qw, qx, qy, qz, tx, ty, tz;
-    if (!(fields >> pair.target >> pair.source >> qw >> qx >> qy >> qz >> tx >> ty >> tz >>
-          pair.inliers)) {
-      throw std::runtime_error(path + ": malformed line '" + line + "'");
-    }
-    pair.target_from_source = colmap::Rigid3d(Eigen::Quaterniond(qw, qx, qy, qz).normalized(),
-                                              Eigen::Vector3d(tx, ty, tz));
-    pairs.push_back(pair);
-  }
-  return pairs;
-}
 
 // cam_from_lidar: rig.json's guess if allowed and present, else hand-eye, else the guess anyway (with
 // the hand-eye failure recorded), else an error saying why.
@@ -125,7 +99,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
   // A_l.
   std::vector<std::tuple<colmap::image_t, colmap::image_t, colmap::Rigid3d, double>> lidar_edges;
   if (!registration_path.empty()) {
-    for (const LidarPair& pair :
+    for (const LidarPairRecord& pair :
          ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
       if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) {
         continue;
@@ -133,7 +107,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
       lidar_edges.emplace_back(image_of_station.at(pair.target),
                                image_of_station.at(pair.source),
                                pair.target_from_source,
-                               pair.inliers);
+                               pair.num_inliers);
     }
   }
   init.num_lidar_edges = static_cast<int>(lidar_edges.size());
@@ -267,7 +241,7 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
   PoseInitialization init;
   std::vector<HandEyeMotion> motions;
   if (!registration_path.empty()) {
-    for (const LidarPair& pair :
+    for (const LidarPairRecord& pair :
          ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
       if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) {
         continue;

@@ -6,6 +6,7 @@
 #include "colmap/controllers/feature_extraction.h"
 #include "colmap/controllers/feature_matching.h"
 #include "colmap/controllers/image_reader.h"
+#include "colmap/geometry/gps.h"
 #include "colmap/scene/database.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -100,18 +101,48 @@ std::vector<colmap::image_t> ImportedImageIds(const StationDataset& dataset,
   return image_ids;
 }
 
-// COLMAP's exhaustive or sequential matcher on the database.
+// Pose priors (COLMAP's pose_priors table, cartesian) from the stations' positions, for the spatial
+// matcher; an image that has one already keeps it.
+void WritePosePriors(const StationDataset& dataset,
+                     const std::vector<colmap::image_t>& image_ids,
+                     const DatasetImportOptions& options,
+                     const std::string& database_path) {
+  const colmap::Database database(database_path);
+  size_t written = 0, kept = 0;
+  for (size_t i = 0; i < image_ids.size(); ++i) {
+    const auto position = options.station_positions.find(dataset.stations[i]);
+    if (position == options.station_positions.end()) continue;
+    if (database.ExistsPosePrior(image_ids[i])) {
+      ++kept;
+      continue;
+    }
+    database.WritePosePrior(
+        image_ids[i],
+        colmap::PosePrior(position->second, colmap::PosePrior::CoordinateSystem::CARTESIAN));
+    ++written;
+  }
+  std::cout << "Pose priors for spatial matching: " << written << " written, " << kept << " kept, "
+            << image_ids.size() - written - kept << " stations without a position" << std::endl;
+}
+
+// COLMAP's exhaustive, sequential or spatial matcher on the database.
 void MatchFeatures(const DatasetImportOptions& options, const std::string& database_path) {
   std::cout << "COLMAP " << options.matcher << " matching" << std::endl;
-  auto matcher = options.matcher == "sequential"
-                     ? colmap::CreateSequentialFeatureMatcher(options.sequential_matching,
-                                                              options.sift_matching,
-                                                              options.two_view_geometry,
-                                                              database_path)
-                     : colmap::CreateExhaustiveFeatureMatcher(options.exhaustive_matching,
-                                                              options.sift_matching,
-                                                              options.two_view_geometry,
-                                                              database_path);
+  std::unique_ptr<colmap::Thread> matcher;
+  if (options.matcher == "sequential") {
+    matcher = colmap::CreateSequentialFeatureMatcher(options.sequential_matching,
+                                                     options.sift_matching,
+                                                     options.two_view_geometry,
+                                                     database_path);
+  } else if (options.matcher == "spatial") {
+    matcher = colmap::CreateSpatialFeatureMatcher(
+        options.spatial_matching, options.sift_matching, options.two_view_geometry, database_path);
+  } else {
+    matcher = colmap::CreateExhaustiveFeatureMatcher(options.exhaustive_matching,
+                                                     options.sift_matching,
+                                                     options.two_view_geometry,
+                                                     database_path);
+  }
   matcher->Start();
   matcher->Wait();
 }
@@ -138,10 +169,18 @@ void WriteRigAndLidarFrames(const StationDataset& dataset,
 
 }  // namespace
 
+colmap::SpatialMatchingOptions LidarSpatialMatchingOptions() {
+  colmap::SpatialMatchingOptions options;
+  options.ignore_z = false;
+  return options;
+}
+
 bool DatasetImportOptions::Check() const {
-  CHECK_OPTION(matcher == "exhaustive" || matcher == "sequential");
+  CHECK_OPTION(matcher == "exhaustive" || matcher == "sequential" || matcher == "spatial");
   CHECK_OPTION(exhaustive_matching.Check());
   CHECK_OPTION(sequential_matching.Check());
+  CHECK_OPTION(spatial_matching.Check());
+  CHECK_OPTION(matcher != "spatial" || !station_positions.empty());
   return true;
 }
 
@@ -208,6 +247,7 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
     const std::vector<colmap::image_t> image_ids =
         ImportedImageIds(dataset, names, summary.camera_id, partial);
 
+    if (options.matcher == "spatial") WritePosePriors(dataset, image_ids, options, partial);
     MatchFeatures(options, partial);
 
     WriteRigAndLidarFrames(dataset, summary.camera_id, image_ids, partial);

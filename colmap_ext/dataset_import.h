@@ -1,6 +1,7 @@
 // Imports a station dataset into a COLMAP database: the left camera from rig.json (its intrinsics are
 // kept: prior_focal_length = 1, never re-estimated from EXIF), one image per station named
-// "left/<station>.png", COLMAP's own SIFT extraction and exhaustive matching with geometric verification
+// "left/<station>.png", COLMAP's own SIFT extraction and matching (exhaustive, sequential or spatial) with
+// geometric verification
 // (libcolmap's controllers, so every --SiftExtraction.* / --SiftMatching.* / --TwoViewGeometry.* option
 // is COLMAP's), plus colmap-lidar's rig and lidar_frames rows.
 //
@@ -17,19 +18,31 @@
 #include "colmap/feature/pairing.h"
 #include "colmap/feature/sift.h"
 
+#include <Eigen/Core>
+
+#include <map>
 #include <string>
 
 namespace colmap_lidar {
+
+colmap::SpatialMatchingOptions LidarSpatialMatchingOptions();
 
 struct DatasetImportOptions {
   colmap::SiftExtractionOptions sift_extraction;
   colmap::SiftMatchingOptions sift_matching;
   colmap::TwoViewGeometryOptions two_view_geometry;
-  // "exhaustive" (every image pair) or "sequential" (each image with its successors by name, for
-  // frames of a moving platform: SequentialMatchingOptions::overlap of them).
+  // "exhaustive" (every image pair), "sequential" (each image with its successors by name, for
+  // frames of a moving platform: SequentialMatchingOptions::overlap of them) or "spatial" (each image
+  // with the images whose stations are near: COLMAP's spatial matcher on pose priors written from
+  // `station_positions`).
   std::string matcher = "exhaustive";
   colmap::ExhaustiveMatchingOptions exhaustive_matching;
   colmap::SequentialMatchingOptions sequential_matching;
+  // COLMAP's defaults except ignore_z = false (LiDAR positions, unlike GPS, have a good z).
+  colmap::SpatialMatchingOptions spatial_matching = LidarSpatialMatchingOptions();
+  // "spatial": the position of each station's camera in one world frame, by station name (e.g. from
+  // lidar_registrator's lidar_poses.txt). Stations without one get no pose prior and so no pair.
+  std::map<std::string, Eigen::Vector3d> station_positions;
 
   bool Check() const;
 };

@@ -1,6 +1,7 @@
 // The front end through the CLI on simulated stations: import_dataset (COLMAP SIFT into the database),
 // stereo_depth, depth_prior_extractor; accuracy against the simulator's ground truth; COLMAP's own
 // mapper on the imported database; bad input.
+#include "bridge/lidar_registration_files.h"
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/station_dataset.h"
 #include "tests/simulator/scene.h"
@@ -279,6 +280,64 @@ TEST(FrontEndTest, SequentialMatcherPairsOnlyNeighbouringFrames) {
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("matcher"), std::string::npos) << result.output;
   EXPECT_FALSE(fs::exists(dir.File("bad.db")));
+}
+
+// `--matcher spatial`: pose priors from a LiDAR registration folder (here written from the ground truth:
+// frames 000-005 one component, 006-007 another with a world of its own), COLMAP's spatial matcher on
+// them: every verified pair lies within the first component and is near in space; the other component
+// gets no prior and so no pair.
+TEST(FrontEndTest, SpatialMatcherPairsStationsNearInTheLidarRegistration) {
+  testing::ScopedTempDir dir;
+  sim::SimulationOptions options;
+  options.scene = "street";
+  options.motion = "drive";
+  options.output_path = dir.File("street");
+  options.num_stations = 8;
+  options.image_scale = 0.5;
+  options.lidar_points = 5000;
+  sim::SimulateDataset(options);
+  const auto cam_from_world = ReadNamedPoses(dir.File("street/ground_truth/cam_from_world.txt"));
+  const colmap::Rigid3d cam_from_lidar =
+      ReadPoseFile(dir.File("street/ground_truth/cam_from_lidar.txt"));
+  std::map<std::string, colmap::Rigid3d> world_from_lidar;
+  std::vector<LidarPairRecord> pairs;
+  for (const auto& [station, pose] : cam_from_world) {
+    world_from_lidar[station] = colmap::Inverse(pose) * cam_from_lidar;
+  }
+  for (int i = 0; i + 1 < 8; ++i) {
+    if (i == 5) continue;  // two components: 000-005 and 006-007
+    LidarPairRecord pair;
+    pair.target = "00" + std::to_string(i);
+    pair.source = "00" + std::to_string(i + 1);
+    pairs.push_back(pair);
+  }
+  fs::create_directories(dir.File("lidar"));
+  WriteLidarPairs(dir.File("lidar/pairs.txt"), pairs, {});
+  WriteNamedPoses(dir.File("lidar/lidar_poses.txt"), "ground truth", world_from_lidar);
+  const auto result = RunCommand(kCli + " import_dataset --dataset_path " + dir.File("street") +
+                                 " --database_path " + dir.File("spatial.db") + kSift +
+                                 " --matcher spatial --lidar_registration_path " +
+                                 dir.File("lidar") + " --SpatialMatching.max_num_neighbors 3");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const colmap::Database database(dir.File("spatial.db"));
+  EXPECT_EQ(database.NumPosePriors(), 6u);
+  std::vector<std::pair<colmap::image_t, colmap::image_t>> image_pairs;
+  std::vector<int> num_inliers;
+  database.ReadTwoViewGeometryNumInliers(&image_pairs, &num_inliers);
+  size_t num_verified = 0;
+  for (size_t k = 0; k < image_pairs.size(); ++k) {
+    const auto frame = [&database](colmap::image_t id) {
+      return std::stoi(fs::path(database.ReadImage(id).Name()).stem().string());
+    };
+    const int a = frame(image_pairs[k].first), b = frame(image_pairs[k].second);
+    EXPECT_LE(std::max(a, b), 5) << a << "-" << b;
+    EXPECT_LE(std::abs(a - b), 2) << a << "-" << b;
+    num_verified += num_inliers[k] > 0;
+  }
+  std::cout << num_verified << " of " << image_pairs.size() << " pairs verified" << std::endl;
+  // Measured: 7 of 7 (each of the 6 frames with its 2 nearest); exhaustive matching would try 28.
+  EXPECT_GE(num_verified, 6u);
+  EXPECT_LE(image_pairs.size(), 9u);
 }
 
 // Bad stereo pairs: one clear error naming the station; the database is left exactly as it was.
