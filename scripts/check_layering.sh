@@ -2,7 +2,9 @@
 # Fails when a layer includes (or links) what it must not:
 #   lidar/       no COLMAP, no colmap_ext/bridge/tests; its public headers (.h) include only Eigen and std
 #   colmap_ext/  no lidar/, bridge/ or tests/
-#   bridge/      no tests/ (only the CLI main, bridge/colmap_lidar_main.cc, links the simulator)
+#   bridge/      no tests/ (only the CLI main, bridge/exe/colmap_lidar_main.cc, links the simulator)
+#   bridge/exe/  the commands: nothing outside it includes bridge/exe/ (algorithms never include a
+#                command), and the bridge library's sources list none of its files
 # Prints every violation as file:line and exits 1 if there is any.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -20,9 +22,16 @@ check_includes() {  # folder, regex of forbidden includes, what
 check_includes lidar 'colmap/|colmap_ext/|bridge/|tests/' "COLMAP, colmap_ext, bridge or tests"
 check_includes colmap_ext 'lidar/|bridge/|tests/' "lidar, bridge or tests"
 hits=$(grep -rnE '^\s*#\s*include\s*"tests/' --include='*.h' --include='*.cc' bridge |
-       grep -v '^bridge/colmap_lidar_main.cc:' |
+       grep -v '^bridge/exe/colmap_lidar_main.cc:' |
        grep -vE '_test\.cc:[0-9]+:\s*#\s*include\s*"tests/testing/' || true)
 [ -z "$hits" ] || violation "the bridge library must not include tests/:"$'\n'"$hits"
+
+# Commands apart from algorithms: only bridge/exe/ includes bridge/exe/.
+hits=$(grep -rnE '^\s*#\s*include\s*"bridge/exe/' --include='*.h' --include='*.cc' \
+         lidar colmap_ext bridge tests | grep -v '^bridge/exe/' || true)
+[ -z "$hits" ] || violation "only the commands (bridge/exe/) may include bridge/exe/:"$'\n'"$hits"
+sed -n '/add_library(colmap_lidar_bridge/,/^)/p' bridge/CMakeLists.txt | grep -qE '_commands?\.cc|main\.cc' &&
+  violation "the bridge library compiles a command (they belong in bridge/exe/)"
 
 # lidar's public headers speak Eigen: no PCL, FLANN, nanoflann, OpenCV or Ceres in lidar/*.h.
 hits=$(grep -nE '^\s*#\s*include\s*<(pcl/|flann/|nanoflann|opencv2/|ceres/)' lidar/*.h || true)
@@ -37,5 +46,5 @@ sed -n '/add_library(colmap_lidar_bridge/,/^)/p;/target_link_libraries(colmap_li
   bridge/CMakeLists.txt | grep -q 'simulator' &&
   violation "the bridge library links the simulator"
 
-[ $status -eq 0 ] && echo "layering: ok (lidar | colmap_ext -> bridge -> CLI)"
+[ $status -eq 0 ] && echo "layering: ok (lidar | colmap_ext -> bridge -> bridge/exe (CLI))"
 exit $status

@@ -1,6 +1,6 @@
 // The colmap-lidar command-line dispatcher: `colmap-lidar COMMAND [--options]`, as COLMAP's `colmap`.
 // This executable (not the bridge library) is the only place that links the simulator.
-#include "bridge/commands.h"
+#include "bridge/exe/commands.h"
 #include "tests/simulator/simulator_commands.h"
 
 #include "colmap/util/logging.h"

@@ -1,4 +1,4 @@
-#include "bridge/commands.h"
+#include "bridge/exe/commands.h"
 #include "bridge/densifier.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"

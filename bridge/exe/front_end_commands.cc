@@ -1,5 +1,5 @@
 // The front end's commands: import_dataset, stereo_depth, depth_prior_extractor.
-#include "bridge/commands.h"
+#include "bridge/exe/commands.h"
 #include "bridge/lidar_registration_files.h"
 #include "colmap_ext/dataset_import.h"
 #include "colmap_ext/depth_prior_extractor.h"

@@ -1,4 +1,4 @@
-#include "bridge/commands.h"
+#include "bridge/exe/commands.h"
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/logging.h"
 

@@ -1,4 +1,4 @@
-#include "bridge/commands.h"
+#include "bridge/exe/commands.h"
 #include "bridge/lidar_registration_files.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"

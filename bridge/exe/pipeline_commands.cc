@@ -1,5 +1,5 @@
 // pose_initializer and pipeline: from raw stations to a metric sparse model with cam_from_lidar.
-#include "bridge/commands.h"
+#include "bridge/exe/commands.h"
 #include "bridge/pose_initializer.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"

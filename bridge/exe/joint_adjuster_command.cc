@@ -1,5 +1,5 @@
 // colmap-lidar joint_adjuster: the joint problem on a COLMAP sparse model (bridge/joint_adjuster.h).
-#include "bridge/commands.h"
+#include "bridge/exe/commands.h"
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
 #include "colmap_ext/logging.h"

@@ -1,5 +1,5 @@
 #include "bridge/calibration_evaluation.h"
-#include "bridge/commands.h"
+#include "bridge/exe/commands.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
