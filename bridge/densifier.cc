@@ -404,11 +404,10 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
                 << reconstruction.Camera(camera_id).height << std::endl;
     }
   }
-  const fs::path partial = output_path + ".partial";
-  fs::remove_all(partial);
+  PartialOutputFolder partial(output_path);
   DensifierSummary summary;
-  try {
-    const DenseWorkspace workspace(partial.string());
+  {
+    const DenseWorkspace workspace(partial.Path());
     VoxelAccumulator lidar_map(options.lidar_map_voxel_size_m);
     std::cout << "densifier: " << views.size() << " stations, "
               << (options.refine_with_lidar ? "LiDAR-refined" : "stereo only") << std::endl;
@@ -448,11 +447,11 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
     std::cout << "densifier: fused " << fused.NumPointsAdded() << " points into "
               << fused_cloud.Size() << " voxels of " << options.fused_voxel_size_m * 1000 << " mm"
               << std::endl;
-    WritePointCloud((partial / "fused.ply").string(), fused_cloud);
+    WritePointCloud(partial.File("fused.ply"), fused_cloud);
     PointCloud lidar_cloud = lidar_map.Extract();
     lidar_cloud.normals.clear();
     summary.lidar_map_points = lidar_cloud.Size();
-    WritePointCloud((partial / "lidar_map.ply").string(), lidar_cloud);
+    WritePointCloud(partial.File("lidar_map.ply"), lidar_cloud);
 
     workspace.WriteSparse(reconstruction);
     std::vector<std::string> names;
@@ -478,13 +477,9 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
     for (const StationDensification& station : summary.stations) {
       report["stations"].push_back(StationReport(station));
     }
-    WriteFileAtomically((partial / "densifier.json").string(), report.dump(2) + "\n");
-  } catch (...) {
-    fs::remove_all(partial);
-    throw;
+    WriteFileAtomically(partial.File("densifier.json"), report.dump(2) + "\n");
   }
-  fs::remove_all(output_path);
-  fs::rename(partial, output_path);
+  partial.Commit();
   return summary;
 }
 

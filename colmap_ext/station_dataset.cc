@@ -131,21 +131,6 @@ colmap::Rigid3d ParsePose(std::istream& tokens, const std::string& path, size_t 
 
 }  // namespace
 
-void WriteFileAtomically(const std::string& path, const std::string& contents) {
-  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
-  {
-    std::ofstream file(tmp, std::ios::binary);
-    if (!file) throw std::runtime_error("Cannot write " + path);
-    file << contents;
-    file.flush();
-    if (!file) {
-      fs::remove(tmp);
-      throw std::runtime_error("Cannot write " + path + " (disk full?)");
-    }
-  }
-  fs::rename(tmp, path);
-}
-
 StationRig ReadRigJson(const std::string& path) {
   std::ifstream file(path);
   if (!file) Fail(path, "cannot open rig.json");

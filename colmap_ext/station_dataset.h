@@ -10,6 +10,8 @@
 // quaternions (xyzw storage) inside colmap::Rigid3d.
 #pragma once
 
+#include "colmap_ext/atomic_file.h"  // WriteFileAtomically, used with the pose files
+
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/camera.h"
 
@@ -65,8 +67,5 @@ colmap::Rigid3d ReadPoseFile(const std::string& path);
 void WritePoseFile(const std::string& path,
                    const std::string& header_comment,
                    const colmap::Rigid3d& target_from_source);
-
-// Writes `contents` to `path` through a temporary file and a rename: never half-written.
-void WriteFileAtomically(const std::string& path, const std::string& contents);
 
 }  // namespace colmap_lidar

@@ -1,5 +1,6 @@
 #include "colmap_ext/stereo_depth.h"
 
+#include "colmap_ext/atomic_file.h"
 #include "colmap_ext/logging.h"
 
 #include "colmap/mvs/depth_map.h"
@@ -138,13 +139,6 @@ cv::Mat Confidence(const StereoRectifier& rectifier,
   return confidence;
 }
 
-void WriteAtomically(const std::string& path,
-                     const std::function<void(const std::string&)>& write) {
-  const std::string temporary = path + ".tmp";
-  write(temporary);
-  fs::rename(temporary, path);
-}
-
 cv::Mat ReadImageOrThrow(const std::string& path) {
   cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (image.empty()) {
@@ -263,17 +257,13 @@ void WriteStationStereoDepth(const std::string& output_path,
       depth_map.Set(row, col, depth.depth.at<float>(row, col));
     }
   }
-  WriteAtomically(StereoDepthMapPath(output_path, station),
-                  [&](const std::string& path) { depth_map.Write(path); });
+  WriteAtomically(StereoDepthMapPath(output_path, station), [&](const std::string& path) {
+    depth_map.Write(path);
+    return fs::exists(path) && fs::file_size(path) > 0;
+  });
 
   const auto write_png = [](const cv::Mat& image) {
-    return [&image](const std::string& path) {
-      std::vector<uchar> bytes;
-      THROW_CHECK(cv::imencode(".png", image, bytes)) << path;
-      std::ofstream(path, std::ios::binary)
-          .write(reinterpret_cast<const char*>(bytes.data()),
-                 static_cast<std::streamsize>(bytes.size()));
-    };
+    return [&image](const std::string& path) { return cv::imwrite(path, image); };
   };
   WriteAtomically((root / "confidence_maps" / (station + ".png")).string(),
                   write_png(depth.confidence));

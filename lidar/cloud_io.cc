@@ -1,5 +1,7 @@
 #include "lidar/cloud_io.h"
 
+#include "lidar/atomic_file.h"
+
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
 #include <unistd.h>
@@ -489,25 +491,17 @@ void WritePointCloud(const std::string& path, const PointCloud& cloud) {
     throw std::invalid_argument("Cannot write point cloud " + path +
                                 ": extension must be .pcd or .ply");
   }
-  const std::string tmp_path = path + ".tmp" + std::to_string(static_cast<long>(::getpid()));
-  {
-    std::ofstream out(tmp_path, std::ios::binary);
-    if (!out) {
-      throw std::runtime_error("Cannot write point cloud " + path + ": cannot create " + tmp_path);
-    }
+  WriteLidarFileAtomically(path, [&](const std::string& temporary) {
+    std::ofstream out(temporary, std::ios::binary);
+    if (!out) return false;
     if (ext == ".pcd") {
       WritePcdBinary(out, cloud);
     } else {
       WritePlyBinary(out, cloud);
     }
     out.flush();
-    if (!out) {
-      out.close();
-      fs::remove(tmp_path);
-      throw std::runtime_error("Cannot write point cloud " + path + ": write failed (disk full?)");
-    }
-  }
-  fs::rename(tmp_path, path);
+    return static_cast<bool>(out);
+  });
 }
 
 }  // namespace colmap_lidar

@@ -1,5 +1,7 @@
 #include "lidar/plot.h"
 
+#include "lidar/atomic_file.h"
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <unistd.h>
@@ -26,9 +28,8 @@ void PutText(cv::Mat* canvas, const std::string& text, const cv::Point& origin, 
 }
 
 void WritePngAtomically(const std::string& path, const cv::Mat& canvas) {
-  const std::string tmp = path + ".tmp" + std::to_string(::getpid()) + ".png";
-  if (!cv::imwrite(tmp, canvas)) throw std::runtime_error("Cannot write plot " + path);
-  std::filesystem::rename(tmp, path);
+  WriteLidarFileAtomically(
+      path, [&canvas](const std::string& temporary) { return cv::imwrite(temporary, canvas); });
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-#include "bridge/exe/commands.h"
 #include "bridge/densifier.h"
+#include "bridge/exe/commands.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 

@@ -315,21 +315,16 @@ int RunJointAdjuster(int argc, char** argv) {
   const JointAdjustmentSummary summary =
       JointAdjuster(adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);
 
-  // Everything into OUTPUT.partial, renamed at the end: never a half-written output folder.
-  const fs::path output(output_path);
-  const fs::path partial = output.string() + ".partial";
-  fs::remove_all(partial);
-  fs::create_directories(partial);
-  reconstruction.WriteBinary(partial.string());
-  if (write_text) reconstruction.WriteText(partial.string());
+  PartialOutputFolder partial(output_path);
+  reconstruction.WriteBinary(partial.Path());
+  if (write_text) reconstruction.WriteText(partial.Path());
   WritePoseFile(
-      (partial / "cam_from_lidar.txt").string(),
+      partial.File("cam_from_lidar.txt"),
       "cam_from_lidar refined by colmap-lidar joint_adjuster (" + mode + "); qw qx qy qz tx ty tz",
       cam_from_lidar);
-  WriteReport(partial.string(), adjuster, *loaded, initial, cam_from_lidar, summary);
-  WritePlots(partial.string(), summary);
-  fs::remove_all(output);
-  fs::rename(partial, output);
+  WriteReport(partial.Path(), adjuster, *loaded, initial, cam_from_lidar, summary);
+  WritePlots(partial.Path(), summary);
+  partial.Commit();
   PrintUncertainty(summary);
   std::cout << "Wrote " << output_path << " ("
             << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()

@@ -54,8 +54,7 @@ int RunPoseInitializer(int argc, char** argv) {
   options.Parse(argc, argv);
   const auto start = std::chrono::steady_clock::now();
   const StationDataset dataset = ReadStationDataset(dataset_path);
-  const fs::path partial = output_path + ".partial";
-  fs::remove_all(partial);
+  PartialOutputFolder partial(output_path);
   PoseInitialization init;
   double scale = 1;
   if (input_path.empty()) {
@@ -63,10 +62,8 @@ int RunPoseInitializer(int argc, char** argv) {
     std::cout << "Pose graph: " << init.num_image_edges << " image edges (A_c), "
               << init.num_lidar_edges << " LiDAR edges (A_l); " << init.cam_from_world.size()
               << " stations reachable" << std::endl;
-    TriangulateInitialModel(*options.database_path,
-                            (fs::path(dataset.root) / "images").string(),
-                            init,
-                            partial.string());
+    TriangulateInitialModel(
+        *options.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
   } else {
     THROW_CHECK(fs::is_directory(input_path)) << "no sparse model folder " << input_path;
     colmap::Reconstruction model;
@@ -76,8 +73,7 @@ int RunPoseInitializer(int argc, char** argv) {
     std::cout << "Rescaled " << input_path << " to metres by " << scale
               << " (median of depth prior / model depth); " << model.NumRegImages()
               << " registered images" << std::endl;
-    fs::create_directories(partial);
-    model.WriteBinary(partial.string());
+    model.WriteBinary(partial.Path());
   }
   std::cout << "cam_from_lidar: " << init.extrinsic_source
             << "; hand-eye: " << init.hand_eye.message << std::endl;
@@ -85,7 +81,7 @@ int RunPoseInitializer(int argc, char** argv) {
     std::cout << "WARNING: station image " << name
               << " is not in the model (no image or LiDAR edge reaches it)" << std::endl;
   }
-  WritePoseFile((partial / "cam_from_lidar.txt").string(),
+  WritePoseFile(partial.File("cam_from_lidar.txt"),
                 "initial cam_from_lidar (" + init.extrinsic_source + "); qw qx qy qz tx ty tz",
                 init.cam_from_lidar);
   nlohmann::json report;
@@ -100,9 +96,8 @@ int RunPoseInitializer(int argc, char** argv) {
   report["unreachable"] = init.unreachable;
   report["input_model"] = input_path;
   report["scale_to_metres"] = scale;
-  WriteFileAtomically((partial / "initialization.json").string(), report.dump(2) + "\n");
-  fs::remove_all(output_path);
-  fs::rename(partial, output_path);
+  WriteFileAtomically(partial.File("initialization.json"), report.dump(2) + "\n");
+  partial.Commit();
   std::cout << "Wrote the initial model to " << output_path << " (" << std::fixed
             << std::setprecision(1)
             << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
