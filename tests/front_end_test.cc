@@ -241,11 +241,8 @@ TEST(FrontEndTest, ImportedDatabaseIsIdempotentAndUsableByColmapMapper) {
   EXPECT_EQ(reconstruction.NumRegImages(), 4u);
 }
 
-// Frames of a moving platform: `--matcher sequential` matches each frame with its successors only
-// (every verified pair is consecutive by name), far fewer pairs than exhaustive matching; an unknown
-// matcher is refused before anything is written.
-TEST(FrontEndTest, SequentialMatcherPairsOnlyNeighbouringFrames) {
-  testing::ScopedTempDir dir;
+// 8 frames of the simulated street drive in dir/street (half-size images, sparse sweeps).
+void SimulateStreet(const testing::ScopedTempDir& dir) {
   sim::SimulationOptions options;
   options.scene = "street";
   options.motion = "drive";
@@ -254,6 +251,14 @@ TEST(FrontEndTest, SequentialMatcherPairsOnlyNeighbouringFrames) {
   options.image_scale = 0.5;
   options.lidar_points = 5000;
   sim::SimulateDataset(options);
+}
+
+// Frames of a moving platform: `--matcher sequential` matches each frame with its successors only
+// (every verified pair is consecutive by name), far fewer pairs than exhaustive matching; an unknown
+// matcher is refused before anything is written.
+TEST(FrontEndTest, SequentialMatcherPairsOnlyNeighbouringFrames) {
+  testing::ScopedTempDir dir;
+  SimulateStreet(dir);
   auto result = RunCommand(kCli + " import_dataset --dataset_path " + dir.File("street") +
                            " --database_path " + dir.File("seq.db") + kSift +
                            " --matcher sequential --SequentialMatching.overlap 3"
@@ -288,14 +293,7 @@ TEST(FrontEndTest, SequentialMatcherPairsOnlyNeighbouringFrames) {
 // gets no prior and so no pair.
 TEST(FrontEndTest, SpatialMatcherPairsStationsNearInTheLidarRegistration) {
   testing::ScopedTempDir dir;
-  sim::SimulationOptions options;
-  options.scene = "street";
-  options.motion = "drive";
-  options.output_path = dir.File("street");
-  options.num_stations = 8;
-  options.image_scale = 0.5;
-  options.lidar_points = 5000;
-  sim::SimulateDataset(options);
+  SimulateStreet(dir);
   const auto cam_from_world = ReadNamedPoses(dir.File("street/ground_truth/cam_from_world.txt"));
   const colmap::Rigid3d cam_from_lidar =
       ReadPoseFile(dir.File("street/ground_truth/cam_from_lidar.txt"));
