@@ -183,7 +183,9 @@ bool LidarPairPointToPlaneCost::EvaluateCompressed(double const* const* paramete
   const Vector3J offset =
       rotation * source_centroid_.cast<Jet>() + translation - reference_centroid_.cast<Jet>();
   Eigen::Matrix<double, kCompressedResiduals, 1> x;
-  TangentJacobian dx = TangentJacobian::Zero(kCompressedResiduals, kTangentSize);
+  // Fixed size: no allocation on the solver's hot path.
+  using MomentJacobian = Eigen::Matrix<double, kCompressedResiduals, kTangentSize, Eigen::RowMajor>;
+  MomentJacobian dx = MomentJacobian::Zero();
   for (int k = 0; k < 12; ++k) {
     const Jet& entry = k < 9 ? change(k / 3, k % 3) : offset[k - 9];
     x[k] = entry.a - (k < 9 && k % 4 == 0 ? 1.0 : 0.0);  // R R0^T - I
@@ -193,7 +195,7 @@ bool LidarPairPointToPlaneCost::EvaluateCompressed(double const* const* paramete
   Eigen::Map<Eigen::Matrix<double, kCompressedResiduals, 1>> out(residuals);
   out = square_root_ * x;
   if (!jacobians) return true;
-  const TangentJacobian rows = square_root_ * dx;
+  const MomentJacobian rows = square_root_ * dx;
   for (int block = 0; block < 6; ++block) {
     if (jacobians[block]) WriteAmbient(rows, block, parameters[block], jacobians[block]);
   }

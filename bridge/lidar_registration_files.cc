@@ -3,6 +3,7 @@
 #include "colmap_ext/station_dataset.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>

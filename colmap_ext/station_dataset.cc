@@ -3,7 +3,6 @@
 #include "colmap/sensor/models.h"
 
 #include <nlohmann/json.hpp>
-#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>

@@ -4,7 +4,6 @@
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
