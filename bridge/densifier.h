@@ -44,7 +44,7 @@ struct DensifierOptions {
   double fused_voxel_size_m = 0.001;     // merge of fused.ply
   double lidar_map_voxel_size_m = 0.01;  // lidar_map.ply
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 struct StationDensification {

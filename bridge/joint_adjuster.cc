@@ -5,6 +5,7 @@
 #include "bridge/lidar_point_to_plane_cost.h"
 #include "colmap_ext/depth_prior_cost.h"
 #include "colmap_ext/logging.h"
+#include "colmap_ext/rigid3_isometry.h"
 
 #include "colmap/estimators/bundle_adjustment.h"
 #include "colmap/estimators/cost_functions.h"
@@ -58,13 +59,6 @@ double MeanIterationSeconds(const ceres::Solver::Summary& summary) {
 }
 
 namespace {
-
-Eigen::Isometry3d ToIsometry(const colmap::Rigid3d& transform) {
-  Eigen::Isometry3d isometry = Eigen::Isometry3d::Identity();
-  isometry.linear() = transform.rotation.toRotationMatrix();
-  isometry.translation() = transform.translation;
-  return isometry;
-}
 
 // lidar_i_from_lidar_j = inverse(T_e) cam_i_from_world inverse(cam_j_from_world) T_e.
 colmap::Rigid3d LidarIFromLidarJ(const colmap::Rigid3d& cam_i_from_world,

@@ -1,8 +1,9 @@
 #include "bridge/pose_initializer.h"
 
 #include "bridge/lidar_registration_files.h"
-#include "bridge/relative_pose_cost.h"
 #include "colmap_ext/logging.h"
+#include "colmap_ext/rigid3_isometry.h"
+#include "lidar/pose_graph.h"
 
 #include "colmap/controllers/incremental_mapper.h"
 #include "colmap/estimators/cost_functions.h"
@@ -15,7 +16,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <queue>
 #include <set>
 #include <sstream>
 
@@ -43,6 +43,41 @@ void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
   } else {
     throw std::runtime_error("cannot initialise cam_from_lidar: " + init->hand_eye.message +
                              "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
+  }
+}
+
+// The camera pose graph A_c v A_l (lidar/pose_graph.h): nodes are the stations in name order, the
+// first one is the world frame; stations outside its component are unreachable.
+void SolveCameraPoseGraph(const std::map<std::string, colmap::image_t>& image_of_station,
+                          const std::map<colmap::image_t, std::string>& names,
+                          const PoseInitializerOptions& options,
+                          PoseInitialization* init) {
+  std::map<colmap::image_t, size_t> node;
+  std::vector<colmap::image_t> image_of_node;
+  for (const auto& [station, image_id] : image_of_station) {
+    node[image_id] = image_of_node.size();
+    image_of_node.push_back(image_id);
+  }
+  const Eigen::Matrix<double, 6, 6> sqrt_information =
+      DiagonalSqrtInformation(options.sigma_rotation_deg * M_PI / 180, options.sigma_translation_m);
+  std::vector<RelativePoseEdge> edges;
+  for (const PoseGraphEdge& edge : init->edges) {
+    edges.push_back({node.at(edge.image_i),
+                     node.at(edge.image_j),
+                     ToIsometry(edge.cam_i_from_cam_j),
+                     edge.weight,
+                     sqrt_information});
+  }
+  PoseGraphOptions pose_graph;
+  pose_graph.loss = "cauchy";
+  pose_graph.loss_scale = 3.0;
+  const PoseGraphSolution solution = SolvePoseGraph(image_of_node.size(), edges, pose_graph);
+  for (size_t k = 0; k < image_of_node.size(); ++k) {
+    if (solution.component[k] != solution.component[0]) {
+      init->unreachable.push_back(names.at(image_of_node[k]));
+      continue;
+    }
+    init->cam_from_world[image_of_node[k]] = ToRigid3d(solution.world_from_node[k].inverse());
   }
 }
 
@@ -131,71 +166,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
          true});
   }
 
-  // Maximum-weight spanning tree from the first station (Prim).
-  const colmap::image_t root = image_of_station.begin()->second;
-  std::map<colmap::image_t, std::vector<size_t>> incident;
-  for (size_t e = 0; e < init.edges.size(); ++e) {
-    incident[init.edges[e].image_i].push_back(e);
-    incident[init.edges[e].image_j].push_back(e);
-  }
-  init.cam_from_world[root] = colmap::Rigid3d();
-  std::priority_queue<std::pair<double, size_t>> queue;
-  for (const size_t e : incident[root]) queue.push({init.edges[e].weight, e});
-  while (!queue.empty()) {
-    const size_t e = queue.top().second;
-    queue.pop();
-    const PoseGraphEdge& edge = init.edges[e];
-    const bool has_i = init.cam_from_world.count(edge.image_i) > 0;
-    const bool has_j = init.cam_from_world.count(edge.image_j) > 0;
-    if (has_i == has_j) continue;
-    colmap::image_t added;
-    if (has_i) {  // cam_j_from_world = inverse(cam_i_from_cam_j) * cam_i_from_world
-      added = edge.image_j;
-      init.cam_from_world[added] =
-          colmap::Inverse(edge.cam_i_from_cam_j) * init.cam_from_world.at(edge.image_i);
-    } else {
-      added = edge.image_i;
-      init.cam_from_world[added] = edge.cam_i_from_cam_j * init.cam_from_world.at(edge.image_j);
-    }
-    for (const size_t next : incident[added]) queue.push({init.edges[next].weight, next});
-  }
-  for (const auto& [station, image_id] : image_of_station) {
-    if (!init.cam_from_world.count(image_id)) init.unreachable.push_back(names.at(image_id));
-  }
-
-  // Pose graph over every edge between reachable stations.
-  ceres::Problem problem;
-  const double sigma_rotation = options.sigma_rotation_deg * M_PI / 180;
-  for (const PoseGraphEdge& edge : init.edges) {
-    if (!init.cam_from_world.count(edge.image_i) || !init.cam_from_world.count(edge.image_j)) {
-      continue;
-    }
-    colmap::Rigid3d& pose_i = init.cam_from_world.at(edge.image_i);
-    colmap::Rigid3d& pose_j = init.cam_from_world.at(edge.image_j);
-    problem.AddResidualBlock(
-        RelativePoseCostFunctor::Create(
-            edge.cam_i_from_cam_j, sigma_rotation, options.sigma_translation_m),
-        new ceres::CauchyLoss(3.0),
-        pose_i.rotation.coeffs().data(),
-        pose_i.translation.data(),
-        pose_j.rotation.coeffs().data(),
-        pose_j.translation.data());
-  }
-  for (auto& [image_id, pose] : init.cam_from_world) {
-    if (!problem.HasParameterBlock(pose.rotation.coeffs().data())) continue;
-    colmap::SetQuaternionManifold(&problem, pose.rotation.coeffs().data());
-    if (image_id == root) {
-      problem.SetParameterBlockConstant(pose.rotation.coeffs().data());
-      problem.SetParameterBlockConstant(pose.translation.data());
-    }
-  }
-  if (problem.NumResidualBlocks() > 0) {
-    ceres::Solver::Options solver_options;
-    solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    solver_options.max_num_iterations = 100;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options, &problem, &summary);
-  }
+  SolveCameraPoseGraph(image_of_station, names, options, &init);
   return init;
 }
 

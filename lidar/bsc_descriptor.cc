@@ -1,5 +1,7 @@
 #include "lidar/bsc_descriptor.h"
 
+#include "lidar/check_option.h"
+
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
@@ -100,9 +102,10 @@ BscDescriptor Describe(const std::vector<Eigen::Vector3d>& local,  // neighbours
 }  // namespace
 
 bool BscOptions::Check() const {
-  if (!(support_radius > 0) || grid_size < 2 || !(occupancy_ratio >= 0) || min_neighbors < 3) {
-    throw std::invalid_argument("BscOptions: invalid radius, grid size, ratio or neighbour count");
-  }
+  LIDAR_CHECK_OPTION_GT(support_radius, 0);
+  LIDAR_CHECK_OPTION_GE(grid_size, 2);
+  LIDAR_CHECK_OPTION_GE(occupancy_ratio, 0);
+  LIDAR_CHECK_OPTION_GE(min_neighbors, 3);
   return true;
 }
 
@@ -111,7 +114,7 @@ std::vector<BscFeature> ComputeBscFeatures(const PointCloud& cloud,
                                            const std::vector<size_t>& keypoints,
                                            const Eigen::Vector3d& viewpoint,
                                            const BscOptions& options) {
-  options.Check();
+  ThrowUnlessValid(options, "BscOptions");
   const double R = options.support_radius;
   const std::vector<CellPair> pairs =
       MakeCellPairs(options.grid_size * options.grid_size, options.pair_seed);

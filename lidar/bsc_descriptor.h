@@ -36,7 +36,7 @@ struct BscOptions {
 
   int NumBits() const { return 9 * grid_size * grid_size; }
   int NumWords() const { return (NumBits() + 63) / 64; }
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 using BscDescriptor = std::vector<uint64_t>;

@@ -1,5 +1,7 @@
 #include "lidar/cycle_consistency.h"
 
+#include "lidar/check_option.h"
+
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -51,15 +53,14 @@ std::vector<Cycle> FindCycles(const std::vector<RelativePose>& edges,
 }  // namespace
 
 bool CycleConsistencyOptions::Check() const {
-  if (!(max_translation_m > 0) || !(max_rotation_deg > 0)) {
-    throw std::invalid_argument("CycleConsistencyOptions: tolerances must be > 0");
-  }
+  LIDAR_CHECK_OPTION_GT(max_translation_m, 0);
+  LIDAR_CHECK_OPTION_GT(max_rotation_deg, 0);
   return true;
 }
 
 CycleCheck CheckThreeCycles(const std::vector<RelativePose>& edges,
                             const CycleConsistencyOptions& options) {
-  options.Check();
+  ThrowUnlessValid(options, "CycleConsistencyOptions");
   const std::vector<Cycle> cycles = FindCycles(edges, options);
   CycleCheck check;
   check.num_cycles = cycles.size();

@@ -17,7 +17,7 @@ struct CycleConsistencyOptions {
   double max_translation_m = 0.15;
   double max_rotation_deg = 1.0;
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 struct RelativePose {

@@ -1,5 +1,7 @@
 #include "lidar/keypoints.h"
 
+#include "lidar/check_option.h"
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -9,17 +11,19 @@
 namespace colmap_lidar {
 
 bool KeypointOptions::Check() const {
-  if (!(radius > 0) || !(nms_radius >= 0) || min_neighbors < 3 || !(max_ratio_21 > 0) ||
-      !(max_ratio_32 > 0) || max_keypoints == 0) {
-    throw std::invalid_argument("KeypointOptions: invalid radius, ratio or count");
-  }
+  LIDAR_CHECK_OPTION_GT(radius, 0);
+  LIDAR_CHECK_OPTION_GE(nms_radius, 0);
+  LIDAR_CHECK_OPTION_GE(min_neighbors, 3);
+  LIDAR_CHECK_OPTION_GT(max_ratio_21, 0);
+  LIDAR_CHECK_OPTION_GT(max_ratio_32, 0);
+  LIDAR_CHECK_OPTION_GT(max_keypoints, 0);
   return true;
 }
 
 std::vector<size_t> DetectKeypoints(const PointCloud& cloud,
                                     const KdTree3& tree,
                                     const KeypointOptions& options) {
-  options.Check();
+  ThrowUnlessValid(options, "KeypointOptions");
   std::vector<double> curvature(cloud.Size(), -1);  // -1: not a candidate
 #pragma omp parallel
   {

@@ -18,7 +18,7 @@ struct KeypointOptions {
   double nms_radius = 0.5;      // greedy non-maximum suppression by curvature within this radius
   size_t max_keypoints = 3000;  // strongest after NMS
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 // Indices into cloud.points (tree built over them), strongest curvature first.

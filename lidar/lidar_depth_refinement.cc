@@ -1,5 +1,7 @@
 #include "lidar/lidar_depth_refinement.h"
 
+#include "lidar/check_option.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -112,28 +114,17 @@ int AutomaticWindowRadius(const LidarSurface& surface,
 }  // namespace
 
 bool LidarDepthRefinementOptions::Check() const {
-  auto fail = [](const char* what) {
-    throw std::invalid_argument(std::string("LidarDepthRefinementOptions: ") + what);
-  };
-  if (window_radius_px < 0) fail("window_radius_px must be >= 0 (0: automatic)");
-  if (!(max_abs_diff_m >= 0) || !(max_rel_diff >= 0) || !(max_check_curvature >= 0) ||
-      !(max_unreplaceable_diff_m >= max_abs_diff_m)) {
-    fail(
-        "need max_abs_diff_m, max_rel_diff, max_check_curvature >= 0 and "
-        "max_unreplaceable_diff_m >= max_abs_diff_m");
-  }
-  if (!(plane_tolerance_m > 0)) fail("plane_tolerance_m must be > 0");
-  if (!(max_normal_angle_deg > 0 && max_normal_angle_deg < 90)) {
-    fail("max_normal_angle_deg must be in (0, 90)");
-  }
-  if (min_fill_samples < 1) fail("min_fill_samples must be >= 1");
-  if (min_fill_quadrants < 0 || min_fill_quadrants > 4) {
-    fail("min_fill_quadrants must be in [0, 4]");
-  }
-  if (!(max_fill_curvature >= 0)) fail("max_fill_curvature must be >= 0");
-  if (!(max_fill_view_angle_deg > 0 && max_fill_view_angle_deg < 90)) {
-    fail("max_fill_view_angle_deg must be in (0, 90)");
-  }
+  LIDAR_CHECK_OPTION_GE(window_radius_px, 0);  // 0: automatic
+  LIDAR_CHECK_OPTION_GE(max_abs_diff_m, 0);
+  LIDAR_CHECK_OPTION_GE(max_rel_diff, 0);
+  LIDAR_CHECK_OPTION_GE(max_check_curvature, 0);
+  LIDAR_CHECK_OPTION_GE(max_unreplaceable_diff_m, max_abs_diff_m);
+  LIDAR_CHECK_OPTION_GT(plane_tolerance_m, 0);
+  LIDAR_CHECK_OPTION(max_normal_angle_deg > 0 && max_normal_angle_deg < 90);
+  LIDAR_CHECK_OPTION_GE(min_fill_samples, 1);
+  LIDAR_CHECK_OPTION(min_fill_quadrants >= 0 && min_fill_quadrants <= 4);
+  LIDAR_CHECK_OPTION_GE(max_fill_curvature, 0);
+  LIDAR_CHECK_OPTION(max_fill_view_angle_deg > 0 && max_fill_view_angle_deg < 90);
   return true;
 }
 
@@ -141,8 +132,8 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
                                   const LidarSurface& surface,
                                   const PinholeIntrinsics& intrinsics,
                                   const LidarDepthRefinementOptions& options) {
-  options.Check();
-  intrinsics.Check();
+  ThrowUnlessValid(options, "LidarDepthRefinementOptions");
+  ThrowUnlessValid(intrinsics, "PinholeIntrinsics");
   if (stereo.rows() != intrinsics.height || stereo.cols() != intrinsics.width) {
     throw std::invalid_argument(
         "RefineDepthWithLidar: the depth map is " + std::to_string(stereo.cols()) + "x" +

@@ -54,7 +54,7 @@ struct LidarDepthRefinementOptions {
   double max_fill_curvature = 0.05;     // LidarSurface::curvature of every window sample
   double max_fill_view_angle_deg = 75;  // between the plane normal and the viewing ray
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 // kRemoved: no depth, the stereo depth was removed by fold 1 and not filled.

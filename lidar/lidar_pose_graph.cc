@@ -1,62 +1,17 @@
 #include "lidar/lidar_pose_graph.h"
 
+#include "lidar/check_option.h"
+#include "lidar/pose_graph.h"
+
 #include <Eigen/Eigenvalues>
-#include <ceres/ceres.h>
-#include <ceres/rotation.h>
 
 #include <algorithm>
 #include <numeric>
-#include <queue>
 #include <set>
 #include <stdexcept>
 
 namespace colmap_lidar {
 namespace {
-
-// Residual of one edge: the left error of the predicted relative pose against the measured one,
-// E = T_pred * T_meas^-1 = (R_e, t_e), r = [2 vec(q_e); t_e], which to first order is the ICP's own
-// increment [omega, t] in the target frame; whitened by the edge's square-root information.
-class RelativePoseError {
- public:
-  RelativePoseError(const Eigen::Isometry3d& target_from_source,
-                    const Eigen::Matrix<double, 6, 6>& sqrt_information)
-      : measured_rotation_(target_from_source.linear()),
-        measured_translation_(target_from_source.translation()),
-        sqrt_information_(sqrt_information) {}
-
-  static ceres::CostFunction* Create(const Eigen::Isometry3d& target_from_source,
-                                     const Eigen::Matrix<double, 6, 6>& sqrt_information) {
-    return new ceres::AutoDiffCostFunction<RelativePoseError, 6, 4, 3, 4, 3>(
-        new RelativePoseError(target_from_source, sqrt_information));
-  }
-
-  template <typename T>
-  bool operator()(const T* world_from_target_q,
-                  const T* world_from_target_t,
-                  const T* world_from_source_q,
-                  const T* world_from_source_t,
-                  T* residuals) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q_i(world_from_target_q);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_i(world_from_target_t);
-    const Eigen::Map<const Eigen::Quaternion<T>> q_j(world_from_source_q);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_j(world_from_source_t);
-    // target_from_source predicted = inverse(world_from_target) * world_from_source
-    const Eigen::Quaternion<T> q_pred = q_i.conjugate() * q_j;
-    const Eigen::Matrix<T, 3, 1> t_pred = q_i.conjugate() * (t_j - t_i);
-    const Eigen::Quaternion<T> q_err = q_pred * measured_rotation_.cast<T>().conjugate();
-    Eigen::Matrix<T, 6, 1> r;
-    r.template head<3>() = T(2.0) * q_err.vec();
-    r.template tail<3>() = t_pred - q_err * measured_translation_.cast<T>();
-    Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residuals);
-    whitened = sqrt_information_.cast<T>() * r;
-    return true;
-  }
-
- private:
-  Eigen::Quaterniond measured_rotation_;
-  Eigen::Vector3d measured_translation_;
-  Eigen::Matrix<double, 6, 6> sqrt_information_;
-};
 
 std::vector<double> GlobalHistogram(const StationCloud& station) {
   std::vector<double> histogram;
@@ -159,81 +114,23 @@ void RemoveInconsistentEdges(const CycleConsistencyOptions& options, LidarGraph*
   graph->edges = std::move(kept);
 }
 
-// Maximum spanning tree (Prim) from the first station of each component: initial poses, components.
-void SpanningTreePoses(size_t n, LidarGraph* graph) {
-  std::vector<std::vector<const LidarEdge*>> adjacent(n);
+// Spanning tree and refinement over the accepted edges (lidar/pose_graph.h).
+void SolveLidarPoseGraph(size_t n, const LidarGraphOptions& options, LidarGraph* graph) {
+  std::vector<RelativePoseEdge> edges;
   for (const LidarEdge& e : graph->edges) {
-    adjacent[e.target].push_back(&e);
-    adjacent[e.source].push_back(&e);
+    edges.push_back(
+        {e.target, e.source, e.target_from_source, e.Weight(), SqrtInformation(e.registration)});
   }
-  graph->world_from_lidar.assign(n, Eigen::Isometry3d::Identity());
-  graph->component.assign(n, -1);
-  for (size_t root = 0; root < n; ++root) {
-    if (graph->component[root] >= 0) continue;
-    const int c = graph->num_components++;
-    graph->component[root] = c;
-    using Item = std::pair<double, const LidarEdge*>;
-    std::priority_queue<Item> queue;
-    for (const LidarEdge* e : adjacent[root]) queue.push({e->Weight(), e});
-    while (!queue.empty()) {
-      const LidarEdge* e = queue.top().second;
-      queue.pop();
-      const bool target_in = graph->component[e->target] == c;
-      const bool source_in = graph->component[e->source] == c;
-      if (target_in == source_in) continue;
-      const size_t added = target_in ? e->source : e->target;
-      // world_from_source = world_from_target * target_from_source
-      graph->world_from_lidar[added] =
-          target_in ? graph->world_from_lidar[e->target] * e->target_from_source
-                    : graph->world_from_lidar[e->source] * e->target_from_source.inverse();
-      graph->component[added] = c;
-      for (const LidarEdge* next : adjacent[added]) queue.push({next->Weight(), next});
-    }
-  }
-}
-
-// Pose-graph refinement over all accepted edges with a Huber loss on the whitened residuals; the
-// first station of each component is the gauge.
-void RefinePoses(const LidarGraphOptions& options, LidarGraph* graph) {
-  const size_t n = graph->world_from_lidar.size();
-  std::vector<Eigen::Quaterniond> rotations(n);
-  std::vector<Eigen::Vector3d> translations(n);
-  for (size_t i = 0; i < n; ++i) {
-    rotations[i] = Eigen::Quaterniond(graph->world_from_lidar[i].linear());
-    translations[i] = graph->world_from_lidar[i].translation();
-  }
-  ceres::Problem problem;
-  for (const LidarEdge& e : graph->edges) {
-    problem.AddResidualBlock(
-        RelativePoseError::Create(e.target_from_source, SqrtInformation(e.registration)),
-        new ceres::HuberLoss(options.robust_loss_sigmas),
-        rotations[e.target].coeffs().data(),
-        translations[e.target].data(),
-        rotations[e.source].coeffs().data(),
-        translations[e.source].data());
-  }
-  std::vector<bool> gauge_set(graph->num_components, false);
-  for (size_t i = 0; i < n; ++i) {
-    if (!problem.HasParameterBlock(rotations[i].coeffs().data())) continue;
-    problem.SetManifold(rotations[i].coeffs().data(), new ceres::EigenQuaternionManifold);
-    if (!gauge_set[graph->component[i]]) {
-      gauge_set[graph->component[i]] = true;
-      problem.SetParameterBlockConstant(rotations[i].coeffs().data());
-      problem.SetParameterBlockConstant(translations[i].data());
-    }
-  }
-  ceres::Solver::Options solver_options;
-  solver_options.max_num_iterations = 100;
-  solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-  graph->refinement_initial_cost = summary.initial_cost;
-  graph->refinement_final_cost = summary.final_cost;
-  for (size_t i = 0; i < n; ++i) {
-    graph->world_from_lidar[i] = Eigen::Isometry3d::Identity();
-    graph->world_from_lidar[i].linear() = rotations[i].normalized().toRotationMatrix();
-    graph->world_from_lidar[i].translation() = translations[i];
-  }
+  PoseGraphOptions pose_graph;
+  pose_graph.refine = options.refine;
+  pose_graph.loss = "huber";
+  pose_graph.loss_scale = options.robust_loss_sigmas;
+  PoseGraphSolution solution = SolvePoseGraph(n, edges, pose_graph);
+  graph->world_from_lidar = std::move(solution.world_from_node);
+  graph->component = std::move(solution.component);
+  graph->num_components = solution.num_components;
+  graph->refinement_initial_cost = solution.initial_cost;
+  graph->refinement_final_cost = solution.final_cost;
 }
 
 }  // namespace
@@ -244,23 +141,20 @@ double LidarEdge::Weight() const {
 }
 
 bool LidarGraphOptions::Check() const {
-  if (!(robust_loss_sigmas > 0)) {
-    throw std::invalid_argument("LidarGraphOptions: robust_loss_sigmas must be > 0");
-  }
+  LIDAR_CHECK_OPTION_GT(robust_loss_sigmas, 0);
   return pair.Check() && cycles.Check();
 }
 
 LidarGraph RegisterAllStations(const std::vector<const StationCloud*>& stations,
                                const LidarGraphOptions& options,
                                const std::function<void(size_t, size_t)>& progress) {
-  options.Check();
+  ThrowUnlessValid(options, "LidarGraphOptions");
   const size_t n = stations.size();
   if (n == 0) throw std::invalid_argument("RegisterAllStations: no stations");
   LidarGraph graph;
   RegisterPairs(stations, options, progress, &graph);
   if (options.check_cycles) RemoveInconsistentEdges(options.cycles, &graph);
-  SpanningTreePoses(n, &graph);
-  if (options.refine && !graph.edges.empty()) RefinePoses(options, &graph);
+  SolveLidarPoseGraph(n, options, &graph);
   return graph;
 }
 

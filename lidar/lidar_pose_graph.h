@@ -41,7 +41,7 @@ struct LidarGraphOptions {
   // Huber loss of the refinement, on residuals whitened by each edge's information (in sigmas).
   double robust_loss_sigmas = 3.0;
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 struct LidarGraph {

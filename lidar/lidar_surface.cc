@@ -1,5 +1,6 @@
 #include "lidar/lidar_surface.h"
 
+#include "lidar/check_option.h"
 #include "lidar/kd_tree.h"
 #include "lidar/preprocessing.h"
 
@@ -48,21 +49,17 @@ double Curvature(const Pca& pca) {
 }  // namespace
 
 bool LidarSurfaceOptions::Check() const {
-  if (!(sample_spacing_m > 0) || !(radius_m > sample_spacing_m)) {
-    throw std::invalid_argument("LidarSurfaceOptions: need 0 < sample_spacing_m < radius_m");
-  }
-  if (!(curvature_radius_m > 0)) {
-    throw std::invalid_argument("LidarSurfaceOptions: curvature_radius_m must be > 0");
-  }
-  if (min_neighbors < 3 || max_neighbors < min_neighbors) {
-    throw std::invalid_argument("LidarSurfaceOptions: need 3 <= min_neighbors <= max_neighbors");
-  }
+  LIDAR_CHECK_OPTION_GT(sample_spacing_m, 0);
+  LIDAR_CHECK_OPTION_GT(radius_m, sample_spacing_m);
+  LIDAR_CHECK_OPTION_GT(curvature_radius_m, 0);
+  LIDAR_CHECK_OPTION_GE(min_neighbors, 3);
+  LIDAR_CHECK_OPTION_GE(max_neighbors, min_neighbors);
   return true;
 }
 
 LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam,
                                const LidarSurfaceOptions& options) {
-  options.Check();
+  ThrowUnlessValid(options, "LidarSurfaceOptions");
   LidarSurface surface;
   if (points_in_cam.empty()) return surface;
   PointCloud raw;

@@ -26,7 +26,7 @@ struct LidarSurfaceOptions {
   int min_neighbors = 8;   // fewer samples in the radius: the sample is dropped
   int max_neighbors = 96;  // larger neighbourhoods are subsampled evenly
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 struct LidarSurface {

@@ -1,5 +1,6 @@
 #include "lidar/model_evaluation.h"
 
+#include "lidar/check_option.h"
 #include "lidar/kd_tree.h"
 #include "lidar/point_to_plane_icp.h"
 
@@ -44,19 +45,16 @@ double Percentile(std::vector<double> values, double q) {
 }  // namespace
 
 bool ModelEvaluationOptions::Check() const {
-  if (icp_max_iterations < 0 || crop_distance_m <= 0) {
-    throw std::invalid_argument("ModelEvaluationOptions: non-positive value");
-  }
-  for (double t : thresholds_m) {
-    if (t <= 0) throw std::invalid_argument("ModelEvaluationOptions: threshold <= 0");
-  }
+  LIDAR_CHECK_OPTION_GE(icp_max_iterations, 0);
+  LIDAR_CHECK_OPTION_GT(crop_distance_m, 0);
+  for (const double threshold : thresholds_m) LIDAR_CHECK_OPTION_GT(threshold, 0);
   return true;
 }
 
 ModelEvaluation EvaluateModel(const PointCloud& model,
                               const PointCloud& truth,
                               const ModelEvaluationOptions& options) {
-  options.Check();
+  ThrowUnlessValid(options, "ModelEvaluationOptions");
   if (model.Empty()) throw std::invalid_argument("The model cloud is empty");
   if (truth.Empty() || !truth.HasNormals()) {
     throw std::invalid_argument("The ground-truth surface needs points with normals");

@@ -19,7 +19,7 @@ struct ModelEvaluationOptions {
       0.05;  // model points farther than this from the truth are not the structure
   std::vector<double> thresholds_m = {0.002, 0.005, 0.010};  // completeness / precision / F-score
 
-  bool Check() const;  // throws std::invalid_argument on a bad value
+  bool Check() const;
 };
 
 struct ModelEvaluation {

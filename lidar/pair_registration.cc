@@ -1,5 +1,7 @@
 #include "lidar/pair_registration.h"
 
+#include "lidar/check_option.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -196,12 +198,17 @@ void Judge(const PairRegistrationOptions& options, PairRegistration* result) {
 }  // namespace
 
 bool PairRegistrationOptions::Check() const {
-  if (!(max_ratio > 0) || ransac_iterations < 1 || !(inlier_threshold > 0) ||
-      !(edge_tolerance > 0) || min_inliers < 3 || num_hypotheses < 1 || !(min_overlap >= 0) ||
-      !(max_rmse_to_noise > 0) || !(max_rmse >= 0) || !(min_constraint_ratio >= 0) ||
-      !(weak_constraint_ratio >= min_constraint_ratio)) {
-    throw std::invalid_argument("PairRegistrationOptions: invalid value");
-  }
+  LIDAR_CHECK_OPTION_GT(max_ratio, 0);
+  LIDAR_CHECK_OPTION_GE(ransac_iterations, 1);
+  LIDAR_CHECK_OPTION_GT(inlier_threshold, 0);
+  LIDAR_CHECK_OPTION_GT(edge_tolerance, 0);
+  LIDAR_CHECK_OPTION_GE(min_inliers, 3);
+  LIDAR_CHECK_OPTION_GE(num_hypotheses, 1);
+  LIDAR_CHECK_OPTION_GE(min_overlap, 0);
+  LIDAR_CHECK_OPTION_GT(max_rmse_to_noise, 0);
+  LIDAR_CHECK_OPTION_GE(max_rmse, 0);
+  LIDAR_CHECK_OPTION_GE(min_constraint_ratio, 0);
+  LIDAR_CHECK_OPTION_GE(weak_constraint_ratio, min_constraint_ratio);
   return icp.Check();
 }
 
@@ -226,7 +233,7 @@ std::vector<std::pair<size_t, size_t>> MatchBscFeatures(const std::vector<BscFea
 PairRegistration RegisterStationClouds(const StationCloud& source,
                                        const StationCloud& target,
                                        const PairRegistrationOptions& options) {
-  options.Check();
+  ThrowUnlessValid(options, "PairRegistrationOptions");
   PairRegistration result;
   Eigen::Matrix3Xd source_points, target_points;
   std::vector<Hypothesis> hypotheses =

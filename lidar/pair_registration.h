@@ -43,7 +43,7 @@ struct PairRegistrationOptions {
   double min_constraint_ratio = 1e-4;
   double weak_constraint_ratio = 0.02;
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 struct PairRegistration {

@@ -1,5 +1,7 @@
 #include "lidar/pinhole_depth_image.h"
 
+#include "lidar/check_option.h"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -7,14 +9,11 @@
 namespace colmap_lidar {
 
 bool PinholeIntrinsics::Check() const {
-  if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("PinholeIntrinsics: image size must be positive");
-  }
-  if (!(fx > 0) || !(fy > 0) || !std::isfinite(cx) || !std::isfinite(cy)) {
-    throw std::invalid_argument(
-        "PinholeIntrinsics: focal lengths must be positive and the principal "
-        "point finite");
-  }
+  LIDAR_CHECK_OPTION_GT(width, 0);
+  LIDAR_CHECK_OPTION_GT(height, 0);
+  LIDAR_CHECK_OPTION_GT(fx, 0);
+  LIDAR_CHECK_OPTION_GT(fy, 0);
+  LIDAR_CHECK_OPTION(std::isfinite(cx) && std::isfinite(cy));
   return true;
 }
 

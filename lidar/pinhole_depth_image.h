@@ -19,7 +19,7 @@ struct PinholeIntrinsics {
   int height = 0;
   double fx = 0, fy = 0, cx = 0, cy = 0;
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 
   // Continuous image coordinates of a point in the camera frame; false behind the camera.
   bool Project(const Eigen::Vector3d& point_in_cam, Eigen::Vector2d* xy) const {

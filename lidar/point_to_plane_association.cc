@@ -1,5 +1,7 @@
 #include "lidar/point_to_plane_association.h"
 
+#include "lidar/check_option.h"
+
 #include <algorithm>
 #include <numeric>
 #include <random>
@@ -68,11 +70,9 @@ std::vector<size_t> NormalSpaceSample(const PointCloud& cloud,
 }  // namespace
 
 bool AssociationOptions::Check() const {
-  if (num_samples == 0 || !(max_distance > 0) || !(max_curvature > 0)) {
-    throw std::invalid_argument(
-        "AssociationOptions: num_samples, max_distance and max_curvature must "
-        "be > 0");
-  }
+  LIDAR_CHECK_OPTION_GT(num_samples, 0);
+  LIDAR_CHECK_OPTION_GT(max_distance, 0);
+  LIDAR_CHECK_OPTION_GT(max_curvature, 0);
   return true;
 }
 
@@ -84,7 +84,7 @@ std::vector<PointToPlaneObservation> AssociatePointToPlane(
     const AssociationOptions& options,
     const std::vector<double>* target_curvature,
     const std::vector<double>* source_curvature) {
-  options.Check();
+  ThrowUnlessValid(options, "AssociationOptions");
   if (!target.HasNormals())
     throw std::invalid_argument("AssociatePointToPlane: target needs normals");
   if (target_tree.Size() != target.Size()) {

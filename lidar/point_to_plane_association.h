@@ -34,7 +34,7 @@ struct AssociationOptions {
   double max_curvature = 0.05;  // only planar target neighbourhoods (if curvature is given)
   uint64_t seed = 0;
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 // `target` needs normals; `target_curvature` may be null (no planarity filter). `source_curvature`

@@ -1,5 +1,7 @@
 #include "lidar/point_to_plane_icp.h"
 
+#include "lidar/check_option.h"
+
 #include <Eigen/Dense>
 
 #include <cmath>
@@ -62,11 +64,10 @@ NormalEquations BuildNormalEquations(const PointCloud& source,
 }  // namespace
 
 bool IcpOptions::Check() const {
-  if (max_iterations < 1 || !(max_correspondence_distance > 0) ||
-      !(min_correspondence_distance > 0) ||
-      min_correspondence_distance > max_correspondence_distance || max_source_points < 6) {
-    throw std::invalid_argument("IcpOptions: invalid iteration count, gates or point budget");
-  }
+  LIDAR_CHECK_OPTION_GE(max_iterations, 1);
+  LIDAR_CHECK_OPTION_GT(min_correspondence_distance, 0);
+  LIDAR_CHECK_OPTION_GE(max_correspondence_distance, min_correspondence_distance);
+  LIDAR_CHECK_OPTION_GE(max_source_points, 6);
   return true;
 }
 
@@ -75,7 +76,7 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
                           const KdTree3& target_tree,
                           const Eigen::Isometry3d& initial_target_from_source,
                           const IcpOptions& options) {
-  options.Check();
+  ThrowUnlessValid(options, "IcpOptions");
   if (source.Empty() || target.Empty()) throw std::invalid_argument("PointToPlaneIcp: empty cloud");
   if (!target.HasNormals())
     throw std::invalid_argument("PointToPlaneIcp: the target needs normals");

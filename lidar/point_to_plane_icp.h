@@ -20,7 +20,7 @@ struct IcpOptions {
   double convergence_rotation_rad = 1e-6;
   double convergence_translation_m = 1e-5;
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 struct IcpResult {

@@ -1,5 +1,7 @@
 #include "lidar/preprocessing.h"
 
+#include "lidar/check_option.h"
+
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
@@ -62,11 +64,10 @@ PointCloud VoxelDownsample(const PointCloud& cloud, double voxel_size) {
 }
 
 bool NormalEstimationOptions::Check() const {
-  if (num_neighbors < 3 || radius < 0 || min_neighbors < 3 || !viewpoint.allFinite()) {
-    throw std::invalid_argument(
-        "NormalEstimationOptions: need num_neighbors >= 3, radius >= 0, "
-        "min_neighbors >= 3 and a finite viewpoint");
-  }
+  LIDAR_CHECK_OPTION_GE(num_neighbors, 3);
+  LIDAR_CHECK_OPTION_GE(radius, 0);
+  LIDAR_CHECK_OPTION_GE(min_neighbors, 3);
+  LIDAR_CHECK_OPTION(viewpoint.allFinite());
   return true;
 }
 
@@ -74,7 +75,7 @@ void EstimateNormals(const KdTree3& tree,
                      const NormalEstimationOptions& options,
                      PointCloud* cloud,
                      std::vector<double>* curvature) {
-  options.Check();
+  ThrowUnlessValid(options, "NormalEstimationOptions");
   if (tree.Size() != cloud->Size()) {
     throw std::invalid_argument("EstimateNormals: the k-d tree is not built over this cloud");
   }

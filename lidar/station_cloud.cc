@@ -1,5 +1,6 @@
 #include "lidar/station_cloud.h"
 
+#include "lidar/check_option.h"
 #include "lidar/registration_quality.h"
 
 #include <stdexcept>
@@ -7,15 +8,14 @@
 namespace colmap_lidar {
 
 bool StationCloudOptions::Check() const {
-  if (!(voxel_size > 0) || !(feature_voxel_size > 0)) {
-    throw std::invalid_argument("StationCloudOptions: voxel sizes must be > 0");
-  }
+  LIDAR_CHECK_OPTION_GT(voxel_size, 0);
+  LIDAR_CHECK_OPTION_GT(feature_voxel_size, 0);
   return normals.Check() && keypoints.Check() && bsc.Check();
 }
 
 std::unique_ptr<StationCloud> PrepareStationCloud(const PointCloud& raw,
                                                   const StationCloudOptions& options) {
-  options.Check();
+  ThrowUnlessValid(options, "StationCloudOptions");
   if (raw.Empty()) throw std::invalid_argument("PrepareStationCloud: empty cloud");
   auto station = std::make_unique<StationCloud>();
   station->cloud = VoxelDownsample(raw, options.voxel_size);

@@ -21,7 +21,7 @@ struct StationCloudOptions {
   BscOptions bsc;
   bool compute_features = true;  // false: only what association needs (cloud, normals, tree)
 
-  bool Check() const;  // throws std::invalid_argument
+  bool Check() const;
 };
 
 struct StationCloud {

@@ -22,7 +22,7 @@ $cli simulate_dataset --scene t_specimen --output_path "$kWorkspace/dataset" \
 echo "== 2. the pipeline: import (COLMAP SIFT), stereo depth, depth priors, LiDAR registration,"
 echo "         initialisation (hand-eye cam_from_lidar: the guess is not used), joint adjustment,"
 echo "         dense model (LiDAR-refined stereo), evaluation"
-$cli pipeline --dataset_path "$kWorkspace/dataset" --workspace_path "$kWorkspace" --use_guess 0 \
+$cli pipeline --dataset_path "$kWorkspace/dataset" --workspace_path "$kWorkspace" --PoseInitializer.use_guess 0 \
   --overwrite 1 2>&1 | grep -v '^I20'
 
 echo "== 3. accuracy of the reconstruction against the simulator's ground truth"

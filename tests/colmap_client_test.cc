@@ -157,6 +157,24 @@ TEST(CliTest, HelpVersionAndErrors) {
   EXPECT_NE(bad_threshold.output.find("unobservable_translation_mm > 0"), std::string::npos)
       << bad_threshold.output;
   EXPECT_FALSE(fs::exists(dir.File("o")));
+
+  // The pipeline registers every step's options under the step's section; a bad one is refused
+  // before the workspace is created.
+  const auto pipeline_help = RunCommand(cli + " pipeline --help");
+  for (const char* option : {"--JointAdjuster.sigma_lidar_m",
+                             "--StereoDepth.block_size",
+                             "--LidarRegistrator.max_neighbors arg (=4)",
+                             "--Densifier.fill_holes",
+                             "--SiftExtraction.max_image_size"}) {
+    EXPECT_NE(pipeline_help.output.find(option), std::string::npos) << option;
+  }
+  const auto bad_step_option =
+      RunCommand(cli + " pipeline --dataset_path " + dir.File("d") + " --workspace_path " +
+                 dir.File("ws") + " --JointAdjuster.unobservable_translation_mm -1");
+  EXPECT_NE(bad_step_option.exit_code, 0);
+  EXPECT_NE(bad_step_option.output.find("unobservable_translation_mm > 0"), std::string::npos)
+      << bad_step_option.output;
+  EXPECT_FALSE(fs::exists(dir.File("ws")));
 }
 
 TEST(CliTest, OptionsFromAProjectIniFile) {

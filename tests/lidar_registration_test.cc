@@ -1,5 +1,6 @@
 // Pairwise LiDAR registration (BSC + RANSAC + point-to-plane ICP) on simulated station clouds with
 // range noise, against the simulator's ground truth.
+#include "colmap_ext/rigid3_isometry.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
 #include "lidar/lidar_pose_graph.h"
@@ -20,13 +21,6 @@
 
 namespace colmap_lidar {
 namespace {
-
-Eigen::Isometry3d ToIsometry(const colmap::Rigid3d& pose) {
-  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
-  result.linear() = pose.rotation.toRotationMatrix();
-  result.translation() = pose.translation;
-  return result;
-}
 
 class LidarRegistrationTest : public ::testing::Test {
  protected:

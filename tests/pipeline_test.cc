@@ -265,10 +265,13 @@ TEST(PipelineTest, DefaultSceneWithoutAGuessEndToEndAndRestartable) {
   testing::ScopedTempDir dir;
   const std::string dataset = Simulate(dir, "t_specimen", 8, 1.0, 300000, false);
   ASSERT_FALSE(ReadStationDataset(dataset).rig.cam_from_lidar_guess);
-  const std::string command =
-      kCli + " pipeline --dataset_path " + dataset + " --workspace_path " + dir.File("ws");
+  // A step's option given to the pipeline reaches the step.
+  const std::string command = kCli + " pipeline --dataset_path " + dataset + " --workspace_path " +
+                              dir.File("ws") + " --JointAdjuster.write_text 1";
   const auto run = RunCommand(command);
   ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(fs::is_regular_file(dir.File("ws/sparse/joint/images.txt")));
+  EXPECT_FALSE(fs::exists(dir.File("ws/sparse/initial/images.txt")));
   std::cout << run.output.substr(run.output.find("== Pipeline summary")) << std::endl;
   const nlohmann::json init = ReadJson(dir.File("ws/sparse/initial/initialization.json"));
   EXPECT_EQ(init["extrinsic_source"], "hand-eye");
@@ -351,9 +354,13 @@ TEST(PipelineTest, LidarBridgesADisconnectedImageGraph) {
   EXPECT_NE(refused.output.find("add cam_from_lidar_guess"), std::string::npos);
   WriteRigJson(dataset + "/rig.json",
                with_guess.rig);  // the finished steps are kept
-  const auto run = RunCommand(kCli + " pipeline --dataset_path " + dataset + " --workspace_path " +
-                              dir.File("ws"));
+  // Options from an .ini file, COLMAP-style: [Section] key=value reaches the step.
+  std::ofstream(dir.File("project.ini"))
+      << "dataset_path=" << dataset << "\nworkspace_path=" << dir.File("ws")
+      << "\n[JointAdjuster]\nwrite_text=1\n";
+  const auto run = RunCommand(kCli + " pipeline --project_path " + dir.File("project.ini"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(fs::is_regular_file(dir.File("ws/sparse/joint/points3D.txt")));
   const int components = ImageGraphComponents(dir.File("ws/database.db"), 20);
   std::cout << "image graph: " << components << " components" << std::endl;
   EXPECT_GT(components, 1) << "the case needs a disconnected image graph";

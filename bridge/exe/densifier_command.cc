@@ -1,9 +1,7 @@
-#include "bridge/densifier.h"
+// colmap-lidar densifier: the dense model of a refined sparse model (bridge/densifier.h).
 #include "bridge/exe/commands.h"
+#include "bridge/exe/steps.h"
 #include "colmap_ext/logging.h"
-#include "colmap_ext/station_dataset.h"
-
-#include "colmap/controllers/option_manager.h"
 
 #include <filesystem>
 #include <iomanip>
@@ -11,58 +9,54 @@
 
 namespace colmap_lidar {
 
-int RunDensifier(int argc, char** argv) {
-  std::string input_path, dataset_path, depth_path, output_path, cam_from_lidar_path;
-  DensifierOptions densifier;
-  LidarDepthRefinementOptions& refinement = densifier.refinement;
-  colmap::OptionManager options;
-  options.AddRequiredOption("input_path", &input_path, "refined sparse model (joint_adjuster)");
-  options.AddRequiredOption("dataset_path", &dataset_path);
-  options.AddRequiredOption("depth_path", &depth_path, "stereo_depth's output folder");
-  options.AddRequiredOption("output_path", &output_path);
-  options.AddDefaultOption("cam_from_lidar",
-                           &cam_from_lidar_path,
-                           "qw qx qy qz tx ty tz file; default "
-                           "INPUT/cam_from_lidar.txt");
-  options.AddDefaultOption("refine_with_lidar",
-                           &densifier.refine_with_lidar,
-                           "0: fuse the stereo depth maps as they are");
-  options.AddDefaultOption("lidar_sample_spacing_m", &densifier.surface.sample_spacing_m);
-  options.AddDefaultOption("lidar_normal_radius_m", &densifier.surface.radius_m);
-  options.AddDefaultOption("window_radius_px", &refinement.window_radius_px);
-  options.AddDefaultOption("remove_inconsistent", &refinement.remove_inconsistent);
-  options.AddDefaultOption("max_abs_diff_m", &refinement.max_abs_diff_m);
-  options.AddDefaultOption("max_rel_diff", &refinement.max_rel_diff);
-  options.AddDefaultOption("max_check_curvature", &refinement.max_check_curvature);
-  options.AddDefaultOption("max_unreplaceable_diff_m", &refinement.max_unreplaceable_diff_m);
-  options.AddDefaultOption("plane_tolerance_m", &refinement.plane_tolerance_m);
-  options.AddDefaultOption("max_normal_angle_deg", &refinement.max_normal_angle_deg);
-  options.AddDefaultOption("fill_holes", &refinement.fill_holes);
-  options.AddDefaultOption("min_fill_samples", &refinement.min_fill_samples);
-  options.AddDefaultOption("min_fill_quadrants", &refinement.min_fill_quadrants);
-  options.AddDefaultOption("max_fill_curvature", &refinement.max_fill_curvature);
-  options.AddDefaultOption("max_fill_view_angle_deg", &refinement.max_fill_view_angle_deg);
-  options.AddDefaultOption("min_depth_m", &densifier.min_depth_m);
-  options.AddDefaultOption("max_depth_m", &densifier.max_depth_m);
-  options.AddDefaultOption(
-      "min_consistent_views", &densifier.min_consistent_views, "cross-station check (0 = off)");
-  options.AddDefaultOption("max_neighbor_views", &densifier.max_neighbor_views);
-  options.AddDefaultOption("consistency_abs_m", &densifier.consistency_abs_m);
-  options.AddDefaultOption("consistency_rel", &densifier.consistency_rel);
-  options.AddDefaultOption("fused_voxel_size_m", &densifier.fused_voxel_size_m);
-  options.AddDefaultOption("lidar_map_voxel_size_m", &densifier.lidar_map_voxel_size_m);
-  options.Parse(argc, argv);
-  THROW_CHECK(densifier.Check());
-  if (cam_from_lidar_path.empty()) {
-    cam_from_lidar_path = (std::filesystem::path(input_path) / "cam_from_lidar.txt").string();
-  }
-  const StationDataset dataset = ReadStationDataset(dataset_path);
+void AddDensifierOptions(const std::string& prefix,
+                         colmap::OptionManager* manager,
+                         DensifierOptions* options) {
+  PrefixedOptions add(manager, prefix);
+  LidarDepthRefinementOptions& refinement = options->refinement;
+  add.Add("refine_with_lidar",
+          &options->refine_with_lidar,
+          "0: fuse the stereo depth maps as they are");
+  add.Add("lidar_sample_spacing_m", &options->surface.sample_spacing_m);
+  add.Add("lidar_normal_radius_m", &options->surface.radius_m);
+  add.Add("window_radius_px", &refinement.window_radius_px);
+  add.Add("remove_inconsistent", &refinement.remove_inconsistent);
+  add.Add("max_abs_diff_m", &refinement.max_abs_diff_m);
+  add.Add("max_rel_diff", &refinement.max_rel_diff);
+  add.Add("max_check_curvature", &refinement.max_check_curvature);
+  add.Add("max_unreplaceable_diff_m", &refinement.max_unreplaceable_diff_m);
+  add.Add("plane_tolerance_m", &refinement.plane_tolerance_m);
+  add.Add("max_normal_angle_deg", &refinement.max_normal_angle_deg);
+  add.Add("fill_holes", &refinement.fill_holes);
+  add.Add("min_fill_samples", &refinement.min_fill_samples);
+  add.Add("min_fill_quadrants", &refinement.min_fill_quadrants);
+  add.Add("max_fill_curvature", &refinement.max_fill_curvature);
+  add.Add("max_fill_view_angle_deg", &refinement.max_fill_view_angle_deg);
+  add.Add("min_depth_m", &options->min_depth_m);
+  add.Add("max_depth_m", &options->max_depth_m);
+  add.Add("min_consistent_views", &options->min_consistent_views, "cross-station check (0 = off)");
+  add.Add("max_neighbor_views", &options->max_neighbor_views);
+  add.Add("consistency_abs_m", &options->consistency_abs_m);
+  add.Add("consistency_rel", &options->consistency_rel);
+  add.Add("fused_voxel_size_m", &options->fused_voxel_size_m);
+  add.Add("lidar_map_voxel_size_m", &options->lidar_map_voxel_size_m);
+}
+
+void RunDensifierStep(const StationDataset& dataset,
+                      const DensifierPaths& paths,
+                      const DensifierOptions& options) {
+  THROW_CHECK(options.Check());
+  const std::string cam_from_lidar_path =
+      paths.cam_from_lidar_path.empty()
+          ? (std::filesystem::path(paths.input_path) / "cam_from_lidar.txt").string()
+          : paths.cam_from_lidar_path;
   const colmap::Rigid3d cam_from_lidar = ReadPoseFile(cam_from_lidar_path);
-  THROW_CHECK(std::filesystem::is_directory(input_path)) << "No sparse model at " << input_path;
+  THROW_CHECK(std::filesystem::is_directory(paths.input_path))
+      << "No sparse model at " << paths.input_path;
   colmap::Reconstruction reconstruction;
-  reconstruction.Read(input_path);
-  const DensifierSummary summary =
-      Densify(reconstruction, cam_from_lidar, dataset, depth_path, output_path, densifier);
+  reconstruction.Read(paths.input_path);
+  const DensifierSummary summary = Densify(
+      reconstruction, cam_from_lidar, dataset, paths.depth_path, paths.output_path, options);
   size_t removed = 0, filled = 0, stereo = 0;
   for (const StationDensification& station : summary.stations) {
     removed += station.refinement.stereo_removed;
@@ -72,9 +66,27 @@ int RunDensifier(int argc, char** argv) {
   std::cout << std::fixed << std::setprecision(1) << "densifier: " << summary.stations.size()
             << " stations in " << summary.seconds << " s; stereo pixels " << stereo << ", removed "
             << removed << ", filled " << filled << "; " << summary.fused_points << " points in "
-            << output_path << "/fused.ply, " << summary.lidar_map_points
-            << " in lidar_map.ply; COLMAP dense "
-            << "workspace in " << output_path << std::endl;
+            << paths.output_path << "/fused.ply, " << summary.lidar_map_points
+            << " in lidar_map.ply; COLMAP dense workspace in " << paths.output_path << std::endl;
+}
+
+int RunDensifier(int argc, char** argv) {
+  std::string dataset_path;
+  DensifierPaths paths;
+  DensifierOptions densifier;
+  colmap::OptionManager options;
+  options.AddRequiredOption(
+      "input_path", &paths.input_path, "refined sparse model (joint_adjuster)");
+  options.AddRequiredOption("dataset_path", &dataset_path);
+  options.AddRequiredOption("depth_path", &paths.depth_path, "stereo_depth's output folder");
+  options.AddRequiredOption("output_path", &paths.output_path);
+  options.AddDefaultOption("cam_from_lidar",
+                           &paths.cam_from_lidar_path,
+                           "qw qx qy qz tx ty tz file; default INPUT/cam_from_lidar.txt");
+  AddDensifierOptions("", &options, &densifier);
+  options.Parse(argc, argv);
+  THROW_CHECK(densifier.Check());  // before any file is read
+  RunDensifierStep(ReadStationDataset(dataset_path), paths, densifier);
   return EXIT_SUCCESS;
 }
 

@@ -1,5 +1,6 @@
 #include "bridge/calibration_evaluation.h"
 #include "bridge/exe/commands.h"
+#include "bridge/exe/steps.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
@@ -46,26 +47,41 @@ std::vector<double> ParseThresholds(const std::string& csv) {
 
 }  // namespace
 
+void AddModelEvaluationOptions(const std::string& prefix,
+                               colmap::OptionManager* manager,
+                               ModelEvaluationOptions* options) {
+  PrefixedOptions add(manager, prefix);
+  add.Add("align_icp", &options->align_icp, "rigid point-to-plane ICP first");
+  add.Add("crop_distance_m", &options->crop_distance_m);
+}
+
 int RunEvaluateModel(int argc, char** argv) {
   std::string model_path, ground_truth_path, output_path, thresholds = "0.002,0.005,0.01";
+  std::string truth_from_model_path;
   ModelEvaluationOptions options;
   colmap::OptionManager manager;
   manager.AddRequiredOption("model_path", &model_path, "reconstructed cloud (.ply/.pcd)");
   manager.AddRequiredOption("ground_truth_path", &ground_truth_path, "surface.ply with normals");
   manager.AddRequiredOption("output_path", &output_path, "directory for metrics.json and plots");
-  std::string truth_from_model_path;
   manager.AddDefaultOption("truth_from_model",
                            &truth_from_model_path,
-                           "pose file moving the model into the truth's "
-                           "frame first (evaluate_calibration writes one)");
-  manager.AddDefaultOption("align_icp", &options.align_icp, "rigid point-to-plane ICP first");
-  manager.AddDefaultOption("crop_distance_m", &options.crop_distance_m);
+                           "pose file moving the model into the truth's frame first "
+                           "(evaluate_calibration writes one)");
+  AddModelEvaluationOptions("", &manager, &options);
   manager.AddDefaultOption("thresholds_m", &thresholds, "comma-separated, metres");
   manager.Parse(argc, argv);
   options.thresholds_m = ParseThresholds(thresholds);
   THROW_CHECK(!options.thresholds_m.empty())
       << "--thresholds_m must be comma-separated numbers in metres, not '" << thresholds << "'";
+  RunEvaluateModelStep(model_path, ground_truth_path, truth_from_model_path, output_path, options);
+  return EXIT_SUCCESS;
+}
 
+void RunEvaluateModelStep(const std::string& model_path,
+                          const std::string& ground_truth_path,
+                          const std::string& truth_from_model_path,
+                          const std::string& output_path,
+                          const ModelEvaluationOptions& options) {
   // Inputs first: a missing or bad cloud must not leave an output folder behind.
   PointCloud model = ReadPointCloud(model_path);
   if (!truth_from_model_path.empty()) {
@@ -133,7 +149,6 @@ int RunEvaluateModel(int argc, char** argv) {
   }
   std::cout << "evaluate_model: wrote " << output_path
             << "/{metrics.json, error_histogram.png, error_colored.ply}" << std::endl;
-  return EXIT_SUCCESS;
 }
 
 int RunEvaluateCalibration(int argc, char** argv) {
@@ -147,16 +162,25 @@ int RunEvaluateCalibration(int argc, char** argv) {
   manager.AddDefaultOption("output_path", &output_path, "directory for metrics.json (optional)");
   manager.AddDefaultOption("alignment", &alignment, "rigid | similarity");
   manager.Parse(argc, argv);
+  RunEvaluateCalibrationStep(dataset_path, input_path, cam_from_lidar_path, output_path, alignment);
+  return EXIT_SUCCESS;
+}
+
+void RunEvaluateCalibrationStep(const std::string& dataset_path,
+                                const std::string& input_path,
+                                const std::string& cam_from_lidar_path,
+                                const std::string& output_path,
+                                const std::string& alignment) {
   THROW_CHECK(alignment == "rigid" || alignment == "similarity")
       << "--alignment must be rigid or similarity, not " << alignment;
-  if (cam_from_lidar_path.empty()) {
-    cam_from_lidar_path = (fs::path(input_path) / "cam_from_lidar.txt").string();
-  }
+  const std::string estimate_path = cam_from_lidar_path.empty()
+                                        ? (fs::path(input_path) / "cam_from_lidar.txt").string()
+                                        : cam_from_lidar_path;
   const fs::path truth_dir = fs::path(dataset_path) / "ground_truth";
   const auto true_cam_from_world = ReadNamedPoses((truth_dir / "cam_from_world.txt").string());
   const colmap::Rigid3d true_cam_from_lidar =
       ReadPoseFile((truth_dir / "cam_from_lidar.txt").string());
-  const colmap::Rigid3d cam_from_lidar = ReadPoseFile(cam_from_lidar_path);
+  const colmap::Rigid3d cam_from_lidar = ReadPoseFile(estimate_path);
   THROW_CHECK(fs::is_directory(input_path)) << "No sparse model at " << input_path;
   colmap::Reconstruction reconstruction;
   reconstruction.Read(input_path);
@@ -208,7 +232,6 @@ int RunEvaluateCalibration(int argc, char** argv) {
   } else {
     std::cout << metrics.dump(2) << std::endl;
   }
-  return EXIT_SUCCESS;
 }
 
 }  // namespace colmap_lidar

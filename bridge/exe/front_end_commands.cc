@@ -1,13 +1,9 @@
-// The front end's commands: import_dataset, stereo_depth, depth_prior_extractor.
+// The front end's steps and commands: import_dataset, stereo_depth, depth_prior_extractor.
 #include "bridge/exe/commands.h"
+#include "bridge/exe/steps.h"
 #include "bridge/lidar_registration_files.h"
-#include "colmap_ext/dataset_import.h"
-#include "colmap_ext/depth_prior_extractor.h"
 #include "colmap_ext/logging.h"
-#include "colmap_ext/station_dataset.h"
-#include "colmap_ext/stereo_depth.h"
 
-#include "colmap/controllers/option_manager.h"
 #include "colmap/feature/pairing.h"
 
 #include <chrono>
@@ -15,102 +11,128 @@
 #include <iostream>
 
 namespace colmap_lidar {
-
-int RunImportDataset(int argc, char** argv) {
-  std::string dataset_path;
-  colmap::OptionManager options;
+void AddImportStepOptions(const std::string& prefix,
+                          colmap::OptionManager* manager,
+                          ImportStepOptions* options) {
   // GPU SIFT needs CUDA or an OpenGL context; a headless build has neither.
-  options.sift_extraction->use_gpu = false;
-  options.sift_matching->use_gpu = false;
-  options.AddRequiredOption("dataset_path", &dataset_path);
-  options.AddDatabaseOptions();
-  options.AddExtractionOptions();
-  options.AddExhaustiveMatchingOptions();
-  options.AddSequentialMatchingOptions();
-  DatasetImportOptions import_options;
-  *options.spatial_matching = import_options.spatial_matching;
-  options.AddSpatialMatchingOptions();
-  std::string registration_path;
-  options.AddDefaultOption(
-      "matcher",
-      &import_options.matcher,
-      "exhaustive | sequential (frames of a moving platform, by name) | spatial "
-      "(stations near in --lidar_registration_path)");
-  options.AddDefaultOption("lidar_registration_path",
-                           &registration_path,
-                           "lidar_registrator's output folder, for --matcher spatial");
-  options.Parse(argc, argv);
+  manager->sift_extraction->use_gpu = false;
+  manager->sift_matching->use_gpu = false;
+  manager->AddExtractionOptions();
+  manager->AddExhaustiveMatchingOptions();
+  manager->AddSequentialMatchingOptions();
+  *manager->spatial_matching = options->import.spatial_matching;
+  manager->AddSpatialMatchingOptions();
+  PrefixedOptions add(manager, prefix);
+  add.Add("matcher",
+          &options->import.matcher,
+          "exhaustive | sequential (frames of a moving platform, by name) | spatial "
+          "(stations near in --lidar_registration_path)");
+  add.Add("lidar_registration_path",
+          &options->lidar_registration_path,
+          "lidar_registrator's output folder, for --matcher spatial");
+}
 
+void TakeColmapImportOptions(const colmap::OptionManager& manager, ImportStepOptions* options) {
+  options->import.sift_extraction = *manager.sift_extraction;
+  options->import.sift_matching = *manager.sift_matching;
+  options->import.two_view_geometry = *manager.two_view_geometry;
+  options->import.exhaustive_matching = *manager.exhaustive_matching;
+  options->import.sequential_matching = *manager.sequential_matching;
+  options->import.spatial_matching = *manager.spatial_matching;
+}
+
+void RunImportStep(const StationDataset& dataset,
+                   const std::string& database_path,
+                   ImportStepOptions options) {
   const auto start = std::chrono::steady_clock::now();
-  const StationDataset dataset = ReadStationDataset(dataset_path);
-  import_options.sift_extraction = *options.sift_extraction;
-  import_options.sift_matching = *options.sift_matching;
-  import_options.two_view_geometry = *options.two_view_geometry;
-  import_options.exhaustive_matching = *options.exhaustive_matching;
-  import_options.sequential_matching = *options.sequential_matching;
-  import_options.spatial_matching = *options.spatial_matching;
-  if (import_options.matcher == "spatial") {
-    THROW_CHECK(!registration_path.empty()) << "--matcher spatial needs --lidar_registration_path";
-    import_options.station_positions = StationCameraPositions(
-        registration_path, dataset.rig.cam_from_lidar_guess.value_or(colmap::Rigid3d()));
+  if (options.import.matcher == "spatial") {
+    THROW_CHECK(!options.lidar_registration_path.empty())
+        << "--matcher spatial needs --lidar_registration_path";
+    options.import.station_positions =
+        StationCameraPositions(options.lidar_registration_path,
+                               dataset.rig.cam_from_lidar_guess.value_or(colmap::Rigid3d()));
   }
-  const DatasetImportSummary summary =
-      ImportDataset(dataset, *options.database_path, import_options);
-  std::cout << "Imported " << dataset.root << " into " << *options.database_path << ": "
+  const DatasetImportSummary summary = ImportDataset(dataset, database_path, options.import);
+  std::cout << "Imported " << dataset.root << " into " << database_path << ": "
             << summary.num_images << " station images (" << summary.num_new_images
             << " new), camera " << summary.camera_id << ", " << summary.num_verified_pairs
             << " verified image pairs (" << std::fixed << std::setprecision(0)
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-            << " s)" << std::endl;
+            << SecondsSince(start) << " s)" << std::endl;
+}
+
+int RunImportDataset(int argc, char** argv) {
+  std::string dataset_path;
+  ImportStepOptions import;
+  colmap::OptionManager options;
+  options.AddRequiredOption("dataset_path", &dataset_path);
+  options.AddDatabaseOptions();
+  AddImportStepOptions("", &options, &import);
+  options.Parse(argc, argv);
+  TakeColmapImportOptions(options, &import);
+  THROW_CHECK(import.import.Check());  // before any file is read
+  RunImportStep(ReadStationDataset(dataset_path), *options.database_path, import);
   return EXIT_SUCCESS;
+}
+
+void AddStereoDepthOptions(const std::string& prefix,
+                           colmap::OptionManager* manager,
+                           StereoDepthOptions* options) {
+  PrefixedOptions add(manager, prefix);
+  add.Add("mode", &options->mode, "sgbm | hh | 3way | hh4");
+  add.Add("min_depth_m", &options->min_depth_m);
+  add.Add("max_depth_m", &options->max_depth_m);
+  add.Add("vertically_symmetric", &options->vertically_symmetric);
+  add.Add("block_size", &options->block_size);
+  add.Add("p1_factor", &options->p1_factor);
+  add.Add("p2_factor", &options->p2_factor);
+  add.Add("uniqueness_ratio", &options->uniqueness_ratio);
+  add.Add("pre_filter_cap", &options->pre_filter_cap);
+  add.Add("speckle_window_size", &options->speckle_window_size);
+  add.Add("speckle_range_px", &options->speckle_range_px);
+  add.Add("max_left_right_diff_px", &options->max_left_right_diff_px);
+  add.Add("num_threads", &options->num_threads);
+}
+
+void RunStereoDepthStep(const StationDataset& dataset,
+                        const std::string& output_path,
+                        const StereoDepthOptions& options) {
+  THROW_CHECK(options.Check());
+  const auto start = std::chrono::steady_clock::now();
+  ComputeDatasetStereoDepth(dataset, output_path, options);
+  std::cout << "Depth maps of " << dataset.stations.size() << " stations written to " << output_path
+            << " (" << std::fixed << std::setprecision(0) << SecondsSince(start) << " s)"
+            << std::endl;
 }
 
 int RunStereoDepth(int argc, char** argv) {
   std::string dataset_path;
   std::string output_path;
   StereoDepthOptions stereo;
-  colmap::OptionManager options(/*add_project_options=*/true);
+  colmap::OptionManager options;
   options.AddRequiredOption("dataset_path", &dataset_path);
   options.AddRequiredOption("output_path", &output_path);
-  options.AddDefaultOption("mode", &stereo.mode, "sgbm | hh | 3way | hh4");
-  options.AddDefaultOption("min_depth_m", &stereo.min_depth_m);
-  options.AddDefaultOption("max_depth_m", &stereo.max_depth_m);
-  options.AddDefaultOption("vertically_symmetric", &stereo.vertically_symmetric);
-  options.AddDefaultOption("block_size", &stereo.block_size);
-  options.AddDefaultOption("p1_factor", &stereo.p1_factor);
-  options.AddDefaultOption("p2_factor", &stereo.p2_factor);
-  options.AddDefaultOption("uniqueness_ratio", &stereo.uniqueness_ratio);
-  options.AddDefaultOption("pre_filter_cap", &stereo.pre_filter_cap);
-  options.AddDefaultOption("speckle_window_size", &stereo.speckle_window_size);
-  options.AddDefaultOption("speckle_range_px", &stereo.speckle_range_px);
-  options.AddDefaultOption("max_left_right_diff_px", &stereo.max_left_right_diff_px);
-  options.AddDefaultOption("num_threads", &stereo.num_threads);
+  AddStereoDepthOptions("", &options, &stereo);
   options.Parse(argc, argv);
-  THROW_CHECK(stereo.Check());
-  const StationDataset dataset = ReadStationDataset(dataset_path);
-  const auto start = std::chrono::steady_clock::now();
-  ComputeDatasetStereoDepth(dataset, output_path, stereo);
-  std::cout << "Depth maps of " << dataset.stations.size() << " stations written to " << output_path
-            << " (" << std::fixed << std::setprecision(0)
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-            << " s)" << std::endl;
+  THROW_CHECK(stereo.Check());  // before any file is read
+  RunStereoDepthStep(ReadStationDataset(dataset_path), output_path, stereo);
   return EXIT_SUCCESS;
 }
 
-int RunDepthPriorExtractor(int argc, char** argv) {
-  std::string depth_path;
-  DepthPriorOptions prior_options;
-  colmap::OptionManager options;
-  options.AddDatabaseOptions();
-  options.AddRequiredOption("depth_path", &depth_path);
-  options.AddDefaultOption("max_radius_px", &prior_options.max_radius_px);
-  options.AddDefaultOption(
-      "sigma_pixels", &prior_options.sigma_pixels, "sigma_p of sigma_d = d^2/(b f) sigma_p");
-  options.AddDefaultOption("max_relative_jump", &prior_options.max_relative_jump);
-  options.Parse(argc, argv);
-  THROW_CHECK(prior_options.Check());
+void AddDepthPriorOptions(const std::string& prefix,
+                          colmap::OptionManager* manager,
+                          DepthPriorOptions* options) {
+  PrefixedOptions add(manager, prefix);
+  add.Add("max_radius_px", &options->max_radius_px);
+  add.Add("sigma_pixels", &options->sigma_pixels, "sigma_p of sigma_d = d^2/(b f) sigma_p");
+  add.Add("max_relative_jump", &options->max_relative_jump);
+}
+
+void RunDepthPriorStep(const std::string& database_path,
+                       const std::string& depth_path,
+                       const DepthPriorOptions& options) {
+  THROW_CHECK(options.Check());
   const std::vector<ImageDepthPriorCount> counts =
-      ExtractDatabaseDepthPriors(*options.database_path, depth_path, prior_options);
+      ExtractDatabaseDepthPriors(database_path, depth_path, options);
   size_t num_keypoints = 0, num_priors = 0, num_without_map = 0;
   for (const ImageDepthPriorCount& count : counts) {
     num_keypoints += count.num_keypoints;
@@ -125,6 +147,17 @@ int RunDepthPriorExtractor(int argc, char** argv) {
     std::cout << "; " << num_without_map << " images had no depth map";
   }
   std::cout << std::endl;
+}
+
+int RunDepthPriorExtractor(int argc, char** argv) {
+  std::string depth_path;
+  DepthPriorOptions prior_options;
+  colmap::OptionManager options;
+  options.AddDatabaseOptions();
+  options.AddRequiredOption("depth_path", &depth_path);
+  AddDepthPriorOptions("", &options, &prior_options);
+  options.Parse(argc, argv);
+  RunDepthPriorStep(*options.database_path, depth_path, prior_options);
   return EXIT_SUCCESS;
 }
 

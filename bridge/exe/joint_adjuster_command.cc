@@ -1,5 +1,6 @@
 // colmap-lidar joint_adjuster: the joint problem on a COLMAP sparse model (bridge/joint_adjuster.h).
 #include "bridge/exe/commands.h"
+#include "bridge/exe/steps.h"
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
 #include "colmap_ext/logging.h"
@@ -192,50 +193,6 @@ void WritePlots(const std::string& directory, const JointAdjustmentSummary& summ
   WriteLinePlotPng(directory + "/perturbation_rotation.png", rotation, plot);
 }
 
-// The adjuster's and the data loader's options; `num_samples` and `hold_translation` are parsed after.
-void AddJointOptions(colmap::OptionManager* options,
-                     JointAdjusterOptions* adjuster,
-                     JointDataOptions* data_options,
-                     int* num_samples,
-                     std::string* hold_translation) {
-  options->AddDefaultOption("sigma_lidar_m", &adjuster->sigma_lidar_m);
-  options->AddDefaultOption("depth_weight", &adjuster->depth_weight);
-  options->AddDefaultOption("lidar_weight", &adjuster->lidar_weight);
-  options->AddDefaultOption("loss", &adjuster->loss, "none | huber | cauchy");
-  options->AddDefaultOption("loss_scale", &adjuster->loss_scale);
-  options->AddDefaultOption("compress_lidar_blocks", &adjuster->compress_lidar_blocks);
-  options->AddDefaultOption("max_reprojection_error_px", &adjuster->max_reprojection_error_px);
-  options->AddDefaultOption("max_depth_error_sigmas", &adjuster->max_depth_error_sigmas);
-  options->AddDefaultOption("depth_gate_from_residual_scale",
-                            &adjuster->depth_gate_from_residual_scale);
-  options->AddDefaultOption("max_depth_error_m",
-                            &adjuster->max_depth_error_m,
-                            "absolute cap on top of the sigma gate; 0: off");
-  options->AddDefaultOption("max_point_to_plane_m", &adjuster->max_point_to_plane_m);
-  options->AddDefaultOption("max_outlier_iterations", &adjuster->max_outlier_iterations);
-  options->AddDefaultOption("num_association_rounds", &adjuster->num_association_rounds);
-  *num_samples = static_cast<int>(adjuster->association.num_samples);
-  options->AddDefaultOption("num_samples_per_pair", num_samples);
-  options->AddDefaultOption("normal_space_sampling", &adjuster->association.normal_space_sampling);
-  options->AddDefaultOption("association_max_distance_m", &adjuster->association.max_distance);
-  options->AddDefaultOption("initial_association_distance_m",
-                            &adjuster->initial_association_distance_m);
-  options->AddDefaultOption("hold_rotation", &adjuster->hold_rotation);
-  options->AddDefaultOption(
-      "hold_translation", hold_translation, "comma-separated camera axes, e.g. y or x,z");
-  options->AddDefaultOption("max_num_iterations", &adjuster->max_num_iterations);
-  options->AddDefaultOption("extrinsic_prior_sigma_m", &adjuster->extrinsic_prior_sigma_m);
-  options->AddDefaultOption("min_image_pair_inliers", &data_options->min_image_pair_inliers);
-  options->AddDefaultOption("max_lidar_neighbors", &data_options->max_lidar_neighbors);
-  options->AddDefaultOption("stereo_scale_sigma", &adjuster->observability.stereo_scale_sigma);
-  options->AddDefaultOption("two_way_lidar_clusters",
-                            &adjuster->observability.two_way_lidar_clusters);
-  options->AddDefaultOption("unobservable_translation_mm",
-                            &adjuster->observability.unobservable_translation_mm);
-  options->AddDefaultOption("unobservable_rotation_deg",
-                            &adjuster->observability.unobservable_rotation_deg);
-}
-
 // --cam_from_lidar FILE, else INPUT/cam_from_lidar.txt (pose_initializer's), else rig.json's guess.
 colmap::Rigid3d InitialCamFromLidar(const std::string& cam_from_lidar_path,
                                     const std::string& input_path,
@@ -264,71 +221,112 @@ void PrintUncertainty(const JointAdjustmentSummary& summary) {
 
 }  // namespace
 
-int RunJointAdjuster(int argc, char** argv) {
-  std::string input_path, dataset_path, output_path, cam_from_lidar_path;
-  std::string mode = "joint", hold_translation;
-  bool write_text = false;
-  int num_samples = 0;
-  JointAdjusterOptions adjuster;
-  JointDataOptions data_options;
-  colmap::OptionManager options;
-  options.AddDatabaseOptions();
-  options.AddRequiredOption("input_path", &input_path);
-  options.AddRequiredOption("dataset_path", &dataset_path);
-  options.AddRequiredOption("output_path", &output_path);
-  options.AddDefaultOption("mode", &mode, "joint | precalibrated | stereo_only");
-  options.AddDefaultOption("cam_from_lidar",
-                           &cam_from_lidar_path,
-                           "qw qx qy qz tx ty tz file; default: INPUT/cam_from_lidar.txt, else "
-                           "rig.json's cam_from_lidar_guess");
-  options.AddDefaultOption("write_text", &write_text);
-  AddJointOptions(&options, &adjuster, &data_options, &num_samples, &hold_translation);
-  options.Parse(argc, argv);
+bool JointAdjusterStepOptions::Check() {
   adjuster.mode = JointModeFromName(mode);
   adjuster.hold_translation = ParseHeldAxes(hold_translation);
-  THROW_CHECK_GT(num_samples, 0);
-  adjuster.association.num_samples = static_cast<size_t>(num_samples);
-  THROW_CHECK(adjuster.Check());
-  THROW_CHECK(data_options.Check());
-  const auto start = std::chrono::steady_clock::now();
+  CHECK_OPTION_GT(num_samples_per_pair, 0);
+  adjuster.association.num_samples = static_cast<size_t>(num_samples_per_pair);
+  return adjuster.Check() && data.Check();
+}
 
-  const StationDataset dataset = ReadStationDataset(dataset_path);
-  THROW_CHECK(fs::is_directory(input_path)) << "no sparse model folder " << input_path;
+void AddJointAdjusterOptions(const std::string& prefix,
+                             colmap::OptionManager* manager,
+                             JointAdjusterStepOptions* options) {
+  PrefixedOptions add(manager, prefix);
+  JointAdjusterOptions& adjuster = options->adjuster;
+  add.Add("sigma_lidar_m", &adjuster.sigma_lidar_m);
+  add.Add("depth_weight", &adjuster.depth_weight);
+  add.Add("lidar_weight", &adjuster.lidar_weight);
+  add.Add("loss", &adjuster.loss, "none | huber | cauchy");
+  add.Add("loss_scale", &adjuster.loss_scale);
+  add.Add("compress_lidar_blocks", &adjuster.compress_lidar_blocks);
+  add.Add("max_reprojection_error_px", &adjuster.max_reprojection_error_px);
+  add.Add("max_depth_error_sigmas", &adjuster.max_depth_error_sigmas);
+  add.Add("depth_gate_from_residual_scale", &adjuster.depth_gate_from_residual_scale);
+  add.Add("max_depth_error_m",
+          &adjuster.max_depth_error_m,
+          "absolute cap on top of the sigma gate; 0: off");
+  add.Add("max_point_to_plane_m", &adjuster.max_point_to_plane_m);
+  add.Add("max_outlier_iterations", &adjuster.max_outlier_iterations);
+  add.Add("num_association_rounds", &adjuster.num_association_rounds);
+  add.Add("num_samples_per_pair", &options->num_samples_per_pair);
+  add.Add("normal_space_sampling", &adjuster.association.normal_space_sampling);
+  add.Add("association_max_distance_m", &adjuster.association.max_distance);
+  add.Add("initial_association_distance_m", &adjuster.initial_association_distance_m);
+  add.Add("hold_rotation", &adjuster.hold_rotation);
+  add.Add(
+      "hold_translation", &options->hold_translation, "comma-separated camera axes, e.g. y or x,z");
+  add.Add("max_num_iterations", &adjuster.max_num_iterations);
+  add.Add("extrinsic_prior_sigma_m", &adjuster.extrinsic_prior_sigma_m);
+  add.Add("min_image_pair_inliers", &options->data.min_image_pair_inliers);
+  add.Add("max_lidar_neighbors", &options->data.max_lidar_neighbors);
+  add.Add("stereo_scale_sigma", &adjuster.observability.stereo_scale_sigma);
+  add.Add("two_way_lidar_clusters", &adjuster.observability.two_way_lidar_clusters);
+  add.Add("unobservable_translation_mm", &adjuster.observability.unobservable_translation_mm);
+  add.Add("unobservable_rotation_deg", &adjuster.observability.unobservable_rotation_deg);
+  add.Add("write_text", &options->write_text, "also write cameras.txt, images.txt, points3D.txt");
+}
+
+void RunJointAdjusterStep(const StationDataset& dataset,
+                          const JointAdjusterPaths& paths,
+                          JointAdjusterStepOptions options) {
+  THROW_CHECK(options.Check());
+  const auto start = std::chrono::steady_clock::now();
+  THROW_CHECK(fs::is_directory(paths.input_path)) << "no sparse model folder " << paths.input_path;
   colmap::Reconstruction reconstruction;
-  reconstruction.Read(input_path);
+  reconstruction.Read(paths.input_path);
   THROW_CHECK_GE(reconstruction.NumRegImages(), 2)
-      << input_path << " has fewer than 2 registered images";
-  colmap::Rigid3d cam_from_lidar = InitialCamFromLidar(cam_from_lidar_path, input_path, dataset);
+      << paths.input_path << " has fewer than 2 registered images";
+  colmap::Rigid3d cam_from_lidar =
+      InitialCamFromLidar(paths.cam_from_lidar_path, paths.input_path, dataset);
   const colmap::Rigid3d initial = cam_from_lidar;
-  std::cout << "Joint adjuster (" << mode << "): " << reconstruction.NumRegImages() << " images, "
-            << reconstruction.NumPoints3D() << " landmarks" << std::endl;
+  std::cout << "Joint adjuster (" << options.mode << "): " << reconstruction.NumRegImages()
+            << " images, " << reconstruction.NumPoints3D() << " landmarks" << std::endl;
   const std::unique_ptr<LoadedJointData> loaded =
-      LoadJointProblemData(*options.database_path,
+      LoadJointProblemData(paths.database_path,
                            dataset,
                            reconstruction,
                            cam_from_lidar,
-                           adjuster.mode != JointMode::kStereoOnly,
-                           data_options);
-  std::cout << "Loaded depth priors, clouds and the pose graph ("
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-            << " s)" << std::endl;
+                           options.adjuster.mode != JointMode::kStereoOnly,
+                           options.data);
+  std::cout << "Loaded depth priors, clouds and the pose graph (" << SecondsSince(start) << " s)"
+            << std::endl;
   const JointAdjustmentSummary summary =
-      JointAdjuster(adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);
+      JointAdjuster(options.adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);
 
-  PartialOutputFolder partial(output_path);
+  PartialOutputFolder partial(paths.output_path);
   reconstruction.WriteBinary(partial.Path());
-  if (write_text) reconstruction.WriteText(partial.Path());
-  WritePoseFile(
-      partial.File("cam_from_lidar.txt"),
-      "cam_from_lidar refined by colmap-lidar joint_adjuster (" + mode + "); qw qx qy qz tx ty tz",
-      cam_from_lidar);
-  WriteReport(partial.Path(), adjuster, *loaded, initial, cam_from_lidar, summary);
+  if (options.write_text) reconstruction.WriteText(partial.Path());
+  WritePoseFile(partial.File("cam_from_lidar.txt"),
+                "cam_from_lidar refined by colmap-lidar joint_adjuster (" + options.mode +
+                    "); qw qx qy qz tx ty tz",
+                cam_from_lidar);
+  WriteReport(partial.Path(), options.adjuster, *loaded, initial, cam_from_lidar, summary);
   WritePlots(partial.Path(), summary);
   partial.Commit();
   PrintUncertainty(summary);
-  std::cout << "Wrote " << output_path << " ("
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-            << " s)" << std::endl;
+  std::cout << "Wrote " << paths.output_path << " (" << SecondsSince(start) << " s)" << std::endl;
+}
+
+int RunJointAdjuster(int argc, char** argv) {
+  std::string dataset_path;
+  JointAdjusterPaths paths;
+  JointAdjusterStepOptions joint;
+  colmap::OptionManager options;
+  options.AddDatabaseOptions();
+  options.AddRequiredOption("input_path", &paths.input_path);
+  options.AddRequiredOption("dataset_path", &dataset_path);
+  options.AddRequiredOption("output_path", &paths.output_path);
+  options.AddDefaultOption("mode", &joint.mode, "joint | precalibrated | stereo_only");
+  options.AddDefaultOption("cam_from_lidar",
+                           &paths.cam_from_lidar_path,
+                           "qw qx qy qz tx ty tz file; default: INPUT/cam_from_lidar.txt, else "
+                           "rig.json's cam_from_lidar_guess");
+  AddJointAdjusterOptions("", &options, &joint);
+  options.Parse(argc, argv);
+  THROW_CHECK(joint.Check());  // before any file is read
+  paths.database_path = *options.database_path;
+  RunJointAdjusterStep(ReadStationDataset(dataset_path), paths, joint);
   return EXIT_SUCCESS;
 }
 

@@ -1,6 +1,8 @@
 #include "bridge/exe/commands.h"
+#include "bridge/exe/steps.h"
 #include "bridge/lidar_registration_files.h"
 #include "colmap_ext/logging.h"
+#include "colmap_ext/rigid3_isometry.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
 #include "lidar/lidar_pose_graph.h"
@@ -18,10 +20,6 @@ namespace colmap_lidar {
 namespace {
 
 namespace fs = std::filesystem;
-
-colmap::Rigid3d ToRigid3d(const Eigen::Isometry3d& pose) {
-  return colmap::Rigid3d(Eigen::Quaterniond(pose.linear()).normalized(), pose.translation());
-}
 
 LidarPairRecord ToRecord(const std::vector<std::string>& names, const LidarEdge& e) {
   LidarPairRecord record;
@@ -82,42 +80,9 @@ std::string Summary(const std::vector<std::string>& names,
   return summary.str();
 }
 
-}  // namespace
-
-int RunLidarRegistrator(int argc, char** argv) {
-  std::string lidar_path, output_path;
-  LidarGraphOptions graph_options;
-  StationCloudOptions cloud_options;
-  int max_neighbors = 0, sequential = 0;
-  colmap::OptionManager manager;
-  manager.AddRequiredOption("lidar_path", &lidar_path, "folder of station clouds (.pcd/.ply/.bin)");
-  manager.AddRequiredOption("output_path", &output_path, "folder for pairs.txt, lidar_poses.txt");
-  manager.AddDefaultOption("voxel_size", &cloud_options.voxel_size, "ICP/normals voxel [m]");
-  manager.AddDefaultOption("feature_voxel_size", &cloud_options.feature_voxel_size);
-  manager.AddDefaultOption("bsc_support_radius", &cloud_options.bsc.support_radius);
-  manager.AddDefaultOption(
-      "max_neighbors", &max_neighbors, "0: all pairs; k: the k most similar stations each");
-  manager.AddDefaultOption(
-      "sequential", &sequential, "k > 0: register each frame with its k successors (sweeps)");
-  manager.AddDefaultOption("min_overlap", &graph_options.pair.min_overlap);
-  manager.AddDefaultOption("max_rmse_to_noise",
-                           &graph_options.pair.max_rmse_to_noise,
-                           "ICP RMSE / the clouds' own plane noise");
-  manager.AddDefaultOption("max_rmse", &graph_options.pair.max_rmse, "absolute cap [m]; 0: none");
-  manager.AddDefaultOption("try_identity", &graph_options.pair.try_identity);
-  manager.AddDefaultOption("min_constraint_ratio", &graph_options.pair.min_constraint_ratio);
-  manager.AddDefaultOption("weak_constraint_ratio", &graph_options.pair.weak_constraint_ratio);
-  manager.AddDefaultOption("check_cycles", &graph_options.check_cycles);
-  manager.AddDefaultOption("max_cycle_translation_m", &graph_options.cycles.max_translation_m);
-  manager.AddDefaultOption("max_cycle_rotation_deg", &graph_options.cycles.max_rotation_deg);
-  manager.AddDefaultOption("robust_loss_sigmas", &graph_options.robust_loss_sigmas);
-  manager.Parse(argc, argv);
-  THROW_CHECK_GE(max_neighbors, 0) << "--max_neighbors must be >= 0";
-  THROW_CHECK_GE(sequential, 0) << "--sequential must be >= 0";
-  graph_options.max_neighbors = static_cast<size_t>(max_neighbors);
-  graph_options.sequential = static_cast<size_t>(sequential);
+// The station clouds of a folder (.pcd, .ply, .bin), sorted by name; at least two.
+std::vector<fs::path> StationCloudFiles(const std::string& lidar_path) {
   THROW_CHECK(fs::is_directory(lidar_path)) << "No such folder: " << lidar_path;
-
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(lidar_path)) {
     const std::string ext = entry.path().extension().string();
@@ -125,44 +90,98 @@ int RunLidarRegistrator(int argc, char** argv) {
   }
   std::sort(files.begin(), files.end());
   THROW_CHECK_GE(files.size(), 2) << "Fewer than 2 clouds in " << lidar_path;
+  return files;
+}
+
+}  // namespace
+
+bool LidarRegistratorStepOptions::Check() {
+  CHECK_OPTION_GE(max_neighbors, 0);
+  CHECK_OPTION_GE(sequential, 0);
+  graph.max_neighbors = static_cast<size_t>(max_neighbors);
+  graph.sequential = static_cast<size_t>(sequential);
+  return true;
+}
+
+void AddLidarRegistratorOptions(const std::string& prefix,
+                                colmap::OptionManager* manager,
+                                LidarRegistratorStepOptions* options) {
+  PrefixedOptions add(manager, prefix);
+  StationCloudOptions& cloud = options->cloud;
+  PairRegistrationOptions& pair = options->graph.pair;
+  add.Add("voxel_size", &cloud.voxel_size, "ICP/normals voxel [m]");
+  add.Add("feature_voxel_size", &cloud.feature_voxel_size);
+  add.Add("bsc_support_radius", &cloud.bsc.support_radius);
+  add.Add("max_neighbors",
+          &options->max_neighbors,
+          "0: all pairs; k: the k most similar stations each");
+  add.Add("sequential",
+          &options->sequential,
+          "k > 0: register each frame with its k successors (sweeps)");
+  add.Add("min_overlap", &pair.min_overlap);
+  add.Add("max_rmse_to_noise", &pair.max_rmse_to_noise, "ICP RMSE / the clouds' own plane noise");
+  add.Add("max_rmse", &pair.max_rmse, "absolute cap [m]; 0: none");
+  add.Add("try_identity", &pair.try_identity);
+  add.Add("min_constraint_ratio", &pair.min_constraint_ratio);
+  add.Add("weak_constraint_ratio", &pair.weak_constraint_ratio);
+  add.Add("check_cycles", &options->graph.check_cycles);
+  add.Add("max_cycle_translation_m", &options->graph.cycles.max_translation_m);
+  add.Add("max_cycle_rotation_deg", &options->graph.cycles.max_rotation_deg);
+  add.Add("robust_loss_sigmas", &options->graph.robust_loss_sigmas);
+}
+
+void RunLidarRegistratorStep(const std::string& lidar_path,
+                             const std::string& output_path,
+                             LidarRegistratorStepOptions options) {
+  THROW_CHECK(options.Check());
+  const std::vector<fs::path> files = StationCloudFiles(lidar_path);
   const auto start = std::chrono::steady_clock::now();
-  auto seconds = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
   std::vector<std::string> names;
   std::vector<std::unique_ptr<StationCloud>> stations;
   for (const fs::path& file : files) {
     CloudReadStats stats;
     const PointCloud raw = ReadPointCloud(file.string(), &stats);
-    stations.push_back(PrepareStationCloud(raw, cloud_options));
+    stations.push_back(PrepareStationCloud(raw, options.cloud));
     names.push_back(file.stem().string());
     std::cout << "lidar_registrator: " << names.back() << ": " << raw.Size() << " points ("
               << stats.num_dropped_non_finite << " non-finite dropped), "
-              << stations.back()->cloud.Size() << " after voxel " << cloud_options.voxel_size
+              << stations.back()->cloud.Size() << " after voxel " << options.cloud.voxel_size
               << " m, " << stations.back()->features.size() << " BSC features [" << std::fixed
-              << std::setprecision(1) << seconds() << " s]" << std::defaultfloat
+              << std::setprecision(1) << SecondsSince(start) << " s]" << std::defaultfloat
               << std::setprecision(6) << std::endl;
   }
   std::vector<const StationCloud*> pointers;
   for (const auto& s : stations) pointers.push_back(s.get());
   const LidarGraph graph =
-      RegisterAllStations(pointers, graph_options, [&](size_t done, size_t total) {
+      RegisterAllStations(pointers, options.graph, [&](size_t done, size_t total) {
         if (done % 10 == 0 || done == total) {
           std::cout << "lidar_registrator: registered " << done << "/" << total << " pairs ["
-                    << std::fixed << std::setprecision(1) << seconds() << " s]" << std::defaultfloat
-                    << std::setprecision(6) << std::endl;
+                    << std::fixed << std::setprecision(1) << SecondsSince(start) << " s]"
+                    << std::defaultfloat << std::setprecision(6) << std::endl;
         }
       });
 
   fs::create_directories(output_path);
   WritePairsAndPoses(output_path, names, graph);
-  const std::string summary = Summary(names, graph, seconds());
+  const std::string summary = Summary(names, graph, SecondsSince(start));
   WriteFileAtomically((fs::path(output_path) / "summary.txt").string(), summary);
   std::cout << summary;
   if (graph.num_components > 1) {
     std::cout << "lidar_registrator: WARNING: the stations form " << graph.num_components
               << " disconnected components (see summary.txt)" << std::endl;
   }
+}
+
+int RunLidarRegistrator(int argc, char** argv) {
+  std::string lidar_path, output_path;
+  LidarRegistratorStepOptions registrator;
+  colmap::OptionManager manager;
+  manager.AddRequiredOption("lidar_path", &lidar_path, "folder of station clouds (.pcd/.ply/.bin)");
+  manager.AddRequiredOption("output_path", &output_path, "folder for pairs.txt, lidar_poses.txt");
+  AddLidarRegistratorOptions("", &manager, &registrator);
+  manager.Parse(argc, argv);
+  THROW_CHECK(registrator.Check());  // before any file is read
+  RunLidarRegistratorStep(lidar_path, output_path, registrator);
   return EXIT_SUCCESS;
 }
 

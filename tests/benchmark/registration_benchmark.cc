@@ -2,6 +2,7 @@
 // SampleConsensusPrerejective on the same simulated station pairs, both followed by the same
 // point-to-plane ICP. Prints a markdown table (success rate, rotation/translation error, time).
 //   registration_benchmark DATASET_DIR [num_stations]
+#include "colmap_ext/rigid3_isometry.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
 #include "lidar/pair_registration.h"
@@ -22,13 +23,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double Since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-Eigen::Isometry3d ToIsometry(const colmap::Rigid3d& pose) {
-  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
-  result.linear() = pose.rotation.toRotationMatrix();
-  result.translation() = pose.translation;
-  return result;
 }
 
 struct FpfhCloud {

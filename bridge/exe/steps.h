@@ -1,0 +1,180 @@
+// The steps of the pipeline as typed calls. Each step has its options (an algorithm's Options struct, or
+// a small struct around it for what only the command needs), a function that registers them in a
+// colmap::OptionManager under a prefix, and a Run*Step function that prints progress and writes the
+// step's outputs. A command (`colmap-lidar joint_adjuster ...`, commands.h) registers its step's options
+// without a prefix; `pipeline` registers every step's options in one manager under the step's section
+// ("JointAdjuster.sigma_lidar_m", "StereoDepth.block_size", ...; COLMAP's own SiftExtraction.* etc. keep
+// their names), so that an option on its command line or in its --project_path .ini reaches the step,
+// as COLMAP's automatic_reconstructor does. Errors are thrown.
+#pragma once
+
+#include "bridge/densifier.h"
+#include "bridge/joint_adjuster.h"
+#include "bridge/joint_problem_data.h"
+#include "bridge/pose_initializer.h"
+#include "colmap_ext/dataset_import.h"
+#include "colmap_ext/depth_prior_extractor.h"
+#include "colmap_ext/station_dataset.h"
+#include "colmap_ext/stereo_depth.h"
+#include "lidar/lidar_pose_graph.h"
+#include "lidar/model_evaluation.h"
+#include "lidar/station_cloud.h"
+
+#include "colmap/controllers/option_manager.h"
+
+#include <chrono>
+#include <string>
+
+namespace colmap_lidar {
+
+// Wall-clock seconds since `start`, for progress lines.
+inline double SecondsSince(const std::chrono::steady_clock::time_point& start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Registers options as "<prefix><name>" with their current values as defaults.
+class PrefixedOptions {
+ public:
+  PrefixedOptions(colmap::OptionManager* manager, std::string prefix)
+      : manager_(manager), prefix_(std::move(prefix)) {}
+
+  template <typename T>
+  void Add(const std::string& name, T* value, const std::string& help = "") {
+    manager_->AddDefaultOption(prefix_ + name, value, help);
+  }
+
+ private:
+  colmap::OptionManager* manager_;
+  std::string prefix_;
+};
+
+// import_dataset: COLMAP SIFT extraction and matching, our rig and lidar_frames rows.
+struct ImportStepOptions {
+  DatasetImportOptions import;
+  // lidar_registrator's output folder, for import.matcher == "spatial".
+  std::string lidar_registration_path;
+};
+// Also registers COLMAP's SiftExtraction.*, SiftMatching.*, TwoViewGeometry.*, ExhaustiveMatching.*,
+// SequentialMatching.* and SpatialMatching.* sections (CPU SIFT by default: a headless build has no
+// OpenGL context); TakeColmapImportOptions copies them in after Parse().
+void AddImportStepOptions(const std::string& prefix,
+                          colmap::OptionManager* manager,
+                          ImportStepOptions* options);
+void TakeColmapImportOptions(const colmap::OptionManager& manager, ImportStepOptions* options);
+void RunImportStep(const StationDataset& dataset,
+                   const std::string& database_path,
+                   ImportStepOptions options);
+
+// stereo_depth: SGM depth maps of every station.
+void AddStereoDepthOptions(const std::string& prefix,
+                           colmap::OptionManager* manager,
+                           StereoDepthOptions* options);
+void RunStereoDepthStep(const StationDataset& dataset,
+                        const std::string& output_path,
+                        const StereoDepthOptions& options);
+
+// depth_prior_extractor: depth priors of the database's keypoints.
+void AddDepthPriorOptions(const std::string& prefix,
+                          colmap::OptionManager* manager,
+                          DepthPriorOptions* options);
+void RunDepthPriorStep(const std::string& database_path,
+                       const std::string& depth_path,
+                       const DepthPriorOptions& options);
+
+// lidar_registrator: BSC + RANSAC + ICP over station pairs, the LiDAR pose graph A_l.
+struct LidarRegistratorStepOptions {
+  StationCloudOptions cloud;
+  LidarGraphOptions graph;
+  // Parsed as int (the OptionManager has no size_t); copied into `graph` by Check().
+  int max_neighbors = 0;
+  int sequential = 0;
+
+  // Validates and copies max_neighbors and sequential into `graph`.
+  bool Check();
+};
+void AddLidarRegistratorOptions(const std::string& prefix,
+                                colmap::OptionManager* manager,
+                                LidarRegistratorStepOptions* options);
+void RunLidarRegistratorStep(const std::string& lidar_path,
+                             const std::string& output_path,
+                             LidarRegistratorStepOptions options);
+
+// pose_initializer: initial poses, cam_from_lidar and landmarks; or an existing model rescaled.
+void AddPoseInitializerOptions(const std::string& prefix,
+                               colmap::OptionManager* manager,
+                               PoseInitializerOptions* options);
+struct PoseInitializerPaths {
+  std::string database_path;
+  std::string registration_path;  // may be empty: no LiDAR edges
+  std::string input_path;         // an existing model to rescale; empty: initialise
+  std::string output_path;
+};
+void RunPoseInitializerStep(const StationDataset& dataset,
+                            const PoseInitializerPaths& paths,
+                            const PoseInitializerOptions& options);
+
+// joint_adjuster: the joint problem on a sparse model.
+struct JointAdjusterStepOptions {
+  JointAdjusterOptions adjuster;
+  JointDataOptions data;
+  // joint | precalibrated | stereo_only; copied into `adjuster.mode` by Check(). Registered by the
+  // joint_adjuster command, not by AddJointAdjusterOptions (the pipeline's --mode sets it).
+  std::string mode = "joint";
+  // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by Check().
+  std::string hold_translation;
+  // LiDAR samples per pair (int for the OptionManager); into `adjuster.association` by Check().
+  int num_samples_per_pair = static_cast<int>(JointAdjusterOptions().association.num_samples);
+  // Also write the model as text (cameras.txt, images.txt, points3D.txt).
+  bool write_text = false;
+
+  // Copies mode, hold_translation and num_samples_per_pair in; throws on a malformed one.
+  bool Check();
+};
+void AddJointAdjusterOptions(const std::string& prefix,
+                             colmap::OptionManager* manager,
+                             JointAdjusterStepOptions* options);
+struct JointAdjusterPaths {
+  std::string database_path;
+  std::string input_path;
+  // qw qx qy qz tx ty tz; empty: INPUT/cam_from_lidar.txt, else rig.json's guess.
+  std::string cam_from_lidar_path;
+  std::string output_path;
+};
+void RunJointAdjusterStep(const StationDataset& dataset,
+                          const JointAdjusterPaths& paths,
+                          JointAdjusterStepOptions options);
+
+// densifier: the dense model.
+void AddDensifierOptions(const std::string& prefix,
+                         colmap::OptionManager* manager,
+                         DensifierOptions* options);
+struct DensifierPaths {
+  std::string input_path;
+  std::string cam_from_lidar_path;  // empty: INPUT/cam_from_lidar.txt
+  std::string depth_path;
+  std::string output_path;
+};
+void RunDensifierStep(const StationDataset& dataset,
+                      const DensifierPaths& paths,
+                      const DensifierOptions& options);
+
+// evaluate_calibration: cam_from_lidar and station poses against ground_truth/. `output_path` empty:
+// print the metrics only. `alignment`: rigid | similarity.
+void RunEvaluateCalibrationStep(const std::string& dataset_path,
+                                const std::string& input_path,
+                                const std::string& cam_from_lidar_path,
+                                const std::string& output_path,
+                                const std::string& alignment);
+
+// evaluate_model's options but the thresholds (a list, parsed by the command).
+void AddModelEvaluationOptions(const std::string& prefix,
+                               colmap::OptionManager* manager,
+                               ModelEvaluationOptions* options);
+// evaluate_model: a cloud against ground_truth/surface.ply. `truth_from_model_path` may be empty.
+void RunEvaluateModelStep(const std::string& model_path,
+                          const std::string& ground_truth_path,
+                          const std::string& truth_from_model_path,
+                          const std::string& output_path,
+                          const ModelEvaluationOptions& options);
+
+}  // namespace colmap_lidar
