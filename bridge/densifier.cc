@@ -3,7 +3,7 @@
 #include "colmap_ext/camera_undistortion.h"
 #include "colmap_ext/dense_workspace.h"
 #include "colmap_ext/logging.h"
-#include "colmap_ext/stereo_depth.h"
+#include "colmap_ext/stereo_depth_files.h"
 #include "lidar/cloud_io.h"
 #include "lidar/pinhole_depth_image.h"
 #include "lidar/voxel_accumulator.h"
@@ -346,6 +346,67 @@ nlohmann::json StationReport(const StationDensification& station) {
           {"seconds", station.seconds}};
 }
 
+// The model in undistorted pinhole cameras: distorted ones are replaced by COLMAP's undistorted camera
+// (and the keypoints moved), as colmap::UndistortReconstruction does but for every non-pinhole model
+// (it skips models whose coefficients happen to be zero, which the workspace could not hold). The
+// undistorters resample each distorted camera's maps and images.
+colmap::Reconstruction PinholeModel(
+    const colmap::Reconstruction& input_model,
+    std::map<colmap::camera_t, std::unique_ptr<CameraUndistorter>>* undistorters) {
+  colmap::Reconstruction reconstruction = input_model;
+  for (const auto& [camera_id, camera] : input_model.Cameras()) {
+    if (IsPinholeCamera(camera)) continue;
+    reconstruction.Camera(camera_id) =
+        colmap::UndistortCamera(colmap::UndistortCameraOptions(), camera);
+    (*undistorters)[camera_id] =
+        std::make_unique<CameraUndistorter>(camera, reconstruction.Camera(camera_id));
+    std::cout << "densifier: camera " << camera_id << " (" << camera.ModelName()
+              << ") is undistorted to PINHOLE " << reconstruction.Camera(camera_id).width << "x"
+              << reconstruction.Camera(camera_id).height << std::endl;
+  }
+  if (undistorters->empty()) return reconstruction;
+  for (const auto& [image_id, image] : input_model.Images()) {
+    const colmap::Camera& original = input_model.Camera(image.CameraId());
+    const colmap::Camera& pinhole = reconstruction.Camera(image.CameraId());
+    colmap::Image& moved = reconstruction.Image(image_id);
+    for (colmap::point2D_t k = 0; k < moved.NumPoints2D(); ++k) {
+      moved.Point2D(k).xy = pinhole.ImgFromCam(original.CamFromImg(image.Point2D(k).xy));
+    }
+  }
+  return reconstruction;
+}
+
+void PrintStation(size_t k, size_t num_stations, const StationDensification& station) {
+  const LidarDepthRefinementStats& s = station.refinement;
+  std::cout << "densifier: [" << k + 1 << "/" << num_stations << "] station " << station.station
+            << ": " << s.stereo_pixels << " stereo pixels (" << s.stereo_confirmed
+            << " confirmed by LiDAR, " << s.stereo_removed << " removed), " << s.filled
+            << " filled from " << station.lidar_points_in_view << " LiDAR points in view ("
+            << std::fixed << std::setprecision(1) << station.seconds << " s)" << std::endl;
+}
+
+nlohmann::json DensifierReport(const DensifierOptions& options, const DensifierSummary& summary) {
+  nlohmann::json report;
+  report["refine_with_lidar"] = options.refine_with_lidar;
+  report["min_consistent_views"] = options.min_consistent_views;
+  report["fused_voxel_size_m"] = options.fused_voxel_size_m;
+  report["fused_points"] = summary.fused_points;
+  report["lidar_map_points"] = summary.lidar_map_points;
+  report["seconds"] = summary.seconds;
+  const LidarDepthRefinementOptions& r = options.refinement;
+  report["refinement"] = {{"window_radius_px", r.window_radius_px},
+                          {"max_abs_diff_m", r.max_abs_diff_m},
+                          {"max_rel_diff", r.max_rel_diff},
+                          {"plane_tolerance_m", r.plane_tolerance_m},
+                          {"max_normal_angle_deg", r.max_normal_angle_deg},
+                          {"max_fill_curvature", r.max_fill_curvature},
+                          {"max_fill_view_angle_deg", r.max_fill_view_angle_deg}};
+  for (const StationDensification& station : summary.stations) {
+    report["stations"].push_back(StationReport(station));
+  }
+  return report;
+}
+
 }  // namespace
 
 bool DensifierOptions::Check() const {
@@ -371,114 +432,57 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
   THROW_CHECK(options.Check());
   const auto start = std::chrono::steady_clock::now();
   const std::vector<StationView> views = StationViews(input_model, dataset);
-  // Everything below works in undistorted pinhole cameras: distorted ones are replaced by COLMAP's
-  // undistorted camera (and the keypoints moved), their maps and images resampled.
-  colmap::Reconstruction reconstruction = input_model;
   std::map<colmap::camera_t, std::unique_ptr<CameraUndistorter>> undistorters;
-  bool distorted = false;
-  for (const auto& [camera_id, camera] : input_model.Cameras()) {
-    distorted = distorted || !IsPinholeCamera(camera);
-  }
-  if (distorted) {
-    // As colmap::UndistortReconstruction, but for every non-pinhole model (it skips models whose
-    // coefficients happen to be zero, which the workspace could not hold).
-    for (const auto& [camera_id, camera] : input_model.Cameras()) {
-      if (IsPinholeCamera(camera)) continue;
-      reconstruction.Camera(camera_id) =
-          colmap::UndistortCamera(colmap::UndistortCameraOptions(), camera);
-    }
-    for (const auto& [image_id, image] : input_model.Images()) {
-      const colmap::Camera& original = input_model.Camera(image.CameraId());
-      const colmap::Camera& pinhole = reconstruction.Camera(image.CameraId());
-      colmap::Image& moved = reconstruction.Image(image_id);
-      for (colmap::point2D_t k = 0; k < moved.NumPoints2D(); ++k) {
-        moved.Point2D(k).xy = pinhole.ImgFromCam(original.CamFromImg(image.Point2D(k).xy));
-      }
-    }
-    for (const auto& [camera_id, camera] : input_model.Cameras()) {
-      if (IsPinholeCamera(camera)) continue;
-      undistorters[camera_id] =
-          std::make_unique<CameraUndistorter>(camera, reconstruction.Camera(camera_id));
-      std::cout << "densifier: camera " << camera_id << " (" << camera.ModelName()
-                << ") is undistorted to PINHOLE " << reconstruction.Camera(camera_id).width << "x"
-                << reconstruction.Camera(camera_id).height << std::endl;
-    }
-  }
+  const colmap::Reconstruction reconstruction = PinholeModel(input_model, &undistorters);
   PartialOutputFolder partial(output_path);
   DensifierSummary summary;
-  {
-    const DenseWorkspace workspace(partial.Path());
-    VoxelAccumulator lidar_map(options.lidar_map_voxel_size_m);
-    std::cout << "densifier: " << views.size() << " stations, "
-              << (options.refine_with_lidar ? "LiDAR-refined" : "stereo only") << std::endl;
-    for (size_t k = 0; k < views.size(); ++k) {
-      const auto station_start = std::chrono::steady_clock::now();
-      const colmap::camera_t camera_id = input_model.Image(views[k].image_id).CameraId();
-      const auto undistorter = undistorters.find(camera_id);
-      StationDensification station =
-          RefineStation(reconstruction,
-                        views[k],
-                        cam_from_lidar,
-                        dataset,
-                        depth_path,
-                        workspace,
-                        options,
-                        input_model.Camera(camera_id),
-                        undistorter == undistorters.end() ? nullptr : undistorter->second.get(),
-                        &lidar_map);
-      station.seconds = SecondsSince(station_start);
-      const LidarDepthRefinementStats& s = station.refinement;
-      std::cout << "densifier: [" << k + 1 << "/" << views.size() << "] station " << station.station
-                << ": " << s.stereo_pixels << " stereo pixels (" << s.stereo_confirmed
-                << " confirmed by LiDAR, " << s.stereo_removed << " removed), " << s.filled
-                << " filled from " << station.lidar_points_in_view << " LiDAR points in view ("
-                << std::fixed << std::setprecision(1) << station.seconds << " s)" << std::endl;
-      summary.stations.push_back(station);
-    }
-
-    VoxelAccumulator fused(options.fused_voxel_size_m);
-    for (size_t k = 0; k < views.size(); ++k) {
-      const auto station_start = std::chrono::steady_clock::now();
-      FuseStation(reconstruction, views, k, workspace, options, &summary.stations[k], &fused);
-      summary.stations[k].seconds += SecondsSince(station_start);
-    }
-    const PointCloud fused_cloud = fused.Extract();
-    summary.fused_points = fused_cloud.Size();
-    std::cout << "densifier: fused " << fused.NumPointsAdded() << " points into "
-              << fused_cloud.Size() << " voxels of " << options.fused_voxel_size_m * 1000 << " mm"
-              << std::endl;
-    WritePointCloud(partial.File("fused.ply"), fused_cloud);
-    PointCloud lidar_cloud = lidar_map.Extract();
-    lidar_cloud.normals.clear();
-    summary.lidar_map_points = lidar_cloud.Size();
-    WritePointCloud(partial.File("lidar_map.ply"), lidar_cloud);
-
-    workspace.WriteSparse(reconstruction);
-    std::vector<std::string> names;
-    for (const StationView& view : views) names.push_back(view.image_name);
-    workspace.WriteConfigs(names);
-
-    summary.seconds = SecondsSince(start);
-    nlohmann::json report;
-    report["refine_with_lidar"] = options.refine_with_lidar;
-    report["min_consistent_views"] = options.min_consistent_views;
-    report["fused_voxel_size_m"] = options.fused_voxel_size_m;
-    report["fused_points"] = summary.fused_points;
-    report["lidar_map_points"] = summary.lidar_map_points;
-    report["seconds"] = summary.seconds;
-    const LidarDepthRefinementOptions& r = options.refinement;
-    report["refinement"] = {{"window_radius_px", r.window_radius_px},
-                            {"max_abs_diff_m", r.max_abs_diff_m},
-                            {"max_rel_diff", r.max_rel_diff},
-                            {"plane_tolerance_m", r.plane_tolerance_m},
-                            {"max_normal_angle_deg", r.max_normal_angle_deg},
-                            {"max_fill_curvature", r.max_fill_curvature},
-                            {"max_fill_view_angle_deg", r.max_fill_view_angle_deg}};
-    for (const StationDensification& station : summary.stations) {
-      report["stations"].push_back(StationReport(station));
-    }
-    WriteFileAtomically(partial.File("densifier.json"), report.dump(2) + "\n");
+  const DenseWorkspace workspace(partial.Path());
+  VoxelAccumulator lidar_map(options.lidar_map_voxel_size_m);
+  std::cout << "densifier: " << views.size() << " stations, "
+            << (options.refine_with_lidar ? "LiDAR-refined" : "stereo only") << std::endl;
+  for (size_t k = 0; k < views.size(); ++k) {
+    const auto station_start = std::chrono::steady_clock::now();
+    const colmap::camera_t camera_id = input_model.Image(views[k].image_id).CameraId();
+    const auto undistorter = undistorters.find(camera_id);
+    summary.stations.push_back(
+        RefineStation(reconstruction,
+                      views[k],
+                      cam_from_lidar,
+                      dataset,
+                      depth_path,
+                      workspace,
+                      options,
+                      input_model.Camera(camera_id),
+                      undistorter == undistorters.end() ? nullptr : undistorter->second.get(),
+                      &lidar_map));
+    summary.stations.back().seconds = SecondsSince(station_start);
+    PrintStation(k, views.size(), summary.stations.back());
   }
+
+  VoxelAccumulator fused(options.fused_voxel_size_m);
+  for (size_t k = 0; k < views.size(); ++k) {
+    const auto station_start = std::chrono::steady_clock::now();
+    FuseStation(reconstruction, views, k, workspace, options, &summary.stations[k], &fused);
+    summary.stations[k].seconds += SecondsSince(station_start);
+  }
+  const PointCloud fused_cloud = fused.Extract();
+  summary.fused_points = fused_cloud.Size();
+  std::cout << "densifier: fused " << fused.NumPointsAdded() << " points into "
+            << fused_cloud.Size() << " voxels of " << options.fused_voxel_size_m * 1000 << " mm"
+            << std::endl;
+  WritePointCloud(partial.File("fused.ply"), fused_cloud);
+  PointCloud lidar_cloud = lidar_map.Extract();
+  lidar_cloud.normals.clear();
+  summary.lidar_map_points = lidar_cloud.Size();
+  WritePointCloud(partial.File("lidar_map.ply"), lidar_cloud);
+
+  workspace.WriteSparse(reconstruction);
+  std::vector<std::string> names;
+  for (const StationView& view : views) names.push_back(view.image_name);
+  workspace.WriteConfigs(names);
+  summary.seconds = SecondsSince(start);
+  WriteFileAtomically(partial.File("densifier.json"),
+                      DensifierReport(options, summary).dump(2) + "\n");
   partial.Commit();
   return summary;
 }

@@ -35,6 +35,131 @@ double Overlap(const StationCloud& target,
   return static_cast<double>(num_close) / num_samples;
 }
 
+using ImagePairSet = std::set<std::pair<colmap::image_t, colmap::image_t>>;
+
+// The station index of each registered image, by the image name's stem.
+std::map<colmap::image_t, size_t> StationOfImage(const StationDataset& dataset,
+                                                 const colmap::Reconstruction& reconstruction,
+                                                 const std::vector<colmap::image_t>& image_ids) {
+  std::map<std::string, size_t> station_index;
+  for (size_t i = 0; i < dataset.stations.size(); ++i) station_index[dataset.stations[i]] = i;
+  std::map<colmap::image_t, size_t> station_of_image;
+  for (const colmap::image_t image_id : image_ids) {
+    const std::string& name = reconstruction.Image(image_id).Name();
+    const auto it = station_index.find(fs::path(name).stem().string());
+    if (it == station_index.end()) {
+      throw std::runtime_error("registered image '" + name + "' is not a station of " +
+                               dataset.root);
+    }
+    station_of_image[image_id] = it->second;
+  }
+  return station_of_image;
+}
+
+// The model's image ids must be the database's (depth priors and matches are keyed by them).
+void CheckModelIsFromDatabase(const colmap::Database& database,
+                              const std::string& database_path,
+                              const colmap::Reconstruction& reconstruction,
+                              const std::vector<colmap::image_t>& image_ids) {
+  for (const colmap::image_t image_id : image_ids) {
+    const std::string& name = reconstruction.Image(image_id).Name();
+    if (!database.ExistsImage(image_id) || database.ReadImage(image_id).Name() != name) {
+      throw std::runtime_error("image " + std::to_string(image_id) + " ('" + name +
+                               "') of the model is not the same image in " + database_path +
+                               ": the model was not made from this database");
+    }
+  }
+}
+
+void ReadDepthPriors(const std::string& database_path,
+                     const std::vector<colmap::image_t>& image_ids,
+                     JointProblemData* data) {
+  const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
+  size_t num_priors = 0;
+  for (const colmap::image_t image_id : image_ids) {
+    auto& priors = data->depth_priors[image_id];
+    for (const DepthPrior& prior : extension.ReadDepthPriors(image_id)) {
+      priors[prior.point2D_idx] = prior;
+    }
+    num_priors += priors.size();
+  }
+  std::cout << "Depth priors: " << num_priors << " for " << image_ids.size() << " registered images"
+            << std::endl;
+}
+
+// A_c: COLMAP's verified pairs between registered images with enough inliers.
+ImagePairSet VerifiedImagePairs(const colmap::Database& database,
+                                const std::map<colmap::image_t, size_t>& station_of_image,
+                                int min_inliers) {
+  std::vector<std::pair<colmap::image_t, colmap::image_t>> image_pairs;
+  std::vector<int> num_inliers;
+  database.ReadTwoViewGeometryNumInliers(&image_pairs, &num_inliers);
+  ImagePairSet pairs;
+  for (size_t k = 0; k < image_pairs.size(); ++k) {
+    const auto [a, b] = image_pairs[k];
+    if (!station_of_image.count(a) || !station_of_image.count(b)) continue;
+    if (num_inliers[k] < min_inliers) continue;
+    pairs.insert({std::min(a, b), std::max(a, b)});
+  }
+  return pairs;
+}
+
+// Clouds, one station at a time (the raw cloud is dropped after downsampling).
+void LoadClouds(const StationDataset& dataset,
+                const std::vector<colmap::image_t>& image_ids,
+                const std::map<colmap::image_t, size_t>& station_of_image,
+                double voxel_size_m,
+                LoadedJointData* loaded) {
+  StationCloudOptions cloud_options;
+  cloud_options.voxel_size = voxel_size_m;
+  cloud_options.compute_features = false;
+  for (const colmap::image_t image_id : image_ids) {
+    const size_t station = station_of_image.at(image_id);
+    const PointCloud raw = ReadPointCloud(dataset.cloud_paths[station]);
+    loaded->clouds.push_back(PrepareStationCloud(raw, cloud_options));
+    loaded->data.clouds[image_id] = loaded->clouds.back().get();
+    std::cout << "  cloud " << dataset.stations[station] << ": " << raw.Size() << " points -> "
+              << loaded->clouds.back()->cloud.Size() << " after " << voxel_size_m << " m voxels"
+              << std::endl;
+  }
+}
+
+// A_l: overlapping clouds under the initial estimate; each station keeps its `max_lidar_neighbors`
+// most overlapping partners (all stations of a courtyard overlap; the term needs a connected graph,
+// not every pair).
+ImagePairSet OverlappingLidarPairs(const colmap::Reconstruction& reconstruction,
+                                   const std::vector<colmap::image_t>& image_ids,
+                                   const colmap::Rigid3d& cam_from_lidar,
+                                   const std::map<colmap::image_t, const StationCloud*>& clouds,
+                                   const JointDataOptions& options) {
+  std::vector<std::vector<std::pair<double, size_t>>> partners(image_ids.size());
+  for (size_t a = 0; a < image_ids.size(); ++a) {
+    for (size_t b = a + 1; b < image_ids.size(); ++b) {
+      const colmap::Rigid3d lidar_a_from_lidar_b =
+          colmap::Inverse(cam_from_lidar) * reconstruction.Image(image_ids[a]).CamFromWorld() *
+          colmap::Inverse(reconstruction.Image(image_ids[b]).CamFromWorld()) * cam_from_lidar;
+      const double overlap = Overlap(*clouds.at(image_ids[a]),
+                                     *clouds.at(image_ids[b]),
+                                     lidar_a_from_lidar_b,
+                                     options.lidar_overlap_distance_m);
+      if (overlap >= options.min_lidar_overlap) {
+        partners[a].emplace_back(overlap, b);
+        partners[b].emplace_back(overlap, a);
+      }
+    }
+  }
+  ImagePairSet lidar_pairs;
+  for (size_t a = 0; a < image_ids.size(); ++a) {
+    std::sort(partners[a].rbegin(), partners[a].rend());
+    const size_t keep = std::min(partners[a].size(), size_t(options.max_lidar_neighbors));
+    for (size_t k = 0; k < keep; ++k) {
+      const colmap::image_t other = image_ids[partners[a][k].second];
+      lidar_pairs.insert({std::min(image_ids[a], other), std::max(image_ids[a], other)});
+    }
+  }
+  return lidar_pairs;
+}
+
 }  // namespace
 
 bool JointDataOptions::Check() const {
@@ -56,121 +181,31 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(const std::string& databas
   THROW_CHECK(fs::is_regular_file(database_path))
       << "Database file does not exist: " << database_path;
   auto loaded = std::make_unique<LoadedJointData>();
-  std::map<std::string, size_t> station_index;
-  for (size_t i = 0; i < dataset.stations.size(); ++i) {
-    station_index[dataset.stations[i]] = i;
-  }
   std::vector<colmap::image_t> image_ids = reconstruction.RegImageIds();
   std::sort(image_ids.begin(), image_ids.end());
-  std::map<colmap::image_t, size_t> station_of_image;
-  for (const colmap::image_t image_id : image_ids) {
-    const std::string& name = reconstruction.Image(image_id).Name();
-    const auto it = station_index.find(fs::path(name).stem().string());
-    if (it == station_index.end()) {
-      throw std::runtime_error("registered image '" + name + "' is not a station of " +
-                               dataset.root);
-    }
-    station_of_image[image_id] = it->second;
-  }
-
-  // The model's image ids must be the database's (depth priors and matches are keyed by them).
+  const std::map<colmap::image_t, size_t> station_of_image =
+      StationOfImage(dataset, reconstruction, image_ids);
+  ImagePairSet pairs;
   {
     const colmap::Database database(database_path);
-    for (const colmap::image_t image_id : image_ids) {
-      const std::string& name = reconstruction.Image(image_id).Name();
-      if (!database.ExistsImage(image_id) || database.ReadImage(image_id).Name() != name) {
-        throw std::runtime_error("image " + std::to_string(image_id) + " ('" + name +
-                                 "') of the model is not the same image in " + database_path +
-                                 ": the model was not made from this database");
-      }
-    }
+    CheckModelIsFromDatabase(database, database_path, reconstruction, image_ids);
+    pairs = VerifiedImagePairs(database, station_of_image, options.min_image_pair_inliers);
   }
-
-  // Depth priors.
-  {
-    const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
-    size_t num_priors = 0;
-    for (const colmap::image_t image_id : image_ids) {
-      auto& priors = loaded->data.depth_priors[image_id];
-      for (const DepthPrior& prior : extension.ReadDepthPriors(image_id)) {
-        priors[prior.point2D_idx] = prior;
-      }
-      num_priors += priors.size();
-    }
-    std::cout << "Depth priors: " << num_priors << " for " << image_ids.size()
-              << " registered images" << std::endl;
+  ReadDepthPriors(database_path, image_ids, &loaded->data);
+  loaded->num_image_pairs = pairs.size();
+  if (load_clouds) {
+    LoadClouds(dataset, image_ids, station_of_image, options.voxel_size_m, loaded.get());
+    const ImagePairSet lidar_pairs = OverlappingLidarPairs(
+        reconstruction, image_ids, cam_from_lidar, loaded->data.clouds, options);
+    loaded->num_lidar_pairs = lidar_pairs.size();
+    pairs.insert(lidar_pairs.begin(), lidar_pairs.end());
   }
-
-  // A_c from COLMAP's verified pairs.
-  std::set<std::pair<colmap::image_t, colmap::image_t>> pairs;
-  {
-    const colmap::Database database(database_path);
-    std::vector<std::pair<colmap::image_t, colmap::image_t>> image_pairs;
-    std::vector<int> num_inliers;
-    database.ReadTwoViewGeometryNumInliers(&image_pairs, &num_inliers);
-    for (size_t k = 0; k < image_pairs.size(); ++k) {
-      auto [a, b] = image_pairs[k];
-      if (!station_of_image.count(a) || !station_of_image.count(b)) continue;
-      if (num_inliers[k] < options.min_image_pair_inliers) continue;
-      pairs.insert({std::min(a, b), std::max(a, b)});
-    }
-    loaded->num_image_pairs = pairs.size();
-  }
-  if (!load_clouds) {
-    loaded->data.pairs.assign(pairs.begin(), pairs.end());
-    return loaded;
-  }
-
-  // Clouds, one station at a time (the raw cloud is dropped after downsampling).
-  StationCloudOptions cloud_options;
-  cloud_options.voxel_size = options.voxel_size_m;
-  cloud_options.compute_features = false;
-  for (const colmap::image_t image_id : image_ids) {
-    const size_t station = station_of_image.at(image_id);
-    const PointCloud raw = ReadPointCloud(dataset.cloud_paths[station]);
-    loaded->clouds.push_back(PrepareStationCloud(raw, cloud_options));
-    loaded->data.clouds[image_id] = loaded->clouds.back().get();
-    std::cout << "  cloud " << dataset.stations[station] << ": " << raw.Size() << " points -> "
-              << loaded->clouds.back()->cloud.Size() << " after " << options.voxel_size_m
-              << " m voxels" << std::endl;
-  }
-
-  // A_l: overlapping clouds under the initial estimate; each station keeps its `max_lidar_neighbors`
-  // most overlapping partners (all stations of a courtyard overlap; the term needs a connected graph,
-  // not every pair).
-  std::vector<std::vector<std::pair<double, size_t>>> partners(image_ids.size());
-  for (size_t a = 0; a < image_ids.size(); ++a) {
-    for (size_t b = a + 1; b < image_ids.size(); ++b) {
-      const colmap::Rigid3d lidar_a_from_lidar_b =
-          colmap::Inverse(cam_from_lidar) * reconstruction.Image(image_ids[a]).CamFromWorld() *
-          colmap::Inverse(reconstruction.Image(image_ids[b]).CamFromWorld()) * cam_from_lidar;
-      const double overlap = Overlap(*loaded->data.clouds.at(image_ids[a]),
-                                     *loaded->data.clouds.at(image_ids[b]),
-                                     lidar_a_from_lidar_b,
-                                     options.lidar_overlap_distance_m);
-      if (overlap >= options.min_lidar_overlap) {
-        partners[a].emplace_back(overlap, b);
-        partners[b].emplace_back(overlap, a);
-      }
-    }
-  }
-  std::set<std::pair<colmap::image_t, colmap::image_t>> lidar_pairs;
-  for (size_t a = 0; a < image_ids.size(); ++a) {
-    std::sort(partners[a].rbegin(), partners[a].rend());
-    for (size_t k = 0;
-         k < partners[a].size() && k < static_cast<size_t>(options.max_lidar_neighbors);
-         ++k) {
-      const colmap::image_t other = image_ids[partners[a][k].second];
-      lidar_pairs.insert({std::min(image_ids[a], other), std::max(image_ids[a], other)});
-    }
-  }
-  const size_t num_lidar_pairs = lidar_pairs.size();
-  pairs.insert(lidar_pairs.begin(), lidar_pairs.end());
-  loaded->num_lidar_pairs = num_lidar_pairs;
   loaded->data.pairs.assign(pairs.begin(), pairs.end());
-  std::cout << "Pose graph: " << loaded->num_image_pairs << " image pairs (A_c), "
-            << num_lidar_pairs << " overlapping LiDAR pairs (A_l), " << loaded->data.pairs.size()
-            << " pairs in A_c v A_l" << std::endl;
+  if (load_clouds) {
+    std::cout << "Pose graph: " << loaded->num_image_pairs << " image pairs (A_c), "
+              << loaded->num_lidar_pairs << " overlapping LiDAR pairs (A_l), "
+              << loaded->data.pairs.size() << " pairs in A_c v A_l" << std::endl;
+  }
   return loaded;
 }
 

@@ -1,7 +1,7 @@
 #include "colmap_ext/depth_prior_extractor.h"
 
 #include "colmap_ext/logging.h"
-#include "colmap_ext/stereo_depth.h"
+#include "colmap_ext/stereo_depth_files.h"
 
 #include "colmap/scene/database.h"
 

@@ -1,12 +1,6 @@
 // Per-station stereo depth: rectify (StereoRectifier), OpenCV semi-global matching, left-right
 // consistency check, speckle filtering, then z-depth in the original left image's pixel grid.
-//
-// Output layout of WriteStationStereoDepth / ComputeDatasetStereoDepth (DIR = --output_path):
-//   DIR/depth_maps/<station>.png.geometric.bin   z-depth [m], COLMAP's DepthMap format, 0 = no depth
-//   DIR/confidence_maps/<station>.png            8-bit: 0 invalid, 1..255 = left-right agreement
-//   DIR/previews/<station>.png                   colour-mapped inverse depth for people (black = none)
-//   DIR/stereo.json                              rectified focal length, baseline, options, per-station
-//                                                valid fraction; written last (marks a complete run)
+// ComputeDatasetStereoDepth writes the files of stereo_depth_files.h.
 #pragma once
 
 #include "colmap_ext/station_dataset.h"
@@ -57,20 +51,6 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
                                const cv::Mat& right_image,
                                const StereoRectifier& rectifier,
                                const StereoDepthOptions& options);
-
-// Writes one station's maps into the layout above (each file atomically).
-void WriteStationStereoDepth(const std::string& output_path,
-                             const std::string& station,
-                             const StereoDepth& depth);
-
-std::string StereoDepthMapPath(const std::string& depth_path, const std::string& station);
-
-// What stereo.json records, read back by the depth-prior extractor.
-struct StereoDepthInfo {
-  double rectified_focal_px = 0;
-  double baseline_m = 0;
-};
-StereoDepthInfo ReadStereoDepthInfo(const std::string& depth_path);
 
 // All stations of a dataset, in parallel, with a progress line per station. Errors name the station.
 void ComputeDatasetStereoDepth(const StationDataset& dataset,

@@ -6,6 +6,7 @@
 #include <pcl/io/pcd_io.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -219,124 +220,162 @@ double DecodePly(const std::string& type, const char* data, bool swap) {
   return v;
 }
 
-PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) Fail(path, "cannot open the file");
+struct PlyHeader {
+  std::string format;  // ascii | binary_little_endian | binary_big_endian
+  size_t num_vertices = 0;
+  std::vector<PlyProperty> properties;  // of the vertex element
+  bool vertex_seen = false;             // while parsing: the vertex element came
+};
+
+void ParsePlyHeaderLine(const std::string& path,
+                        const std::string& line,
+                        bool* in_vertex,
+                        PlyHeader* header) {
+  std::istringstream tokens(line);
+  std::string keyword;
+  tokens >> keyword;
+  if (keyword == "format") {
+    tokens >> header->format;
+  } else if (keyword == "element") {
+    std::string name;
+    size_t count = 0;
+    tokens >> name >> count;
+    *in_vertex = name == "vertex";
+    if (*in_vertex) {
+      header->num_vertices = count;
+      header->vertex_seen = true;
+    } else if (!header->vertex_seen) {
+      Fail(path, "element '" + name + "' before 'vertex' is not supported");
+    }
+  } else if (keyword == "property" && *in_vertex) {
+    PlyProperty property;
+    tokens >> property.type;
+    if (property.type == "list") Fail(path, "list property in vertex element");
+    tokens >> property.name;
+    property.size = PlyTypeSize(property.type);
+    if (property.size == 0) Fail(path, "unknown property type '" + property.type + "'");
+    header->properties.push_back(property);
+  }
+}
+
+// The header up to and including end_header; the stream is left at the first vertex.
+PlyHeader ReadPlyHeader(const std::string& path, std::istream& file) {
   std::string line;
   std::getline(file, line);
   if (line.rfind("ply", 0) != 0) Fail(path, "not a PLY file (no 'ply' magic)");
-  std::string format;
-  size_t num_vertices = 0;
+  PlyHeader header;
   bool in_vertex = false;
-  bool vertex_seen = false;
-  std::vector<PlyProperty> properties;
   while (std::getline(file, line)) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream tokens(line);
-    std::string keyword;
-    tokens >> keyword;
-    if (keyword == "format") {
-      tokens >> format;
-    } else if (keyword == "element") {
-      std::string name;
-      size_t count = 0;
-      tokens >> name >> count;
-      if (name == "vertex") {
-        in_vertex = true;
-        vertex_seen = true;
-        num_vertices = count;
-      } else {
-        if (!vertex_seen) {
-          Fail(path, "element '" + name + "' before 'vertex' is not supported");
-        }
-        in_vertex = false;
-      }
-    } else if (keyword == "property" && in_vertex) {
-      PlyProperty property;
-      tokens >> property.type;
-      if (property.type == "list") Fail(path, "list property in vertex element");
-      tokens >> property.name;
-      property.size = PlyTypeSize(property.type);
-      if (property.size == 0) {
-        Fail(path, "unknown property type '" + property.type + "'");
-      }
-      properties.push_back(property);
-    } else if (keyword == "end_header") {
-      break;
-    }
+    if (line.rfind("end_header", 0) == 0) break;
+    ParsePlyHeaderLine(path, line, &in_vertex, &header);
   }
   if (line.rfind("end_header", 0) != 0) Fail(path, "no end_header");
-  if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") {
-    Fail(path, "unknown format '" + format + "'");
+  if (header.format != "ascii" && header.format != "binary_little_endian" &&
+      header.format != "binary_big_endian") {
+    Fail(path, "unknown format '" + header.format + "'");
   }
-  auto index_of = [&](std::initializer_list<const char*> names) {
-    for (size_t i = 0; i < properties.size(); ++i) {
-      for (const char* n : names) {
-        if (properties[i].name == n) return static_cast<int>(i);
-      }
-    }
-    return -1;
-  };
-  const int ix = index_of({"x"}), iy = index_of({"y"}), iz = index_of({"z"});
-  if (ix < 0 || iy < 0 || iz < 0) Fail(path, "no x, y, z vertex properties");
-  const int inx = index_of({"nx", "normal_x"});
-  const int iny = index_of({"ny", "normal_y"});
-  const int inz = index_of({"nz", "normal_z"});
-  const int ir = index_of({"red", "r"});
-  const int ig = index_of({"green", "g"});
-  const int ib = index_of({"blue", "b"});
-  const int ii = index_of({"intensity", "scalar_intensity", "scalar_Intensity"});
-  const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
-  const bool colors = ir >= 0 && ig >= 0 && ib >= 0;
-  CloudBuilder builder(normals, colors, ii >= 0);
-  std::vector<double> values(properties.size());
-  size_t record_size = 0;
-  for (const auto& p : properties) record_size += p.size;
-  std::vector<char> record(record_size);
-  const bool swap = format == "binary_big_endian";
-  for (size_t v = 0; v < num_vertices; ++v) {
-    if (format == "ascii") {
-      if (!std::getline(file, line)) {
-        Fail(path,
-             "truncated: " + std::to_string(v) + " of " + std::to_string(num_vertices) +
-                 " vertices");
-      }
-      std::istringstream tokens(line);
-      for (double& value : values) {
-        std::string token;
-        if (!(tokens >> token)) {
-          Fail(path, "vertex " + std::to_string(v) + " has too few values");
-        }
-        try {
-          value = std::stod(token);
-        } catch (const std::exception&) {
-          if (token == "nan" || token == "-nan") {
-            value = std::nan("");
-          } else {
-            Fail(path, "vertex " + std::to_string(v) + ": '" + token + "' is not a number");
-          }
-        }
-      }
-    } else {
-      if (!file.read(record.data(), record_size)) {
-        Fail(path,
-             "truncated: " + std::to_string(v) + " of " + std::to_string(num_vertices) +
-                 " vertices");
-      }
-      size_t offset = 0;
+  return header;
+}
+
+// Where each field of a point lies among the vertex properties (-1: absent).
+struct PlyFields {
+  explicit PlyFields(const std::vector<PlyProperty>& properties) {
+    auto index_of = [&](std::initializer_list<const char*> names) {
       for (size_t i = 0; i < properties.size(); ++i) {
-        values[i] = DecodePly(properties[i].type, record.data() + offset, swap);
-        offset += properties[i].size;
+        for (const char* n : names) {
+          if (properties[i].name == n) return static_cast<int>(i);
+        }
       }
+      return -1;
+    };
+    xyz = {index_of({"x"}), index_of({"y"}), index_of({"z"})};
+    normal = {
+        index_of({"nx", "normal_x"}), index_of({"ny", "normal_y"}), index_of({"nz", "normal_z"})};
+    rgb = {index_of({"red", "r"}), index_of({"green", "g"}), index_of({"blue", "b"})};
+    intensity = index_of({"intensity", "scalar_intensity", "scalar_Intensity"});
+  }
+  static bool All(const std::array<int, 3>& fields) {
+    return fields[0] >= 0 && fields[1] >= 0 && fields[2] >= 0;
+  }
+  std::array<int, 3> xyz, normal, rgb;
+  int intensity;
+};
+
+void ReadPlyAsciiVertex(const std::string& path,
+                        std::istream& file,
+                        size_t v,
+                        size_t num_vertices,
+                        std::vector<double>* values) {
+  std::string line;
+  if (!std::getline(file, line)) {
+    Fail(path,
+         "truncated: " + std::to_string(v) + " of " + std::to_string(num_vertices) + " vertices");
+  }
+  std::istringstream tokens(line);
+  for (double& value : *values) {
+    std::string token;
+    if (!(tokens >> token)) Fail(path, "vertex " + std::to_string(v) + " has too few values");
+    try {
+      value = std::stod(token);
+    } catch (const std::exception&) {
+      if (token != "nan" && token != "-nan") {
+        Fail(path, "vertex " + std::to_string(v) + ": '" + token + "' is not a number");
+      }
+      value = std::nan("");
     }
-    const Eigen::Vector3d point(values[ix], values[iy], values[iz]);
-    const Eigen::Vector3d normal =
-        normals ? Eigen::Vector3d(values[inx], values[iny], values[inz]) : Eigen::Vector3d::Zero();
-    const Color3ub color = colors ? Color3ub(static_cast<uint8_t>(values[ir]),
-                                             static_cast<uint8_t>(values[ig]),
-                                             static_cast<uint8_t>(values[ib]))
+  }
+}
+
+void ReadPlyBinaryVertex(const std::string& path,
+                         std::istream& file,
+                         const PlyHeader& header,
+                         size_t v,
+                         std::vector<char>* record,
+                         std::vector<double>* values) {
+  if (!file.read(record->data(), record->size())) {
+    Fail(path,
+         "truncated: " + std::to_string(v) + " of " + std::to_string(header.num_vertices) +
+             " vertices");
+  }
+  const bool swap = header.format == "binary_big_endian";
+  size_t offset = 0;
+  for (size_t i = 0; i < header.properties.size(); ++i) {
+    (*values)[i] = DecodePly(header.properties[i].type, record->data() + offset, swap);
+    offset += header.properties[i].size;
+  }
+}
+
+PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) Fail(path, "cannot open the file");
+  const PlyHeader header = ReadPlyHeader(path, file);
+  const PlyFields fields(header.properties);
+  if (!PlyFields::All(fields.xyz)) Fail(path, "no x, y, z vertex properties");
+  const bool normals = PlyFields::All(fields.normal);
+  const bool colors = PlyFields::All(fields.rgb);
+  CloudBuilder builder(normals, colors, fields.intensity >= 0);
+  std::vector<double> values(header.properties.size());
+  size_t record_size = 0;
+  for (const auto& p : header.properties) record_size += p.size;
+  std::vector<char> record(record_size);
+  auto vector_of = [&](const std::array<int, 3>& f) {
+    return Eigen::Vector3d(values[f[0]], values[f[1]], values[f[2]]);
+  };
+  for (size_t v = 0; v < header.num_vertices; ++v) {
+    if (header.format == "ascii") {
+      ReadPlyAsciiVertex(path, file, v, header.num_vertices, &values);
+    } else {
+      ReadPlyBinaryVertex(path, file, header, v, &record, &values);
+    }
+    const Color3ub color = colors ? Color3ub(static_cast<uint8_t>(values[fields.rgb[0]]),
+                                             static_cast<uint8_t>(values[fields.rgb[1]]),
+                                             static_cast<uint8_t>(values[fields.rgb[2]]))
                                   : Color3ub(0, 0, 0);
-    builder.Add(point, normal, color, ii >= 0 ? static_cast<float>(values[ii]) : 0.f);
+    builder.Add(vector_of(fields.xyz),
+                normals ? vector_of(fields.normal) : Eigen::Vector3d::Zero(),
+                color,
+                fields.intensity >= 0 ? static_cast<float>(values[fields.intensity]) : 0.f);
   }
   return builder.Finish(path, stats);
 }

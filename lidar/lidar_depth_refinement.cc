@@ -111,6 +111,211 @@ int AutomaticWindowRadius(const LidarSurface& surface,
   return std::clamp(static_cast<int>(std::lround(1.5 * spacing_px[spacing_px.size() / 2])), 3, 30);
 }
 
+// The visible samples (those owning a pixel of the z-buffer), bucketed in square cells of the window
+// radius: a pixel's window is gathered from 3 x 3 cells, not from (2 radius + 1)^2 pixels, which at
+// 12 MP and a 30 px window would be thousands of lookups per pixel.
+class SampleGrid {
+ public:
+  SampleGrid(const std::vector<Eigen::Vector2d>& xy,
+             const IndexImage& index,
+             int radius,
+             int width,
+             int height)
+      : xy_(xy),
+        index_(index),
+        radius_(radius),
+        cells_x_((width + radius - 1) / radius),
+        cells_y_((height + radius - 1) / radius) {
+    std::vector<uint8_t> visible(xy.size(), 0);
+    for (Eigen::Index k = 0; k < index.size(); ++k) {
+      if (index.data()[k] >= 0) visible[index.data()[k]] = 1;
+    }
+    cell_start_.assign(size_t(cells_x_) * cells_y_ + 1, 0);
+    for (size_t s = 0; s < xy.size(); ++s) {
+      if (visible[s]) ++cell_start_[CellOf(xy[s]) + 1];
+    }
+    for (size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
+    cell_samples_.resize(cell_start_.back());
+    std::vector<int> fill = cell_start_;
+    for (size_t s = 0; s < xy.size(); ++s) {
+      if (visible[s]) cell_samples_[fill[CellOf(xy[s])]++] = int(s);
+    }
+  }
+
+  // The visible samples whose projection lies within the radius of the pixel's centre, and the
+  // sample owning the pixel (a splat may reach it from farther away).
+  void Window(int col, int row, std::vector<int>* window) const {
+    window->clear();
+    const Eigen::Vector2d centre(col + 0.5, row + 0.5);
+    const int cell_x = col / radius_, cell_y = row / radius_;
+    for (int cy = std::max(0, cell_y - 1); cy <= std::min(cells_y_ - 1, cell_y + 1); ++cy) {
+      for (int cx = std::max(0, cell_x - 1); cx <= std::min(cells_x_ - 1, cell_x + 1); ++cx) {
+        const size_t c = size_t(cy) * cells_x_ + cx;
+        for (int k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
+          const int s = cell_samples_[k];
+          if ((xy_[s] - centre).squaredNorm() <= double(radius_) * radius_) window->push_back(s);
+        }
+      }
+    }
+    const int owner = index_(row, col);
+    if (owner >= 0 && std::find(window->begin(), window->end(), owner) == window->end()) {
+      window->push_back(owner);
+    }
+  }
+
+ private:
+  size_t CellOf(const Eigen::Vector2d& xy) const {  // visible samples may lie just outside
+    const int cx = std::clamp(static_cast<int>(std::floor(xy.x())) / radius_, 0, cells_x_ - 1);
+    const int cy = std::clamp(static_cast<int>(std::floor(xy.y())) / radius_, 0, cells_y_ - 1);
+    return size_t(cy) * cells_x_ + cx;
+  }
+
+  const std::vector<Eigen::Vector2d>& xy_;
+  const IndexImage& index_;
+  const int radius_, cells_x_, cells_y_;
+  std::vector<int> cell_start_;
+  std::vector<int> cell_samples_;
+};
+
+// The LiDAR layer at a pixel: the window's samples on the plane of the sample nearest the pixel.
+struct Layer {
+  std::vector<int> samples;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double plane_offset = 0;  // n . x on the layer's plane
+  double curvature = 0;     // the largest of its samples
+  bool has_plane = false;   // the plane is seen at less than 85 deg and in front of the camera
+  double lidar_z = 0;       // the plane's depth along the pixel's ray
+};
+
+void FitLayer(const LidarSurface& surface,
+              const std::vector<Eigen::Vector2d>& xy,
+              const std::vector<int>& window,
+              int owner,
+              const Eigen::Vector2d& centre,
+              const Eigen::Vector3d& ray,
+              double min_normal_cos,
+              double plane_tolerance_m,
+              Layer* layer) {
+  layer->samples.clear();
+  layer->has_plane = false;
+  layer->curvature = 0;
+  if (window.empty()) return;
+  int nearest = owner;
+  if (nearest < 0) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int s : window) {
+      const double d = (xy[s] - centre).squaredNorm();
+      if (d < best) best = d, nearest = s;
+    }
+  }
+  const Eigen::Vector3d& n0 = surface.normals[nearest];
+  const Eigen::Vector3d& x0 = surface.points[nearest];
+  Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (int s : window) {
+    if (std::abs(n0.dot(surface.points[s] - x0)) <= plane_tolerance_m &&
+        n0.dot(surface.normals[s]) >= min_normal_cos) {
+      layer->samples.push_back(s);
+      normal_sum += surface.normals[s];
+      centroid += surface.points[s];
+      layer->curvature = std::max(layer->curvature, double(surface.curvature[s]));
+    }
+  }
+  layer->normal = normal_sum.normalized();
+  centroid /= double(layer->samples.size());
+  layer->plane_offset = layer->normal.dot(centroid);
+  static const double kMinRayCos = std::cos(DegToRad(85));
+  if (std::abs(layer->normal.dot(ray.normalized())) > kMinRayCos) {
+    layer->lidar_z = layer->plane_offset / layer->normal.dot(ray);
+    layer->has_plane = layer->lidar_z > 0;
+  }
+}
+
+void AddStats(const LidarDepthRefinementStats& local, LidarDepthRefinementStats* stats) {
+  stats->stereo_pixels += local.stereo_pixels;
+  stats->stereo_without_lidar += local.stereo_without_lidar;
+  stats->stereo_confirmed += local.stereo_confirmed;
+  stats->stereo_removed += local.stereo_removed;
+  stats->filled += local.filled;
+  stats->fill_refused_edge += local.fill_refused_edge;
+  stats->fill_refused_sparse += local.fill_refused_sparse;
+  stats->fill_refused_view_angle += local.fill_refused_view_angle;
+  stats->fill_refused_curvature += local.fill_refused_curvature;
+}
+
+void CheckDepthMapSize(const DepthImage& stereo, const PinholeIntrinsics& intrinsics) {
+  ThrowUnlessValid(intrinsics, "PinholeIntrinsics");
+  if (stereo.rows() != intrinsics.height || stereo.cols() != intrinsics.width) {
+    throw std::invalid_argument(
+        "RefineDepthWithLidar: the depth map is " + std::to_string(stereo.cols()) + "x" +
+        std::to_string(stereo.rows()) + " but the camera is " + std::to_string(intrinsics.width) +
+        "x" + std::to_string(intrinsics.height));
+  }
+}
+
+// The result at one pixel.
+struct PixelDepth {
+  float depth = 0;
+  DepthSource source = DepthSource::kNone;
+  bool lidar_normal = false;  // the layer's normal applies
+};
+
+// Fold 1 (paper, mapping step (1)) on a stereo pixel. Disagreement is the stereo point's distance to
+// the LiDAR plane (what the model's accuracy is measured by), not the depth difference along the
+// ray, which an obliquely seen plane magnifies by 1 / cos(view angle).
+PixelDepth JudgeStereo(float stereo_z,
+                       const Eigen::Vector3d& ray,
+                       const Layer& layer,
+                       FillVerdict verdict,
+                       const LidarDepthRefinementOptions& options,
+                       LidarDepthRefinementStats* stats) {
+  const double distance = std::abs(layer.normal.dot(ray * double(stereo_z)) - layer.plane_offset);
+  const bool flat_layer = layer.has_plane && layer.curvature <= options.max_check_curvature;
+  const bool replaceable = verdict == FillVerdict::kFill;
+  const double agreement = options.max_abs_diff_m + options.max_rel_diff * layer.lidar_z;
+  const double tolerance = replaceable ? agreement : options.max_unreplaceable_diff_m;
+  if (!flat_layer || !options.remove_inconsistent) {
+    ++stats->stereo_without_lidar;  // kept, not judged
+    return {stereo_z, DepthSource::kStereo, false};
+  }
+  if (distance <= tolerance) {
+    if (distance <= agreement) {
+      ++stats->stereo_confirmed;
+      return {stereo_z, DepthSource::kStereo, true};
+    }
+    ++stats->stereo_without_lidar;  // off, but nothing better to put there
+    return {stereo_z, DepthSource::kStereo, false};
+  }
+  ++stats->stereo_removed;
+  if (!replaceable) return {0, DepthSource::kRemoved, false};
+  ++stats->filled;
+  return {float(layer.lidar_z), DepthSource::kLidar, true};
+}
+
+// Fold 2 on a pixel without stereo depth: filled from the layer, or counted by why not.
+PixelDepth FillHole(const Layer& layer, FillVerdict verdict, LidarDepthRefinementStats* stats) {
+  switch (verdict) {
+    case FillVerdict::kFill:
+      ++stats->filled;
+      return {float(layer.lidar_z), DepthSource::kLidar, true};
+    case FillVerdict::kEdge:
+      ++stats->fill_refused_edge;
+      break;
+    case FillVerdict::kSparse:
+      ++stats->fill_refused_sparse;
+      break;
+    case FillVerdict::kViewAngle:
+      ++stats->fill_refused_view_angle;
+      break;
+    case FillVerdict::kCurvature:
+      ++stats->fill_refused_curvature;
+      break;
+    case FillVerdict::kNoLayer:
+      break;
+  }
+  return {};
+}
+
 }  // namespace
 
 bool LidarDepthRefinementOptions::Check() const {
@@ -133,13 +338,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
                                   const PinholeIntrinsics& intrinsics,
                                   const LidarDepthRefinementOptions& options) {
   ThrowUnlessValid(options, "LidarDepthRefinementOptions");
-  ThrowUnlessValid(intrinsics, "PinholeIntrinsics");
-  if (stereo.rows() != intrinsics.height || stereo.cols() != intrinsics.width) {
-    throw std::invalid_argument(
-        "RefineDepthWithLidar: the depth map is " + std::to_string(stereo.cols()) + "x" +
-        std::to_string(stereo.rows()) + " but the camera is " + std::to_string(intrinsics.width) +
-        "x" + std::to_string(intrinsics.height));
-  }
+  CheckDepthMapSize(stereo, intrinsics);
   const int width = intrinsics.width;
   const int height = intrinsics.height;
   const std::vector<Eigen::Vector2d> xy = ProjectSamples(surface, intrinsics);
@@ -147,205 +346,63 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
                                                   : AutomaticWindowRadius(surface, xy, intrinsics);
   // Footprints reach at most half the window: a sample never hides a whole window.
   const IndexImage index = Splat(surface, xy, intrinsics, std::max(1, radius / 2));
-  // The visible samples (those owning a pixel of the z-buffer), bucketed in cells of the window's
-  // size: a pixel's window is gathered from 3 x 3 cells, not from (2 radius + 1)^2 pixels, which at
-  // 12 MP and a 30 px window would be thousands of lookups per pixel.
-  const int cell = radius;
-  const int cells_x = (width + cell - 1) / cell, cells_y = (height + cell - 1) / cell;
-  std::vector<uint8_t> visible(surface.Size(), 0);
-  for (Eigen::Index k = 0; k < index.size(); ++k) {
-    if (index.data()[k] >= 0) visible[index.data()[k]] = 1;
-  }
-  std::vector<int> cell_start(size_t(cells_x) * cells_y + 1, 0);
-  auto cell_of = [&](int s) {  // visible samples may project just outside the image
-    const int cx = std::clamp(static_cast<int>(std::floor(xy[s].x())) / cell, 0, cells_x - 1);
-    const int cy = std::clamp(static_cast<int>(std::floor(xy[s].y())) / cell, 0, cells_y - 1);
-    return size_t(cy) * cells_x + cx;
-  };
-  for (size_t s = 0; s < surface.Size(); ++s) {
-    if (visible[s]) ++cell_start[cell_of(static_cast<int>(s)) + 1];
-  }
-  for (size_t c = 1; c < cell_start.size(); ++c) cell_start[c] += cell_start[c - 1];
-  std::vector<int> cell_samples(cell_start.back());
-  {
-    std::vector<int> fill = cell_start;
-    for (size_t s = 0; s < surface.Size(); ++s) {
-      if (visible[s]) cell_samples[fill[cell_of(static_cast<int>(s))]++] = int(s);
-    }
-  }
+  const SampleGrid grid(xy, index, radius, width, height);
   const double min_normal_cos = std::cos(DegToRad(options.max_normal_angle_deg));
   const double min_view_cos = std::cos(DegToRad(options.max_fill_view_angle_deg));
-  const double kMinRayCos = std::cos(DegToRad(85));
 
   RefinedDepth result;
   result.depth = DepthImage::Zero(height, width);
   result.normals = NormalImage(width, height);
   result.source.assign(size_t(width) * height, DepthSource::kNone);
-  LidarDepthRefinementStats stats;
-
 #pragma omp parallel
   {
     LidarDepthRefinementStats local;
     std::vector<int> window;
-    std::vector<int> layer;
+    Layer layer;
 #pragma omp for schedule(dynamic, 8)
     for (int row = 0; row < height; ++row) {
       for (int col = 0; col < width; ++col) {
-        const size_t pixel = size_t(row) * width + col;
         const float stereo_z = stereo(row, col);
         const bool has_stereo = stereo_z > 0 && std::isfinite(stereo_z);
         local.stereo_pixels += has_stereo;
-
-        // The window: the visible samples whose projection lies within `radius` of the pixel.
-        window.clear();
-        const Eigen::Vector2d pixel_centre(col + 0.5, row + 0.5);
-        const int cell_x = col / cell, cell_y = row / cell;
-        for (int cy = std::max(0, cell_y - 1); cy <= std::min(cells_y - 1, cell_y + 1); ++cy) {
-          for (int cx = std::max(0, cell_x - 1); cx <= std::min(cells_x - 1, cell_x + 1); ++cx) {
-            const size_t c = size_t(cy) * cells_x + cx;
-            for (int k = cell_start[c]; k < cell_start[c + 1]; ++k) {
-              const int s = cell_samples[k];
-              if ((xy[s] - pixel_centre).squaredNorm() <= double(radius) * radius) {
-                window.push_back(s);
-              }
-            }
-          }
-        }
-        if (index(row, col) >= 0 &&
-            std::find(window.begin(), window.end(), index(row, col)) == window.end()) {
-          window.push_back(index(row, col));  // a splat reaching the pixel from farther away
-        }
-
-        // The layer of the visible sample nearest the pixel, and its plane.
+        grid.Window(col, row, &window);
         const Eigen::Vector2d centre(col + 0.5, row + 0.5);
         const Eigen::Vector3d ray = intrinsics.PixelRay(col, row);
-        const Eigen::Vector3d unit_ray = ray.normalized();
-        bool has_plane = false;
-        double lidar_z = 0;
-        double layer_curvature = 0;
-        double plane_offset = 0;  // n . x on the layer's plane
-        Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-        layer.clear();
-        if (!window.empty()) {
-          int nearest = index(row, col);
-          if (nearest < 0) {
-            double best = std::numeric_limits<double>::infinity();
-            for (int s : window) {
-              const double d = (xy[s] - centre).squaredNorm();
-              if (d < best) best = d, nearest = s;
-            }
-          }
-          const Eigen::Vector3d& n0 = surface.normals[nearest];
-          const Eigen::Vector3d& x0 = surface.points[nearest];
-          Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
-          Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-          for (int s : window) {
-            if (std::abs(n0.dot(surface.points[s] - x0)) <= options.plane_tolerance_m &&
-                n0.dot(surface.normals[s]) >= min_normal_cos) {
-              layer.push_back(s);
-              normal_sum += surface.normals[s];
-              centroid += surface.points[s];
-            }
-          }
-          for (int s : layer) {
-            layer_curvature = std::max(layer_curvature, double(surface.curvature[s]));
-          }
-          normal = normal_sum.normalized();
-          centroid /= double(layer.size());
-          const double denominator = normal.dot(ray);
-          plane_offset = normal.dot(centroid);
-          if (std::abs(normal.dot(unit_ray)) > kMinRayCos) {
-            lidar_z = plane_offset / denominator;
-            has_plane = lidar_z > 0;
-          }
-        }
-
+        FitLayer(surface,
+                 xy,
+                 window,
+                 index(row, col),
+                 centre,
+                 ray,
+                 min_normal_cos,
+                 options.plane_tolerance_m,
+                 &layer);
         // Fold 2's verdict (paper, mapping step (2)): only inside one flat, well-observed LiDAR
         // layer that surrounds the pixel. With a second surface in the window (a depth edge or a
         // crease) the layer must surround the pixel on all four sides: a pixel beyond the layer's
         // border, on the other surface, never has layer samples on the other surface's side.
-        const FillVerdict verdict = has_plane && options.fill_holes ? JudgeFill(layer,
-                                                                                window.size(),
-                                                                                xy,
-                                                                                centre,
-                                                                                normal,
-                                                                                unit_ray,
-                                                                                layer_curvature,
-                                                                                min_view_cos,
-                                                                                options)
-                                                                    : FillVerdict::kNoLayer;
-
-        if (has_stereo) {
-          // Fold 1 (paper, mapping step (1)). Disagreement is the stereo point's distance to the
-          // LiDAR plane (what the model's accuracy is measured by), not the depth difference along
-          // the ray, which an obliquely seen plane magnifies by 1 / cos(view angle).
-          const double distance = std::abs(normal.dot(ray * double(stereo_z)) - plane_offset);
-          const bool flat_layer = has_plane && layer_curvature <= options.max_check_curvature;
-          const bool replaceable = verdict == FillVerdict::kFill;
-          const double tolerance = replaceable
-                                       ? options.max_abs_diff_m + options.max_rel_diff * lidar_z
-                                       : options.max_unreplaceable_diff_m;
-          if (!flat_layer || !options.remove_inconsistent) {
-            ++local.stereo_without_lidar;  // kept, not judged
-          } else if (distance <= tolerance) {
-            if (distance <= options.max_abs_diff_m + options.max_rel_diff * lidar_z) {
-              ++local.stereo_confirmed;
-              result.normals.normals[pixel] = normal.cast<float>();
-            } else {
-              ++local.stereo_without_lidar;  // off, but nothing better to put there
-            }
-          } else {
-            ++local.stereo_removed;
-            result.source[pixel] = DepthSource::kRemoved;
-            if (replaceable) {
-              ++local.filled;
-              result.depth(row, col) = float(lidar_z);
-              result.normals.normals[pixel] = normal.cast<float>();
-              result.source[pixel] = DepthSource::kLidar;
-            }
-            continue;
-          }
-          result.depth(row, col) = stereo_z;
-          result.source[pixel] = DepthSource::kStereo;
-          continue;
-        }
-
-        switch (verdict) {
-          case FillVerdict::kFill:
-            result.depth(row, col) = float(lidar_z);
-            result.normals.normals[pixel] = normal.cast<float>();
-            result.source[pixel] = DepthSource::kLidar;
-            ++local.filled;
-            break;
-          case FillVerdict::kEdge:
-            ++local.fill_refused_edge;
-            break;
-          case FillVerdict::kSparse:
-            ++local.fill_refused_sparse;
-            break;
-          case FillVerdict::kViewAngle:
-            ++local.fill_refused_view_angle;
-            break;
-          case FillVerdict::kCurvature:
-            ++local.fill_refused_curvature;
-            break;
-          case FillVerdict::kNoLayer:
-            break;
-        }
+        const FillVerdict verdict = layer.has_plane && options.fill_holes
+                                        ? JudgeFill(layer.samples,
+                                                    window.size(),
+                                                    xy,
+                                                    centre,
+                                                    layer.normal,
+                                                    ray.normalized(),
+                                                    layer.curvature,
+                                                    min_view_cos,
+                                                    options)
+                                        : FillVerdict::kNoLayer;
+        const PixelDepth pixel = has_stereo
+                                     ? JudgeStereo(stereo_z, ray, layer, verdict, options, &local)
+                                     : FillHole(layer, verdict, &local);
+        const size_t k = size_t(row) * width + col;
+        result.depth(row, col) = pixel.depth;
+        result.source[k] = pixel.source;
+        if (pixel.lidar_normal) result.normals.normals[k] = layer.normal.cast<float>();
       }
     }
 #pragma omp critical
-    {
-      stats.stereo_pixels += local.stereo_pixels;
-      stats.stereo_without_lidar += local.stereo_without_lidar;
-      stats.stereo_confirmed += local.stereo_confirmed;
-      stats.stereo_removed += local.stereo_removed;
-      stats.filled += local.filled;
-      stats.fill_refused_edge += local.fill_refused_edge;
-      stats.fill_refused_sparse += local.fill_refused_sparse;
-      stats.fill_refused_view_angle += local.fill_refused_view_angle;
-      stats.fill_refused_curvature += local.fill_refused_curvature;
-    }
+    AddStats(local, &result.stats);
   }
 
   // Stereo pixels without a LiDAR layer take their normal from the depth map.
@@ -355,8 +412,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
       result.normals.normals[pixel] = from_depth.normals[pixel];
     }
   }
-  stats.window_radius_px = radius;
-  result.stats = stats;
+  result.stats.window_radius_px = radius;
   return result;
 }
 

@@ -42,6 +42,93 @@ double Percentile(std::vector<double> values, double q) {
   return values[k];
 }
 
+// The sampling spacing of the truth: median nearest-neighbour distance over a subset.
+double TruthSpacing(const PointCloud& truth, const KdTree3& truth_tree) {
+  std::vector<double> spacings;
+  for (size_t i = 0; i < truth.Size(); i += std::max<size_t>(1, truth.Size() / 2000)) {
+    std::vector<size_t> indices;
+    std::vector<double> squared;
+    truth_tree.KNearest(truth.points[i], 2, &indices, &squared);
+    if (squared.size() == 2) spacings.push_back(std::sqrt(squared[1]));
+  }
+  return std::max(1e-6, Percentile(spacings, 0.5));
+}
+
+// Rigid point-to-plane ICP of the model points near the structure (within the crop distance).
+void AlignByIcp(const PointCloud& model,
+                const PointCloud& truth,
+                const KdTree3& truth_tree,
+                double spacing,
+                const ModelEvaluationOptions& options,
+                ModelEvaluation* result) {
+  PointCloud cropped;
+  for (size_t i = 0; i < model.Size(); ++i) {
+    size_t index;
+    double squared;
+    truth_tree.Nearest(model.points[i], &index, &squared);
+    if (squared <= options.crop_distance_m * options.crop_distance_m) {
+      cropped.points.push_back(model.points[i]);
+    }
+  }
+  if (cropped.Size() < 6) return;
+  IcpOptions icp;
+  icp.max_iterations = std::max(1, options.icp_max_iterations);
+  icp.max_correspondence_distance = options.crop_distance_m;
+  icp.min_correspondence_distance = std::min(options.crop_distance_m, 4 * spacing);
+  icp.max_source_points = 100000;
+  const IcpResult aligned =
+      PointToPlaneIcp(cropped, truth, truth_tree, Eigen::Isometry3d::Identity(), icp);
+  result->truth_from_model = aligned.target_from_source;
+  result->icp_converged = aligned.converged;
+  result->icp_iterations = aligned.iterations;
+}
+
+void SummariseDistances(ModelEvaluation* result) {
+  const std::vector<double>& distances = result->distances;
+  double sum = 0, sum_squared = 0;
+  for (double d : distances) {
+    sum += d;
+    sum_squared += d * d;
+  }
+  result->mean = sum / distances.size();
+  result->rmse = std::sqrt(sum_squared / distances.size());
+  result->median = Percentile(distances, 0.5);
+  result->p90 = Percentile(distances, 0.9);
+  result->p95 = Percentile(distances, 0.95);
+  result->p99 = Percentile(distances, 0.99);
+  result->max = *std::max_element(distances.begin(), distances.end());
+}
+
+// Precision (model to truth) and completeness (truth to model, from each truth sample to the nearest
+// evaluated model point, queried once) at each threshold.
+void ScoreThresholds(const PointCloud& truth,
+                     const std::vector<Eigen::Vector3d>& evaluated_points,
+                     const std::vector<double>& thresholds_m,
+                     ModelEvaluation* result) {
+  const KdTree3 model_tree(evaluated_points);
+  std::vector<double> truth_to_model(truth.Size());
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < truth.Size(); ++i) {
+    size_t index;
+    double squared;
+    model_tree.Nearest(truth.points[i], &index, &squared);
+    truth_to_model[i] = std::sqrt(squared);
+  }
+  for (double threshold : thresholds_m) {
+    ModelEvaluation::AtThreshold at;
+    at.threshold = threshold;
+    size_t precise = 0, complete = 0;
+    for (double d : result->distances) precise += d <= threshold;
+    for (double d : truth_to_model) complete += d <= threshold;
+    at.precision = static_cast<double>(precise) / result->distances.size();
+    at.completeness = static_cast<double>(complete) / truth.Size();
+    at.f_score = at.precision + at.completeness > 0
+                     ? 2 * at.precision * at.completeness / (at.precision + at.completeness)
+                     : 0;
+    result->at_thresholds.push_back(at);
+  }
+}
+
 }  // namespace
 
 bool ModelEvaluationOptions::Check() const {
@@ -63,89 +150,23 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
   result.num_model_points = model.Size();
   result.num_truth_points = truth.Size();
   const KdTree3 truth_tree(truth.points);
-
-  // The sampling spacing of the truth: median nearest-neighbour distance over a subset.
-  std::vector<double> spacings;
-  for (size_t i = 0; i < truth.Size(); i += std::max<size_t>(1, truth.Size() / 2000)) {
-    std::vector<size_t> indices;
-    std::vector<double> squared;
-    truth_tree.KNearest(truth.points[i], 2, &indices, &squared);
-    if (squared.size() == 2) spacings.push_back(std::sqrt(squared[1]));
-  }
-  const double spacing = std::max(1e-6, Percentile(spacings, 0.5));
-
-  // Crop: the points near the structure; ICP works on them.
-  PointCloud cropped;
-  for (size_t i = 0; i < model.Size(); ++i) {
-    size_t index;
-    double squared;
-    truth_tree.Nearest(model.points[i], &index, &squared);
-    if (squared <= options.crop_distance_m * options.crop_distance_m) {
-      cropped.points.push_back(model.points[i]);
-    }
-  }
-  if (options.align_icp && cropped.Size() >= 6) {
-    IcpOptions icp;
-    icp.max_iterations = std::max(1, options.icp_max_iterations);
-    icp.max_correspondence_distance = options.crop_distance_m;
-    icp.min_correspondence_distance = std::min(options.crop_distance_m, 4 * spacing);
-    icp.max_source_points = 100000;
-    const IcpResult aligned =
-        PointToPlaneIcp(cropped, truth, truth_tree, Eigen::Isometry3d::Identity(), icp);
-    result.truth_from_model = aligned.target_from_source;
-    result.icp_converged = aligned.converged;
-    result.icp_iterations = aligned.iterations;
-  }
-  std::vector<Eigen::Vector3d> moved;
+  const double spacing = TruthSpacing(truth, truth_tree);
+  if (options.align_icp) AlignByIcp(model, truth, truth_tree, spacing, options, &result);
   // After alignment, evaluate all model points within the crop distance.
+  std::vector<Eigen::Vector3d> evaluated_points;
   for (size_t i = 0; i < model.Size(); ++i) {
     const Eigen::Vector3d p = result.truth_from_model * model.points[i];
     const double d = DistanceToSampledSurface(truth, truth_tree, spacing, p);
     if (d <= options.crop_distance_m) {
       result.distances.push_back(d);
       result.evaluated_indices.push_back(i);
-      moved.push_back(p);
+      evaluated_points.push_back(p);
     }
   }
   result.num_evaluated = result.distances.size();
   if (result.distances.empty()) return result;
-
-  double sum = 0, sum_squared = 0;
-  for (double d : result.distances) {
-    sum += d;
-    sum_squared += d * d;
-  }
-  result.mean = sum / result.distances.size();
-  result.rmse = std::sqrt(sum_squared / result.distances.size());
-  result.median = Percentile(result.distances, 0.5);
-  result.p90 = Percentile(result.distances, 0.9);
-  result.p95 = Percentile(result.distances, 0.95);
-  result.p99 = Percentile(result.distances, 0.99);
-  result.max = *std::max_element(result.distances.begin(), result.distances.end());
-
-  // Completeness: distance from each truth sample to the nearest model point, queried once.
-  const KdTree3 model_tree(moved);
-  std::vector<double> truth_to_model(truth.Size());
-#pragma omp parallel for schedule(static)
-  for (size_t i = 0; i < truth.Size(); ++i) {
-    size_t index;
-    double squared;
-    model_tree.Nearest(truth.points[i], &index, &squared);
-    truth_to_model[i] = std::sqrt(squared);
-  }
-  for (double threshold : options.thresholds_m) {
-    ModelEvaluation::AtThreshold at;
-    at.threshold = threshold;
-    size_t precise = 0, complete = 0;
-    for (double d : result.distances) precise += d <= threshold;
-    for (double d : truth_to_model) complete += d <= threshold;
-    at.precision = static_cast<double>(precise) / result.distances.size();
-    at.completeness = static_cast<double>(complete) / truth.Size();
-    at.f_score = at.precision + at.completeness > 0
-                     ? 2 * at.precision * at.completeness / (at.precision + at.completeness)
-                     : 0;
-    result.at_thresholds.push_back(at);
-  }
+  SummariseDistances(&result);
+  ScoreThresholds(truth, evaluated_points, options.thresholds_m, &result);
 
   // Density on the structure: evaluated points per cm^2 of the true surface they cover. Each truth
   // sample stands for spacing^2 of surface; the covered part is the completeness at the largest threshold.
