@@ -4,23 +4,55 @@ function(colmap_lidar_set_warnings target)
                                            -Wno-sign-compare)
 endfunction()
 
-# colmap_lidar_add_test(NAME module/name SOURCES a_test.cc LINKS lib...)
-# registers one GoogleTest executable in ctest under the given name prefix.
+# colmap_lidar_add_test(NAME module/name SOURCES a_test.cc LINKS lib... [FILTER gtest_filter]
+#                       [LABEL unit|integration|slow] [COST seconds]
+#                       [FIXTURES_SETUP name] [FIXTURES_REQUIRED name])
+# builds one GoogleTest executable and registers its test cases (those matching FILTER, default all) in
+# ctest under the given name prefix, each case a ctest test; colmap_lidar_discover_tests registers
+# further cases of the same executable with other properties.
 function(colmap_lidar_add_test)
-  # COST: CTest starts costlier tests first under -j, so that a long integration test does not run
-  # alone at the end (a clean checkout has no timing history to order by).
-  cmake_parse_arguments(ARG "" "NAME;COST" "SOURCES;LINKS" ${ARGN})
-  if(NOT ARG_COST)
-    set(ARG_COST 0)
-  endif()
+  cmake_parse_arguments(ARG "" "NAME;COST;LABEL;FILTER;FIXTURES_SETUP;FIXTURES_REQUIRED"
+                        "SOURCES;LINKS" ${ARGN})
   string(REPLACE "/" "_" exe ${ARG_NAME})
   add_executable(${exe} ${ARG_SOURCES})
   target_link_libraries(${exe} PRIVATE ${ARG_LINKS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${exe} PRIVATE
     COLMAP_LIDAR_COLMAP_EXE="${COLMAP_LIDAR_COLMAP_EXE}"
-    COLMAP_LIDAR_CLI_EXE="${CMAKE_BINARY_DIR}/bin/colmap-lidar")
+    COLMAP_LIDAR_CLI_EXE="${CMAKE_BINARY_DIR}/bin/colmap-lidar"
+    COLMAP_LIDAR_TEST_FIXTURES="${CMAKE_BINARY_DIR}/test_fixtures")
   colmap_lidar_set_warnings(${exe})
   set_target_properties(${exe} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
-  gtest_discover_tests(${exe} TEST_PREFIX "${ARG_NAME}/" DISCOVERY_TIMEOUT 60
-                       PROPERTIES TIMEOUT 1200 COST ${ARG_COST})
+  colmap_lidar_discover_tests(TARGET ${exe} ${ARGN})
+endfunction()
+
+# colmap_lidar_discover_tests(TARGET exe NAME module/name [FILTER ...] [LABEL ...] [COST ...]
+#                             [FIXTURES_SETUP name] [FIXTURES_REQUIRED name])
+# LABEL (default unit): `ctest -L unit` runs the tests beside the sources; `ctest -LE slow` the quick
+# set. COST: CTest starts costlier tests first under -j, so that a long test does not run alone at the
+# end (a clean checkout has no timing history to order by). FIXTURES_*: CTest fixtures, for tests that
+# read what another test built (it runs first, once).
+function(colmap_lidar_discover_tests)
+  cmake_parse_arguments(ARG "" "TARGET;NAME;COST;LABEL;FILTER;FIXTURES_SETUP;FIXTURES_REQUIRED"
+                        "SOURCES;LINKS" ${ARGN})
+  if(NOT ARG_COST)
+    set(ARG_COST 0)
+  endif()
+  if(NOT ARG_LABEL)
+    set(ARG_LABEL unit)
+  endif()
+  if(NOT ARG_FILTER)
+    set(ARG_FILTER "*")
+  endif()
+  set(fixtures "")
+  if(ARG_FIXTURES_SETUP)
+    list(APPEND fixtures FIXTURES_SETUP ${ARG_FIXTURES_SETUP})
+  endif()
+  if(ARG_FIXTURES_REQUIRED)
+    list(APPEND fixtures FIXTURES_REQUIRED ${ARG_FIXTURES_REQUIRED})
+  endif()
+  # Two tests share two cores under `ctest -j2`: OpenMP threads that wait sleep instead of spinning.
+  gtest_discover_tests(${ARG_TARGET} TEST_PREFIX "${ARG_NAME}/" TEST_FILTER "${ARG_FILTER}"
+                       DISCOVERY_TIMEOUT 60
+                       PROPERTIES TIMEOUT 1200 COST ${ARG_COST} LABELS ${ARG_LABEL}
+                                  ENVIRONMENT OMP_WAIT_POLICY=PASSIVE ${fixtures})
 endfunction()

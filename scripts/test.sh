@@ -1,10 +1,19 @@
 #!/usr/bin/env bash
 # Installs what is missing (scripts/setup.sh), builds colmap-lidar and runs every test: the layering
 # check, the unit tests beside the sources and the integration tests under tests/.
+#   scripts/test.sh           every test (CTest labels unit, integration, slow)
+#   scripts/test.sh --quick   without the slow ones (ctest -LE slow): a few minutes
 #   BUILD_DIR  build directory (default: build)
 #   JOBS       parallel build jobs (default: nproc)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+ctest_selection=()
+if [[ "${1:-}" == "--quick" ]]; then
+  ctest_selection=(-LE slow)
+elif [[ $# -gt 0 ]]; then
+  echo "usage: scripts/test.sh [--quick]" >&2
+  exit 2
+fi
 bash scripts/setup.sh
 readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
 readonly kBuildDir="${BUILD_DIR:-build}"
@@ -16,4 +25,4 @@ cmake -S . -B "$kBuildDir" -G Ninja -DCMAKE_BUILD_TYPE=Release \
 cmake --build "$kBuildDir" -j "${JOBS:-$(nproc)}"
 echo "[test] running the tests"
 cd "$kBuildDir"
-ctest --output-on-failure -j "${JOBS:-$(nproc)}"
+ctest --output-on-failure -j "${JOBS:-$(nproc)}" "${ctest_selection[@]}"
