@@ -28,7 +28,8 @@
 namespace colmap_lidar {
 
 struct DensifierOptions {
-  bool refine_with_lidar = true;  // false: the stereo depth maps as they are
+  // false: the stereo depth maps as they are
+  bool refine_with_lidar = true;
   LidarSurfaceOptions surface;
   LidarDepthRefinementOptions refinement;
   // LiDAR points outside this z range in the camera frame are not projected.
@@ -41,8 +42,10 @@ struct DensifierOptions {
   int max_neighbor_views = 6;
   double consistency_abs_m = 0.01;
   double consistency_rel = 0.005;
-  double fused_voxel_size_m = 0.001;     // merge of fused.ply
-  double lidar_map_voxel_size_m = 0.01;  // lidar_map.ply
+  // merge of fused.ply
+  double fused_voxel_size_m = 0.001;
+  // lidar_map.ply
+  double lidar_map_voxel_size_m = 0.01;
 
   bool Check() const;
 };

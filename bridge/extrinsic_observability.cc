@@ -93,7 +93,7 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
   verdict << std::fixed << std::setprecision(1);
   if (analysis.num_stations < 3) {
     verdict << "only " << analysis.num_stations
-            << " stations: the seed's uniqueness condition needs at least 3";
+            << " stations: the uniqueness condition of Zhen et al. 2019 needs at least 3";
   } else if (analysis.num_rotating_pairs == 0) {
     verdict << "the stations do not rotate relative to each other: T_e's "
                "rotation follows from the translations, its translation is "
@@ -106,7 +106,7 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
                "stations tilted about a second axis";
   } else {
     verdict << "relative rotation axes of " << analysis.num_rotating_pairs << " station pairs span "
-            << analysis.max_axis_angle_deg << " deg: T_e is unique (the seed's condition holds)";
+            << analysis.max_axis_angle_deg << " deg: T_e is unique (Zhen et al. 2019's condition holds)";
   }
   analysis.verdict = verdict.str();
   return analysis;

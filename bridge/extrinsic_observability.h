@@ -6,7 +6,7 @@
 //   landmark's reprojections), because residuals of one cluster share errors (a stereo depth bias, a
 //   LiDAR surface) and the formal covariance is then several times too optimistic. Directions whose
 //   standard deviation exceeds a threshold are named in words;
-// - the seed's uniqueness test on the relative motions: T_e is unique only with >= 3 stations whose
+// - the uniqueness test of Zhen et al. 2019 on the relative motions: T_e is unique only with >= 3 stations whose
 //   relative rotation axes are not all parallel (hand-eye calibration, AX = XB).
 // Units: rotation as a rotation vector about the camera axes in degrees (twice Ceres'
 // EigenQuaternionManifold tangent, which is left-multiplied and rotates by 2|delta|), translation in
@@ -39,8 +39,10 @@ struct ObservabilityOptions {
   // it lowered the 2-sigma coverage of rx, ry, tx from 88-96 % to 88 %, and end to end (10 stations)
   // it moved the sigmas by -15..+10 % without explaining the errors.
   bool two_way_lidar_clusters = false;
-  double min_rotation_deg = 2.0;       // relative rotations below this do not count as rotating
-  double max_parallel_axes_deg = 5.0;  // axes closer than this are parallel
+  // relative rotations below this do not count as rotating
+  double min_rotation_deg = 2.0;
+  // axes closer than this are parallel
+  double max_parallel_axes_deg = 5.0;
 
   bool Check() const;
 };
@@ -69,11 +71,11 @@ struct MotionAnalysis {
   int num_rotating_pairs = 0;     // relative rotation above 2 deg
   double max_axis_angle_deg = 0;  // largest angle between two relative rotation axes
   Eigen::Vector3d common_axis_in_cam = Eigen::Vector3d::Zero();  // if all axes are parallel
-  bool unique = false;  // the seed's test: >= 3 stations, axes not all parallel
+  bool unique = false;  // the test of Zhen et al. 2019: >= 3 stations, axes not all parallel
   std::string verdict;
 };
 
-// The seed's uniqueness test on the relative motions of the registered cameras.
+// The uniqueness test of Zhen et al. 2019 on the relative motions of the registered cameras.
 MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
                              const ObservabilityOptions& options);
 

@@ -1,6 +1,6 @@
 // A weak prior on the translation of cam_from_lidar: E_p = (t - t_0) / sigma (3 residuals).
 //
-// Not part of the seed's cost. With degenerate motion (rotation about one axis, or none) a direction of
+// Not part of the cost of Zhen et al. 2019. With degenerate motion (rotation about one axis, or none) a direction of
 // T_e's translation is unobservable and Levenberg-Marquardt would wander along it (metres, in practice);
 // with sigma of the order of a metre the prior holds that direction at the initial value while its
 // information (1/sigma^2 = 1e-6 per mm^2) is negligible next to what the LiDAR gives an observable one.

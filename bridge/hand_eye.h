@@ -1,4 +1,4 @@
-// Hand-eye calibration of cam_from_lidar from paired relative motions (the seed's uniqueness conditions):
+// Hand-eye calibration of cam_from_lidar from paired relative motions (the uniqueness conditions of Zhen et al. 2019):
 //
 //   A_k X = X B_k,  A_k = cam_i_from_cam_j (images), B_k = lidar_i_from_lidar_j (LiDAR), X = cam_from_lidar.
 //
@@ -21,9 +21,12 @@ struct HandEyeMotion {
 };
 
 struct HandEyeOptions {
-  double min_rotation_deg = 5.0;       // motions rotating less carry no axis
-  double min_axis_angle_deg = 10.0;    // two axes closer than this count as parallel
-  double max_axis_residual_deg = 2.0;  // consistency of A and B rotation angles
+  // motions rotating less carry no axis
+  double min_rotation_deg = 5.0;
+  // two axes closer than this count as parallel
+  double min_axis_angle_deg = 10.0;
+  // consistency of A and B rotation angles
+  double max_axis_residual_deg = 2.0;
 
   bool Check() const;
 };

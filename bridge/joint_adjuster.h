@@ -1,4 +1,4 @@
-// The seed's back end: ONE Levenberg-Marquardt problem over camera poses T, landmarks L and the
+// The back end of Zhen et al. 2019: ONE Levenberg-Marquardt problem over camera poses T, landmarks L and the
 // camera-LiDAR extrinsic T_e, with cost 1/2 sum w_c (E_f^2 + E_d^2) + 1/2 sum w_l E_l^2, built inside
 // COLMAP 3.10's own Ceres problem.
 //
@@ -41,7 +41,7 @@
 
 namespace colmap_lidar {
 
-// The seed's three comparisons.
+// The three modes compared by Zhen et al. 2019.
 enum class JointMode {
   kJoint,          // T_e refined with everything else
   kPrecalibrated,  // T_e held constant

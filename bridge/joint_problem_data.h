@@ -19,8 +19,10 @@ struct JointDataOptions {
   int min_image_pair_inliers = 15;
   double lidar_overlap_distance_m = 0.2;
   double min_lidar_overlap = 0.3;
-  int max_lidar_neighbors = 4;  // most overlapping partners kept per station
-  double voxel_size_m = 0.05;   // clouds for the LiDAR term
+  // most overlapping partners kept per station
+  int max_lidar_neighbors = 4;
+  // clouds for the LiDAR term
+  double voxel_size_m = 0.05;
 
   bool Check() const;
 };

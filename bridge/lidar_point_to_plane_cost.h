@@ -1,4 +1,4 @@
-// The LiDAR residual E_l of the seed's joint cost, in COLMAP 3.10's parameter layout. An observation pairs
+// The LiDAR residual E_l of the joint cost of Zhen et al. 2019, in COLMAP 3.10's parameter layout. An observation pairs
 // a point p of station j's cloud (lidar_j frame) with a point q and unit normal n of station i's cloud
 // (lidar_i frame):
 //

@@ -1,4 +1,4 @@
-// Initial station poses and cam_from_lidar for the joint problem (the seed's initialisation):
+// Initial station poses and cam_from_lidar for the joint problem (the initialisation of Zhen et al. 2019):
 // 1. image edges A_c: metric relative poses from matches with depth priors (bridge/image_pair_poses.h);
 // 2. LiDAR edges A_l: lidar_registrator's pairs.txt;
 // 3. cam_from_lidar: rig.json's guess if present, else hand-eye over the pairs with both an image and a
@@ -24,8 +24,10 @@ namespace colmap_lidar {
 struct PoseInitializerOptions {
   ImagePairPoseOptions image_pairs;
   HandEyeOptions hand_eye;
-  bool use_guess = true;            // false: hand-eye even when rig.json has a guess
-  double sigma_rotation_deg = 0.1;  // pose-graph edge weights
+  // false: hand-eye even when rig.json has a guess
+  bool use_guess = true;
+  // pose-graph edge weights
+  double sigma_rotation_deg = 0.1;
   double sigma_translation_m = 0.005;
 
   bool Check() const;

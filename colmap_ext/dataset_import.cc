@@ -180,7 +180,6 @@ bool DatasetImportOptions::Check() const {
   CHECK_OPTION(exhaustive_matching.Check());
   CHECK_OPTION(sequential_matching.Check());
   CHECK_OPTION(spatial_matching.Check());
-  CHECK_OPTION(matcher != "spatial" || !station_positions.empty());
   return true;
 }
 
@@ -198,6 +197,8 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
   THROW_CHECK(options.sift_matching.Check());
   THROW_CHECK(options.two_view_geometry.Check());
   THROW_CHECK(options.Check());
+  THROW_CHECK(options.matcher != "spatial" || !options.station_positions.empty())
+      << "the spatial matcher needs station positions (none came from the LiDAR registration)";
   THROW_CHECK(!dataset.stations.empty()) << "no stations in " << dataset.root;
   std::cout << "Checking " << dataset.stations.size() << " stereo pairs of " << dataset.root
             << std::endl;

@@ -1,11 +1,11 @@
-// The depth-prior residual E_d of the seed's joint cost, in COLMAP 3.10's parameter layout:
+// The depth-prior residual E_d of the joint cost of Zhen et al. 2019, in COLMAP 3.10's parameter layout:
 //
 //   E_d = (depth(X_cam) - d) / sigma_d,   X_cam = R(q_cam_from_world) X_world + t_cam_from_world
 //
 // with the cam_from_world rotation as an Eigen quaternion (xyzw storage, COLMAP's
 // Rigid3d::rotation.coeffs()), the translation and the landmark X_world (COLMAP's Point3D::xyz).
 //
-// depth(X_cam) is the z coordinate by default. The seed writes the range ||X_cam||, but a rectified
+// depth(X_cam) is the z coordinate by default. Zhen et al. 2019 write the range ||X_cam||, but a rectified
 // stereo pair measures disparity, i.e. z (Z = b f / d), and our depth maps store z in the original left
 // camera; comparing z with z keeps the residual unbiased off the optical axis, where range exceeds z by
 // up to 1/cos(24 deg) = 9 % at the image corner of a 48 deg lens. DepthType::kRange is there for priors

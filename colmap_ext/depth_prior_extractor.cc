@@ -64,7 +64,7 @@ std::optional<double> DepthAtKeypoint(const colmap::mvs::DepthMap& depth_map,
 }
 
 double DepthSigma(double depth, double baseline_m, double focal_px, double sigma_pixels) {
-  // The seed's sigma_d = d^2 / (b f) * sigma_p.
+  // Zhen et al. 2019: sigma_d = d^2 / (b f) * sigma_p.
   return depth * depth / (baseline_m * focal_px) * sigma_pixels;
 }
 

@@ -1,11 +1,11 @@
-// Depth priors for COLMAP keypoints from per-station stereo depth maps (the seed's front end): a keypoint
+// Depth priors for COLMAP keypoints from per-station stereo depth maps (the front end of Zhen et al. 2019): a keypoint
 // gets the stereo depth found at it, with sigma_d = d^2 / (b f) * sigma_p (b baseline, f rectified focal
 // length, sigma_p the disparity noise in pixels; d^2/(b f) is |dZ/dd| for Z = b f / d).
 //
 // Depth at a keypoint (x, y) (COLMAP pixel convention: pixel (col, row) spans [col, col+1) x [row, row+1)):
 //   1. if the four pixel centres around (x, y) all have depth agreeing within `max_relative_jump`,
 //      bilinear interpolation of the four (sub-pixel keypoints on smooth surfaces);
-//   2. else the depth of the NEAREST valid pixel centre within `max_radius_px` (the seed's "valid disparity
+//   2. else the depth of the NEAREST valid pixel centre within `max_radius_px` (Zhen et al. 2019: "valid disparity
 //      within 2 px"); nearest rather than a median of the disc, so that a keypoint on a depth edge takes the
 //      depth of its own side instead of a blend;
 //   3. else no prior (no row in depth_priors).
@@ -24,7 +24,8 @@ namespace colmap_lidar {
 
 struct DepthPriorOptions {
   double max_radius_px = 2.0;
-  double sigma_pixels = 1.0;  // sigma_p
+  // sigma_p
+  double sigma_pixels = 1.0;
   double max_relative_jump = 0.01;
 
   bool Check() const;

@@ -23,11 +23,13 @@ struct StereoDepthOptions {
   // Match each pair top-down and bottom-up (vertically flipped) and average: removes the vertical
   // shift of SGBM's one-directional path aggregation on slanted surfaces at twice the matching time.
   bool vertically_symmetric = true;
-  int block_size = 5;  // odd
+  // odd
+  int block_size = 5;
   // P1 = p1_factor * block_size^2, P2 = p2_factor * block_size^2 (grey images), OpenCV's recommendation.
   int p1_factor = 8;
   int p2_factor = 32;
-  int uniqueness_ratio = 10;  // percent
+  // percent
+  int uniqueness_ratio = 10;
   int pre_filter_cap = 63;
   // Speckle filtering (StereoSGBM's own, on both disparity maps): regions smaller than this many
   // pixels whose disparity varies by at most speckle_range px are removed.
@@ -35,7 +37,8 @@ struct StereoDepthOptions {
   double speckle_range_px = 2.0;
   // Left-right check: |d_left(x) - d_right(x - d_left(x))| must not exceed this (pixels).
   double max_left_right_diff_px = 1.0;
-  int num_threads = -1;  // stations in parallel; -1 = all cores
+  // stations in parallel; -1 = all cores
+  int num_threads = -1;
 
   bool Check() const;
 };

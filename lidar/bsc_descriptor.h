@@ -26,11 +26,16 @@
 namespace colmap_lidar {
 
 struct BscOptions {
-  double support_radius = 1.5;    // R [m]
-  int grid_size = 7;              // N
-  double occupancy_ratio = 0.5;   // occupied: cell density > ratio * mean cell density of the plane
-  double ambiguity_ratio = 0.85;  // lambda_2 / lambda_1 above this: keep the y-axis variants too
-  double sign_ambiguity = 0.1;  // |weighted majority| below this fraction: keep the -x variant too
+  // R [m]
+  double support_radius = 1.5;
+  // N
+  int grid_size = 7;
+  // occupied: cell density > ratio * mean cell density of the plane
+  double occupancy_ratio = 0.5;
+  // lambda_2 / lambda_1 above this: keep the y-axis variants too
+  double ambiguity_ratio = 0.85;
+  // |weighted majority| below this fraction: keep the -x variant too
+  double sign_ambiguity = 0.1;
   int min_neighbors = 10;
   uint64_t pair_seed = 0x5bd1e995;
 

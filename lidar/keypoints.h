@@ -11,12 +11,18 @@
 namespace colmap_lidar {
 
 struct KeypointOptions {
-  double radius = 0.5;          // PCA neighbourhood radius [m]
-  double max_ratio_21 = 0.65;   // lambda2 / lambda1 below this (eigenvalues descending)
-  double max_ratio_32 = 0.65;   // lambda3 / lambda2 below this
-  int min_neighbors = 20;       // more than this many neighbours
-  double nms_radius = 0.5;      // greedy non-maximum suppression by curvature within this radius
-  size_t max_keypoints = 3000;  // strongest after NMS
+  // PCA neighbourhood radius [m]
+  double radius = 0.5;
+  // lambda2 / lambda1 below this (eigenvalues descending)
+  double max_ratio_21 = 0.65;
+  // lambda3 / lambda2 below this
+  double max_ratio_32 = 0.65;
+  // more than this many neighbours
+  int min_neighbors = 20;
+  // greedy non-maximum suppression by curvature within this radius
+  double nms_radius = 0.5;
+  // strongest after NMS
+  size_t max_keypoints = 3000;
 
   bool Check() const;
 };

@@ -48,11 +48,15 @@ struct LidarDepthRefinementOptions {
   double max_normal_angle_deg = 30;
   // Fold 2.
   bool fill_holes = true;
-  int min_fill_samples = 4;    // layer samples in the window
-  int min_fill_quadrants = 3;  // of the 4 quadrants around the pixel holding a sample (interpolate,
-                               // never extrapolate past the LiDAR's coverage)
-  double max_fill_curvature = 0.05;     // LidarSurface::curvature of every window sample
-  double max_fill_view_angle_deg = 75;  // between the plane normal and the viewing ray
+  // layer samples in the window
+  int min_fill_samples = 4;
+  // of the 4 quadrants around the pixel holding a sample (interpolate, never extrapolate past the
+  // LiDAR's coverage)
+  int min_fill_quadrants = 3;
+  // LidarSurface::curvature of every window sample
+  double max_fill_curvature = 0.05;
+  // between the plane normal and the viewing ray
+  double max_fill_view_angle_deg = 75;
 
   bool Check() const;
 };

@@ -1,5 +1,5 @@
-// All-pairs LiDAR registration and the LiDAR pose graph (the seed's A_l): register station pairs, accept
-// edges, remove edges inconsistent around 3-cycles, take a maximum spanning tree for initial poses,
+// All-pairs LiDAR registration and the LiDAR pose graph (A_l of Zhen et al. 2019): register station
+// pairs, accept edges, remove edges inconsistent around 3-cycles, take a maximum spanning tree for initial poses,
 // refine all poses over all accepted edges with Ceres (information-weighted, robust), and report the
 // connected components. Station poses are world_from_lidar with the first station
 // of each component as its world (identity).
@@ -37,7 +37,8 @@ struct LidarGraphOptions {
   // Remove edges inconsistent around 3-cycles before the spanning tree (CheckThreeCycles).
   bool check_cycles = true;
   CycleConsistencyOptions cycles;
-  bool refine = true;  // pose-graph refinement over all accepted edges
+  // pose-graph refinement over all accepted edges
+  bool refine = true;
   // Huber loss of the refinement, on residuals whitened by each edge's information (in sigmas).
   double robust_loss_sigmas = 3.0;
 

@@ -15,16 +15,20 @@
 namespace colmap_lidar {
 
 struct LidarSurfaceOptions {
-  double sample_spacing_m = 0.005;  // voxel edge of the thinning
-  double radius_m = 0.04;           // PCA neighbourhood radius (normal, position)
+  // voxel edge of the thinning
+  double sample_spacing_m = 0.005;
+  // PCA neighbourhood radius (normal, position)
+  double radius_m = 0.04;
   // Neighbourhood of the curvature. Larger than radius_m: range noise sigma alone gives a flat patch
   // a curvature of about 3 sigma^2 / r^2 (0.19 for a VLP-16's 1 cm at 4 cm, 0.03 at 10 cm).
   double curvature_radius_m = 0.1;
   // Neighbourhoods centred on samples half a radius away that compete with the sample's own; the
   // flattest one gives the plane (0: only the sample's own).
   int num_shifted_neighbourhoods = 8;
-  int min_neighbors = 8;   // fewer samples in the radius: the sample is dropped
-  int max_neighbors = 96;  // larger neighbourhoods are subsampled evenly
+  // fewer samples in the radius: the sample is dropped
+  int min_neighbors = 8;
+  // larger neighbourhoods are subsampled evenly
+  int max_neighbors = 96;
 
   bool Check() const;
 };

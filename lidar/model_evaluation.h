@@ -1,6 +1,6 @@
 // Accuracy of a reconstructed cloud against a ground-truth surface (points with normals), following the
-// seed's CloudCompare protocol: crop to the structure, optionally align by point-to-plane ICP, then
-// per-point distances to the true surface.
+// CloudCompare protocol of Zhen et al. 2019: crop to the structure, optionally align by point-to-plane
+// ICP, then per-point distances to the true surface.
 #pragma once
 
 #include "lidar/kd_tree.h"
@@ -13,11 +13,13 @@
 namespace colmap_lidar {
 
 struct ModelEvaluationOptions {
-  bool align_icp = true;  // rigid point-to-plane ICP of the model onto the truth first
+  // rigid point-to-plane ICP of the model onto the truth first
+  bool align_icp = true;
   int icp_max_iterations = 30;
-  double crop_distance_m =
-      0.05;  // model points farther than this from the truth are not the structure
-  std::vector<double> thresholds_m = {0.002, 0.005, 0.010};  // completeness / precision / F-score
+  // model points farther than this from the truth are not the structure
+  double crop_distance_m = 0.05;
+  // completeness / precision / F-score
+  std::vector<double> thresholds_m = {0.002, 0.005, 0.010};
 
   bool Check() const;
 };

@@ -19,19 +19,25 @@
 namespace colmap_lidar {
 
 struct PairRegistrationOptions {
-  double max_ratio = 0.95;  // best / second-best Hamming distance
-  bool mutual = true;       // keep only mutual nearest neighbours
+  // best / second-best Hamming distance
+  double max_ratio = 0.95;
+  // keep only mutual nearest neighbours
+  bool mutual = true;
   int ransac_iterations = 200000;
-  double inlier_threshold = 0.3;  // keypoint distance after alignment [m]
-  double edge_tolerance = 0.2;    // |edge_source - edge_target| of the 3-point sample [m]
+  // keypoint distance after alignment [m]
+  double inlier_threshold = 0.3;
+  // |edge_source - edge_target| of the 3-point sample [m]
+  double edge_tolerance = 0.2;
   int min_inliers = 6;
-  int num_hypotheses = 10;  // distinct RANSAC hypotheses refined by ICP; best overlap wins
+  // distinct RANSAC hypotheses refined by ICP; best overlap wins
+  int num_hypotheses = 10;
   // ICP from the identity as one more hypothesis: consecutive sweeps of a moving platform (and
   // stations close together) often have too few BSC inliers but start inside ICP's basin.
   bool try_identity = true;
   uint64_t seed = 0;
   IcpOptions icp;
-  double min_overlap = 0.3;  // ICP inlier fraction of the source
+  // ICP inlier fraction of the source
+  double min_overlap = 0.3;
   // The ICP point-to-plane RMSE must not exceed this multiple of the clouds' own plane noise
   // (StationCloud::plane_noise_rms; sqrt of the mean of both squares).
   double max_rmse_to_noise = 2.0;

@@ -11,8 +11,10 @@ namespace colmap_lidar {
 struct HistogramPlotOptions {
   std::string title;
   std::string x_label;
-  double value_scale = 1.0;  // values are multiplied by this for the axis (e.g. 1000 for mm)
-  double max_value = 0;      // upper end of the axis in input units; 0 = 99th percentile
+  // values are multiplied by this for the axis (e.g. 1000 for mm)
+  double value_scale = 1.0;
+  // upper end of the axis in input units; 0 = 99th percentile
+  double max_value = 0;
   int num_bins = 50;
 };
 
@@ -31,7 +33,8 @@ struct LinePlotOptions {
   std::string title;
   std::string x_label;
   std::string y_label;
-  bool log_y = false;  // log10 axis for y (values <= 0 are skipped)
+  // log10 axis for y (values <= 0 are skipped)
+  bool log_y = false;
 };
 
 // Writes a line plot PNG of one or more series with a legend (atomically).

@@ -16,7 +16,7 @@
 
 namespace colmap_lidar {
 
-// One observation of the seed's LiDAR residual: E_l = n^T (target_from_source * p - q) / sigma_l.
+// One observation of the LiDAR residual of Zhen et al. 2019: E_l = n^T (target_from_source * p - q) / sigma_l.
 struct PointToPlaneObservation {
   Eigen::Vector3d point_in_source;   // p
   Eigen::Vector3d point_in_target;   // q
@@ -30,8 +30,10 @@ struct AssociationOptions {
   // default: on the simulated structures it made the joint result worse (exact data: 0.022 deg /
   // 1.2 mm against 0.007 deg / 0.35 mm uniform), as rare normals are mostly curved or edge surfaces.
   bool normal_space_sampling = false;
-  double max_distance = 0.1;    // gate on |T p - q| [m]
-  double max_curvature = 0.05;  // only planar target neighbourhoods (if curvature is given)
+  // gate on |T p - q| [m]
+  double max_distance = 0.1;
+  // only planar target neighbourhoods (if curvature is given)
+  double max_curvature = 0.05;
   uint64_t seed = 0;
 
   bool Check() const;

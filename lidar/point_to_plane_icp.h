@@ -12,9 +12,12 @@ namespace colmap_lidar {
 
 struct IcpOptions {
   int max_iterations = 50;
-  double max_correspondence_distance = 0.3;   // metres, first iteration
-  double min_correspondence_distance = 0.05;  // metres, the gate never shrinks below this
-  size_t max_source_points = 30000;           // evenly strided subset of the source
+  // metres, first iteration
+  double max_correspondence_distance = 0.3;
+  // metres, the gate never shrinks below this
+  double min_correspondence_distance = 0.05;
+  // evenly strided subset of the source
+  size_t max_source_points = 30000;
   // Converged when a step is below both and the gate has settled. Nearest neighbours keep
   // switching on noisy clouds, so steps settle around 1e-6 rather than at machine precision.
   double convergence_rotation_rad = 1e-6;

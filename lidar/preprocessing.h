@@ -15,9 +15,12 @@ namespace colmap_lidar {
 PointCloud VoxelDownsample(const PointCloud& cloud, double voxel_size);
 
 struct NormalEstimationOptions {
-  int num_neighbors = 20;  // k of the kNN neighbourhood (used when radius == 0)
-  double radius = 0;       // > 0: radius neighbourhood instead of kNN
-  int min_neighbors = 5;   // fewer: the normal is left zero and the curvature set to 1
+  // k of the kNN neighbourhood (used when radius == 0)
+  int num_neighbors = 20;
+  // > 0: radius neighbourhood instead of kNN
+  double radius = 0;
+  // fewer: the normal is left zero and the curvature set to 1
+  int min_neighbors = 5;
   // Normals point towards this position (the sensor origin in the cloud's frame).
   Eigen::Vector3d viewpoint = Eigen::Vector3d::Zero();
 
@@ -34,7 +37,8 @@ void EstimateNormals(const KdTree3& tree,
 
 struct OutlierRemovalOptions {
   int num_neighbors = 16;
-  double std_ratio = 2.0;  // drop points whose mean kNN distance exceeds mean + std_ratio * std
+  // drop points whose mean kNN distance exceeds mean + std_ratio * std
+  double std_ratio = 2.0;
 };
 
 // Indices of the points kept by statistical outlier removal (ascending).

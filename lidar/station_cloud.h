@@ -14,12 +14,16 @@
 namespace colmap_lidar {
 
 struct StationCloudOptions {
-  double voxel_size = 0.05;         // downsampling for normals, ICP and association [m]
-  double feature_voxel_size = 0.1;  // coarser copy for keypoints and descriptors [m]
-  NormalEstimationOptions normals;  // viewpoint: the LiDAR origin (0, 0, 0)
+  // downsampling for normals, ICP and association [m]
+  double voxel_size = 0.05;
+  // coarser copy for keypoints and descriptors [m]
+  double feature_voxel_size = 0.1;
+  // viewpoint: the LiDAR origin (0, 0, 0)
+  NormalEstimationOptions normals;
   KeypointOptions keypoints;
   BscOptions bsc;
-  bool compute_features = true;  // false: only what association needs (cloud, normals, tree)
+  // false: only what association needs (cloud, normals, tree)
+  bool compute_features = true;
 
   bool Check() const;
 };

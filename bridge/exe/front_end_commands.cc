@@ -32,6 +32,12 @@ void AddImportStepOptions(const std::string& prefix,
           "lidar_registrator's output folder, for --matcher spatial");
 }
 
+bool ImportStepOptions::Check() const {
+  CHECK_OPTION(import.Check());
+  CHECK_OPTION(import.matcher != "spatial" || !lidar_registration_path.empty());
+  return true;
+}
+
 void TakeColmapImportOptions(const colmap::OptionManager& manager, ImportStepOptions* options) {
   options->import.sift_extraction = *manager.sift_extraction;
   options->import.sift_matching = *manager.sift_matching;
@@ -45,9 +51,8 @@ void RunImportStep(const StationDataset& dataset,
                    const std::string& database_path,
                    ImportStepOptions options) {
   const auto start = std::chrono::steady_clock::now();
+  THROW_CHECK(options.Check());
   if (options.import.matcher == "spatial") {
-    THROW_CHECK(!options.lidar_registration_path.empty())
-        << "--matcher spatial needs --lidar_registration_path";
     options.import.station_positions =
         StationCameraPositions(options.lidar_registration_path,
                                dataset.rig.cam_from_lidar_guess.value_or(colmap::Rigid3d()));
@@ -69,7 +74,7 @@ int RunImportDataset(int argc, char** argv) {
   AddImportStepOptions("", &options, &import);
   options.Parse(argc, argv);
   TakeColmapImportOptions(options, &import);
-  THROW_CHECK(import.import.Check());  // before any file is read
+  THROW_CHECK(import.Check());  // before any file is read
   RunImportStep(ReadStationDataset(dataset_path), *options.database_path, import);
   return EXIT_SUCCESS;
 }

@@ -222,7 +222,7 @@ int RunPipeline(int argc, char** argv) {
   pipeline.joint.mode = pipeline.mode;
   if (pipeline.mode == "stereo_only") pipeline.densifier.refine_with_lidar = false;
   // Every step's options are checked before the first step runs.
-  THROW_CHECK(pipeline.import.import.Check());
+  THROW_CHECK(pipeline.import.Check());
   THROW_CHECK(pipeline.stereo.Check());
   THROW_CHECK(pipeline.depth_prior.Check());
   THROW_CHECK(pipeline.registrator.Check());

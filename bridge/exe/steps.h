@@ -53,6 +53,8 @@ struct ImportStepOptions {
   DatasetImportOptions import;
   // lidar_registrator's output folder, for import.matcher == "spatial".
   std::string lidar_registration_path;
+
+  bool Check() const;
 };
 // Also registers COLMAP's SiftExtraction.*, SiftMatching.*, TwoViewGeometry.*, ExhaustiveMatching.*,
 // SequentialMatching.* and SpatialMatching.* sections (CPU SIFT by default: a headless build has no

@@ -15,8 +15,10 @@ namespace colmap_lidar {
 namespace sim {
 
 struct ImageOptions {
-  double pixel_noise = 1.0;  // std. dev. of additive Gaussian noise, grey levels of 255
-  bool vignetting = false;   // cos^4 fall-off
+  // std. dev. of additive Gaussian noise, grey levels of 255
+  double pixel_noise = 1.0;
+  // cos^4 fall-off
+  bool vignetting = false;
   uint64_t seed = 0;
 };
 
@@ -29,11 +31,13 @@ cv::Mat RenderImage(const Scene& scene,
                     cv::Mat* depth);
 
 struct LidarOptions {
-  size_t num_points = 1600000;  // rays per station (the seed's 20 s accumulation gives ~1.6 M)
-  double range_noise_m = 0.01;  // std. dev. along the ray
+  // rays per station (Zhen et al. 2019: a 20 s accumulation gives ~1.6 M)
+  size_t num_points = 1600000;
+  // std. dev. along the ray
+  double range_noise_m = 0.01;
   double max_range_m = 100;
-  bool mixed_edge_points =
-      false;  // returns averaged across depth discontinuities, as real VLP-16s do
+  // returns averaged across depth discontinuities, as real VLP-16s do
+  bool mixed_edge_points = false;
   uint64_t seed = 0;
 };
 

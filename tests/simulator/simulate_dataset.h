@@ -14,16 +14,21 @@ struct SimulationOptions {
   // two_axes | one_axis | fixed_rotation | drive (frames of a car: MakeDriveRig, one ScanSweep per
   // frame with the frame's pose at mid-sweep, cars moving between frames; scene "street")
   std::string motion = "two_axes";
-  double image_scale = 1.0;       // 1 = 1028x752 per camera, 4 = the seed's 4112x3008
-  size_t lidar_points = 1600000;  // LiDAR rays per station
+  // 1 = 1028x752 per camera, 4 = the 4112x3008 of Zhen et al. 2019
+  double image_scale = 1.0;
+  // LiDAR rays per station
+  size_t lidar_points = 1600000;
   double range_noise_m = 0.01;
-  double pixel_noise = 1.0;  // grey levels
+  // grey levels
+  double pixel_noise = 1.0;
   bool vignetting = false;
   bool mixed_edge_points = false;
-  double guess_rotation_deg = 3.0;  // cam_from_lidar_guess = truth perturbed by this much
+  // cam_from_lidar_guess = truth perturbed by this much
+  double guess_rotation_deg = 3.0;
   double guess_translation_m = 0.05;
   bool write_guess = true;
-  double surface_spacing_m = 0.005;  // grid of ground_truth/surface.ply
+  // grid of ground_truth/surface.ply
+  double surface_spacing_m = 0.005;
   uint64_t seed = 0;
   bool overwrite = false;
 
