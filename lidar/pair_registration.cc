@@ -195,6 +195,32 @@ void Judge(const PairRegistrationOptions& options, PairRegistration* result) {
       result->accepted && result->constraints.weakest_ratio < options.weak_constraint_ratio;
 }
 
+// Coarse ICP from every hypothesis on a subset of the source; the `num_refined` with the best overlap
+// are kept, starting from their coarse alignment (the full-resolution ICP refines them).
+void ScreenHypotheses(const StationCloud& source,
+                      const StationCloud& target,
+                      const PairRegistrationOptions& options,
+                      std::vector<Hypothesis>* hypotheses) {
+  if (options.screening_source_points == 0 ||
+      hypotheses->size() <= static_cast<size_t>(options.num_refined)) {
+    return;
+  }
+  IcpOptions coarse = options.icp;
+  coarse.max_source_points = std::min(coarse.max_source_points, options.screening_source_points);
+  std::vector<std::pair<double, size_t>> overlaps;
+  for (size_t k = 0; k < hypotheses->size(); ++k) {
+    Hypothesis& h = (*hypotheses)[k];
+    const IcpResult result =
+        PointToPlaneIcp(source.cloud, target.cloud, *target.tree, h.target_from_source, coarse);
+    h.target_from_source = result.target_from_source;
+    overlaps.emplace_back(-result.overlap_ratio, k);  // best first; ties keep the order
+  }
+  std::stable_sort(overlaps.begin(), overlaps.end());
+  std::vector<Hypothesis> kept;
+  for (int k = 0; k < options.num_refined; ++k) kept.push_back((*hypotheses)[overlaps[k].second]);
+  *hypotheses = std::move(kept);
+}
+
 }  // namespace
 
 bool PairRegistrationOptions::Check() const {
@@ -209,6 +235,8 @@ bool PairRegistrationOptions::Check() const {
   LIDAR_CHECK_OPTION_GE(max_rmse, 0);
   LIDAR_CHECK_OPTION_GE(min_constraint_ratio, 0);
   LIDAR_CHECK_OPTION_GE(weak_constraint_ratio, min_constraint_ratio);
+  LIDAR_CHECK_OPTION(screening_source_points == 0 || screening_source_points >= 6);
+  LIDAR_CHECK_OPTION_GE(num_refined, 1);
   return icp.Check();
 }
 
@@ -241,6 +269,7 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
   const std::string bsc_reason = result.reason;
   if (options.try_identity) hypotheses.push_back({Eigen::Isometry3d::Identity(), {}});
   if (hypotheses.empty()) return result;
+  ScreenHypotheses(source, target, options, &hypotheses);
   bool have_candidate = false;
   for (const Hypothesis& h : hypotheses) {
     const IcpResult fine = PointToPlaneIcp(

@@ -36,6 +36,11 @@ struct PairRegistrationOptions {
   bool try_identity = true;
   uint64_t seed = 0;
   IcpOptions icp;
+  // Coarse to fine: every hypothesis is first refined by ICP on at most this many source points (0:
+  // every hypothesis at icp.max_source_points), and only the `num_refined` best by that overlap are
+  // refined at full resolution from there. Most of a pair's time is ICP's nearest-neighbour queries.
+  size_t screening_source_points = 3000;
+  int num_refined = 2;
   // ICP inlier fraction of the source
   double min_overlap = 0.3;
   // The ICP point-to-plane RMSE must not exceed this multiple of the clouds' own plane noise
