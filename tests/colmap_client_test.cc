@@ -25,7 +25,7 @@ std::string SiftCommands(const std::string& database, const std::string& images)
   return kColmap + " feature_extractor --database_path " + database + " --image_path " + images +
          " --ImageReader.camera_model PINHOLE --ImageReader.single_camera 1"
          " --SiftExtraction.use_gpu 0 --SiftExtraction.num_threads 2"
-         " --SiftExtraction.max_num_features 4096 && " +
+         " --SiftExtraction.max_num_features 2048 && " +
          kColmap + " exhaustive_matcher --database_path " + database +
          " --SiftMatching.use_gpu 0 --SiftMatching.num_threads 2";
 }
