@@ -2,7 +2,7 @@
 # The main job, on the embedded default dataset: installs what is missing, builds, simulates the
 # seed's T-specimen capture (25 stations) into a workspace and runs what the pipeline has so far.
 #   WORKSPACE      where to put it (default: workspace/)
-#   LIDAR_POINTS   LiDAR rays per station (default 400000; the seed's captures have ~1.6 M)
+#   LIDAR_POINTS   LiDAR rays per station (default 400000; the paper's captures have ~1.6 M)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
