@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job, on the embedded default dataset: installs what is missing, builds, simulates the
-# seed's T-specimen capture (25 stations) into a workspace and runs what the pipeline has so far.
+# paper's T-specimen capture (25 stations) into a workspace and runs the pipeline on it.
 #   WORKSPACE      where to put it (default: workspace/)
 #   LIDAR_POINTS   LiDAR rays per station (default 400000; the paper's captures have ~1.6 M)
 set -euo pipefail
