@@ -2,6 +2,7 @@
 
 #include "colmap_ext/camera_undistortion.h"
 #include "colmap_ext/dense_workspace.h"
+#include "colmap_ext/elapsed.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/stereo_depth_files.h"
 #include "lidar/cloud_io.h"
@@ -143,10 +144,6 @@ cv::Mat SourcePreview(const std::vector<DepthSource>& source, int width, int hei
     }
   }
   return preview;
-}
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 // Fold 1 and 2 for one station; writes its maps, image and preview into the workspace and adds its

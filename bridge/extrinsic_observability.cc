@@ -106,7 +106,8 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
                "stations tilted about a second axis";
   } else {
     verdict << "relative rotation axes of " << analysis.num_rotating_pairs << " station pairs span "
-            << analysis.max_axis_angle_deg << " deg: T_e is unique (Zhen et al. 2019's condition holds)";
+            << analysis.max_axis_angle_deg
+            << " deg: T_e is unique (Zhen et al. 2019's condition holds)";
   }
   analysis.verdict = verdict.str();
   return analysis;

@@ -4,6 +4,7 @@
 #include "bridge/lidar_pair_cost.h"
 #include "bridge/lidar_point_to_plane_cost.h"
 #include "colmap_ext/depth_prior_cost.h"
+#include "colmap_ext/elapsed.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
 
@@ -33,10 +34,6 @@ struct LidarObservation {
   PointToPlaneObservation data;
   bool outlier = false;
 };
-
-double SecondsSince(const std::chrono::steady_clock::time_point& start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 double TermCost(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& ids) {
   if (ids.empty()) return 0;
@@ -493,7 +490,7 @@ void SolveWithOutliers(int round,
     stats.reprojection.num_outliers = state->num_reprojection_outliers;
     stats.depth.num_outliers = state->depth_outliers.size();
     stats.lidar.num_outliers = state->num_lidar_outliers;
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.seconds = SecondsSince(start);
     PrintSolve(stats, changes);
     summary->solves.push_back(stats);
     if (changes == 0) break;

@@ -69,8 +69,15 @@ std::map<std::string, std::vector<double>> ReadKittiCalibFile(const std::string&
     if (colon == std::string::npos || colon == 0) {
       throw std::runtime_error(path + ":" + std::to_string(number) + ": not a 'key: values' line");
     }
+    const std::string key = line.substr(0, colon);
     std::vector<double> numbers;
-    if (ParseNumbers(line.substr(colon + 1), &numbers)) values[line.substr(0, colon)] = numbers;
+    if (ParseNumbers(line.substr(colon + 1), &numbers)) {
+      values[key] = numbers;
+    } else if (key.find("rect") != std::string::npos || key == "R" || key == "T") {
+      // A key ReadKittiCamera needs, with a value that is not a finite number.
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": " + key +
+                               " has a value that is not a finite number");
+    }
   }
   return values;
 }

@@ -20,7 +20,8 @@
 namespace colmap_lidar {
 
 // Every "key: v1 v2 ..." line of a KITTI calibration file, values as numbers where they all parse
-// ("calib_time: 15-Mar-2012 11:37:52" is kept out). Throws std::runtime_error naming the file.
+// ("calib_time: 15-Mar-2012 11:37:52" is kept out). Throws std::runtime_error naming the file (and the
+// line for a line without a colon, or a rectification/extrinsic key with a NaN or non-number value).
 std::map<std::string, std::vector<double>> ReadKittiCalibFile(const std::string& path);
 
 struct KittiCamera {

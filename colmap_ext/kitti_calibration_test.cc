@@ -97,6 +97,9 @@ TEST_F(KittiCalibrationTest, BadFilesNameTheFileAndTheKey) {
   short_p.erase(short_p.find('\n', p0) - 22, 22);  // the last value
   expect_error(short_p, 0, "P_rect_00 has 11 values, not 12");
   expect_error(text + "this line has no colon\n", 0, "calib_cam_to_cam.txt:");
+  std::string nan_value = text;
+  nan_value.replace(nan_value.find(' ', nan_value.find("R_rect_00:") + 11), 1, " nan ");
+  expect_error(nan_value, 0, "R_rect_00 has a value that is not a finite number");
   fs::remove(dir_ / "calib_velo_to_cam.txt");
   expect_error(text, 0, "calib_velo_to_cam.txt");
 }

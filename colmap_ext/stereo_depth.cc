@@ -1,5 +1,6 @@
 #include "colmap_ext/stereo_depth.h"
 
+#include "colmap_ext/elapsed.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/stereo_depth_files.h"
 
@@ -267,8 +268,7 @@ void ComputeDatasetStereoDepth(const StationDataset& dataset,
       WriteStationStereoDepth(output_path, station, depth);
       valid_fraction[i] = depth.valid_fraction;
       const int done = ++num_done;
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double seconds = SecondsSince(start);
       std::lock_guard<std::mutex> lock(print_mutex);
       std::cout << "  [" << done << "/" << num_stations << "] station " << station << ": "
                 << std::setprecision(1) << 100 * depth.valid_fraction << " % of pixels with depth ("

@@ -14,6 +14,7 @@
 #include "bridge/pose_initializer.h"
 #include "colmap_ext/dataset_import.h"
 #include "colmap_ext/depth_prior_extractor.h"
+#include "colmap_ext/elapsed.h"
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/stereo_depth.h"
 #include "lidar/lidar_pose_graph.h"
@@ -26,11 +27,6 @@
 #include <string>
 
 namespace colmap_lidar {
-
-// Wall-clock seconds since `start`, for progress lines.
-inline double SecondsSince(const std::chrono::steady_clock::time_point& start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Registers options as "<prefix><name>" with their current values as defaults.
 class PrefixedOptions {
