@@ -20,64 +20,152 @@ bool HandEyeOptions::Check() const {
   return true;
 }
 
-HandEyeResult SolveHandEye(const std::vector<HandEyeMotion>& motions,
-                           const HandEyeOptions& options) {
-  THROW_CHECK(options.Check());
-  HandEyeResult result;
-  std::vector<Eigen::Vector3d> axes_a, axes_b;
+namespace {
+
+// Rotation axes of the motions that rotate enough and whose two rotation angles agree (A and B are
+// conjugate), weighted by the angle.
+struct RotationAxes {
+  std::vector<Eigen::Vector3d> in_cam, in_lidar;
   std::vector<double> weights;
-  std::vector<const HandEyeMotion*> used;
+  std::vector<const HandEyeMotion*> motions;
+};
+
+RotationAxes RotatingMotions(const std::vector<HandEyeMotion>& motions,
+                             const HandEyeOptions& options) {
+  RotationAxes axes;
   for (const HandEyeMotion& motion : motions) {
     const Eigen::AngleAxisd a(motion.cam_i_from_cam_j.rotation);
     const Eigen::AngleAxisd b(motion.lidar_i_from_lidar_j.rotation);
     if (a.angle() < options.min_rotation_deg * kDegToRad) continue;
-    // A and B are conjugate: equal rotation angles.
-    if (std::abs(a.angle() - b.angle()) > options.max_axis_residual_deg * kDegToRad) {
-      continue;
-    }
-    axes_a.push_back(a.axis());
-    axes_b.push_back(b.axis());
-    weights.push_back(a.angle());
-    used.push_back(&motion);
+    if (std::abs(a.angle() - b.angle()) > options.max_axis_residual_deg * kDegToRad) continue;
+    axes.in_cam.push_back(a.axis());
+    axes.in_lidar.push_back(b.axis());
+    axes.weights.push_back(a.angle());
+    axes.motions.push_back(&motion);
   }
-  result.num_motions = static_cast<int>(used.size());
-  for (size_t i = 0; i < axes_a.size(); ++i) {
-    for (size_t j = i + 1; j < axes_a.size(); ++j) {
-      result.max_axis_angle_deg =
-          std::max(result.max_axis_angle_deg,
-                   std::acos(std::min(1.0, std::abs(axes_a[i].dot(axes_a[j])))) / kDegToRad);
-    }
-  }
-  std::ostringstream message;
-  message << std::fixed << std::setprecision(1);
-  if (used.size() < 2 || result.max_axis_angle_deg < options.min_axis_angle_deg) {
-    message << "degenerate motion for hand-eye calibration: " << used.size()
-            << " rotating motion pairs";
-    if (!used.empty()) {
-      message << ", rotation axes within " << result.max_axis_angle_deg
-              << " deg (need >= 2 motions about non-parallel axes)";
-    }
-    result.message = message.str();
-    return result;
-  }
+  return axes;
+}
 
-  // Rotation: weighted Kabsch, axes_a = R axes_b.
+double MaxAngleBetweenLinesDeg(const std::vector<Eigen::Vector3d>& directions) {
+  double max_angle = 0;
+  for (size_t i = 0; i < directions.size(); ++i) {
+    for (size_t j = i + 1; j < directions.size(); ++j) {
+      max_angle = std::max(
+          max_angle, std::acos(std::min(1.0, std::abs(directions[i].dot(directions[j])))));
+    }
+  }
+  return max_angle / kDegToRad;
+}
+
+// The rotation R minimising sum w_k |in_cam_k - R in_lidar_k|^2 (weighted Kabsch).
+Eigen::Matrix3d WeightedKabsch(const RotationAxes& axes) {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (size_t k = 0; k < axes_a.size(); ++k) {
-    covariance += weights[k] * axes_a[k] * axes_b[k].transpose();
+  for (size_t k = 0; k < axes.in_cam.size(); ++k) {
+    covariance += axes.weights[k] * axes.in_cam[k] * axes.in_lidar[k].transpose();
   }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance,
                                               Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
   d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
-  const Eigen::Matrix3d rotation = svd.matrixU() * d * svd.matrixV().transpose();
+  return svd.matrixU() * d * svd.matrixV().transpose();
+}
+
+double AxisFitRmsDeg(const RotationAxes& axes, const Eigen::Matrix3d& rotation) {
   double squared = 0;
-  for (size_t k = 0; k < axes_a.size(); ++k) {
-    squared += std::pow(std::acos(std::min(1.0, axes_a[k].dot(rotation * axes_b[k]))), 2);
+  for (size_t k = 0; k < axes.in_cam.size(); ++k) {
+    squared +=
+        std::pow(std::acos(std::min(1.0, axes.in_cam[k].dot(rotation * axes.in_lidar[k]))), 2);
   }
-  result.rotation_rms_deg = std::sqrt(squared / axes_a.size()) / kDegToRad;
+  return axes.in_cam.empty() ? 0.0 : std::sqrt(squared / axes.in_cam.size()) / kDegToRad;
+}
+
+std::string DegenerateMessage(size_t num_rotating, double max_axis_angle_deg) {
+  std::ostringstream message;
+  message << std::fixed << std::setprecision(1)
+          << "degenerate motion for hand-eye calibration: " << num_rotating
+          << " rotating motion pairs";
+  if (num_rotating > 0) {
+    message << ", rotation axes within " << max_axis_angle_deg
+            << " deg (need >= 2 motions about non-parallel axes)";
+  }
+  return message.str();
+}
+
+// Translation directions of the motions that hardly rotate, as extra direction pairs for the rotation:
+// a / |a| = R_X (t_B - R_X^T (R_A - I) t_X) / |...|, with the current estimate of R_X and t_X (the
+// correction is small for a small rotation and vanishes at t_X = 0).
+void AddTranslationDirections(const std::vector<HandEyeMotion>& motions,
+                              const HandEyeOptions& options,
+                              const colmap::Rigid3d& cam_from_lidar,
+                              RotationAxes* axes) {
+  for (const HandEyeMotion& motion : motions) {
+    const Eigen::AngleAxisd a(motion.cam_i_from_cam_j.rotation);
+    const Eigen::Vector3d& t_a = motion.cam_i_from_cam_j.translation;
+    const Eigen::Vector3d t_b =
+        motion.lidar_i_from_lidar_j.translation -
+        cam_from_lidar.rotation.inverse() *
+            ((a.toRotationMatrix() - Eigen::Matrix3d::Identity()) * cam_from_lidar.translation);
+    if (a.angle() >= options.min_rotation_deg * kDegToRad || t_a.norm() == 0 ||
+        t_b.norm() < 0.1) {
+      continue;
+    }
+    axes->in_cam.push_back(t_a.normalized());
+    axes->in_lidar.push_back(t_b.normalized());
+    axes->weights.push_back(1.0);
+  }
+}
+
+// (R_A - I) t_X + s a = R_X t_B over every motion, for t_X and s given R_X. With a non-zero `axis`,
+// t_X's component along it is not solved for but taken from `fallback`.
+Eigen::Vector3d SolveTranslationAndScale(const std::vector<HandEyeMotion>& motions,
+                                         const Eigen::Matrix3d& rotation,
+                                         const Eigen::Vector3d& axis,
+                                         const Eigen::Vector3d& fallback,
+                                         HandEyeResult* result) {
+  const bool planar = axis.squaredNorm() > 0;
+  Eigen::Matrix3d basis = Eigen::Matrix3d::Identity();
+  int num_free = 3;
+  if (planar) {
+    const Eigen::Vector3d u = axis.unitOrthogonal();
+    basis << u, axis.cross(u), Eigen::Vector3d::Zero();
+    num_free = 2;
+  }
+  const Eigen::Vector3d fixed_part = axis * axis.dot(fallback);
+  Eigen::MatrixXd lhs(3 * motions.size(), num_free + 1);
+  Eigen::VectorXd rhs(3 * motions.size());
+  for (size_t k = 0; k < motions.size(); ++k) {
+    const colmap::Rigid3d& a = motions[k].cam_i_from_cam_j;
+    const Eigen::Matrix3d r_a_minus_i =
+        a.rotation.toRotationMatrix() - Eigen::Matrix3d::Identity();
+    lhs.block(3 * k, 0, 3, num_free) = r_a_minus_i * basis.leftCols(num_free);
+    lhs.block<3, 1>(3 * k, num_free) = a.translation;
+    rhs.segment<3>(3 * k) =
+        rotation * motions[k].lidar_i_from_lidar_j.translation - r_a_minus_i * fixed_part;
+  }
+  const Eigen::VectorXd solution = lhs.colPivHouseholderQr().solve(rhs);
+  result->scale = solution[num_free];
+  result->translation_rms_m = std::sqrt((lhs * solution - rhs).squaredNorm() / rhs.size());
+  return basis.leftCols(num_free) * solution.head(num_free) + fixed_part;
+}
+
+}  // namespace
+
+HandEyeResult SolveHandEye(const std::vector<HandEyeMotion>& motions,
+                           const HandEyeOptions& options) {
+  THROW_CHECK(options.Check());
+  HandEyeResult result;
+  const RotationAxes axes = RotatingMotions(motions, options);
+  result.num_motions = static_cast<int>(axes.motions.size());
+  result.max_axis_angle_deg = MaxAngleBetweenLinesDeg(axes.in_cam);
+  if (axes.motions.size() < 2 || result.max_axis_angle_deg < options.min_axis_angle_deg) {
+    result.message = DegenerateMessage(axes.motions.size(), result.max_axis_angle_deg);
+    return result;
+  }
+  const Eigen::Matrix3d rotation = WeightedKabsch(axes);
+  result.rotation_rms_deg = AxisFitRmsDeg(axes, rotation);
 
   // Translation: (R_A - I) t = R t_B - t_A.
+  const std::vector<const HandEyeMotion*>& used = axes.motions;
   Eigen::MatrixXd lhs(3 * used.size(), 3);
   Eigen::VectorXd rhs(3 * used.size());
   for (size_t k = 0; k < used.size(); ++k) {
@@ -90,12 +178,88 @@ HandEyeResult SolveHandEye(const std::vector<HandEyeMotion>& motions,
   result.translation_rms_m = std::sqrt((lhs * translation - rhs).squaredNorm() / rhs.size());
   result.cam_from_lidar = colmap::Rigid3d(Eigen::Quaterniond(rotation), translation);
   result.unique = true;
-  message << "hand-eye from " << used.size() << " motion pairs (axes span "
-          << result.max_axis_angle_deg << " deg): axis fit " << std::setprecision(3)
-          << result.rotation_rms_deg << " deg rms, translation residual "
+  result.rotation_unique = true;
+  std::ostringstream message;
+  message << std::fixed << std::setprecision(1) << "hand-eye from " << used.size()
+          << " motion pairs (axes span " << result.max_axis_angle_deg << " deg): axis fit "
+          << std::setprecision(3) << result.rotation_rms_deg << " deg rms, translation residual "
           << 1000 * result.translation_rms_m << " mm rms";
   result.message = message.str();
   return result;
+}
+
+HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& motions,
+                                     const HandEyeOptions& options,
+                                     const Eigen::Vector3d& axis_translation_fallback) {
+  THROW_CHECK(options.Check());
+  HandEyeResult result;
+  RotationAxes axes = RotatingMotions(motions, options);
+  result.num_motions = static_cast<int>(axes.motions.size());
+  result.max_axis_angle_deg = MaxAngleBetweenLinesDeg(axes.in_cam);
+  const bool planar =
+      axes.motions.size() < 2 || result.max_axis_angle_deg < options.min_axis_angle_deg;
+  if (planar) {
+    if (axes.motions.empty()) {
+      result.message = DegenerateMessage(0, 0);
+      return result;
+    }
+    result.unobservable_axis_in_cam = axes.in_cam.front();
+    RotationAxes with_directions = axes;
+    AddTranslationDirections(motions, options, colmap::Rigid3d(), &with_directions);
+    if (MaxAngleBetweenLinesDeg(with_directions.in_cam) < options.min_axis_angle_deg) {
+      result.message = DegenerateMessage(axes.motions.size(), result.max_axis_angle_deg) +
+                       ", and no translation across the axis";
+      return result;
+    }
+  }
+  // Planar: the direction pairs depend on t_X; a few rounds converge (the correction is small).
+  const Eigen::Vector3d axis = result.unobservable_axis_in_cam;
+  const RotationAxes rotating = axes;
+  for (int round = 0; round < (planar ? 3 : 1); ++round) {
+    axes = rotating;
+    if (planar) AddTranslationDirections(motions, options, result.cam_from_lidar, &axes);
+    const Eigen::Matrix3d rotation = WeightedKabsch(axes);
+    result.rotation_rms_deg = AxisFitRmsDeg(axes, rotation);
+    result.cam_from_lidar = colmap::Rigid3d(
+        Eigen::Quaterniond(rotation),
+        SolveTranslationAndScale(motions, rotation, axis, axis_translation_fallback, &result));
+  }
+  result.rotation_unique = true;
+  std::ostringstream message;
+  message << std::fixed << std::setprecision(1) << "similarity hand-eye from " << motions.size()
+          << " motion pairs (" << axes.motions.size() << " rotating, axes span "
+          << result.max_axis_angle_deg << " deg): scale " << std::setprecision(4) << result.scale
+          << ", axis fit " << std::setprecision(3) << result.rotation_rms_deg
+          << " deg rms, translation residual " << 1000 * result.translation_rms_m << " mm rms";
+  if (!(result.scale > 0)) {
+    result.rotation_unique = false;
+    result.message = message.str() + "; the scale is not positive (inconsistent motions)";
+    return result;
+  }
+  result.unique = !planar;
+  if (planar) {
+    message << "; rotation about one axis only (camera " << std::setprecision(2)
+            << axis.transpose() << "): the translation along it is not observable from motion";
+  }
+  result.message = message.str();
+  return result;
+}
+
+double HandEyeScale(const std::vector<HandEyeMotion>& motions, const colmap::Rigid3d& cam_from_lidar) {
+  double numerator = 0, denominator = 0;
+  for (const HandEyeMotion& motion : motions) {
+    const colmap::Rigid3d& a = motion.cam_i_from_cam_j;
+    const Eigen::Vector3d metric =
+        cam_from_lidar.rotation * motion.lidar_i_from_lidar_j.translation -
+        (a.rotation.toRotationMatrix() - Eigen::Matrix3d::Identity()) * cam_from_lidar.translation;
+    numerator += a.translation.dot(metric);
+    denominator += a.translation.squaredNorm();
+  }
+  if (!(denominator > 0) || !(numerator > 0)) {
+    throw std::runtime_error(
+        "cannot scale the camera model to metres: no camera motion with a LiDAR motion translates");
+  }
+  return numerator / denominator;
 }
 
 }  // namespace colmap_lidar

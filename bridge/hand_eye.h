@@ -32,7 +32,14 @@ struct HandEyeOptions {
 };
 
 struct HandEyeResult {
+  // Rotation and translation recovered (for the similarity variant: scale too).
   bool unique = false;
+  // Similarity variant: the rotation is recovered, but the translation along
+  // `unobservable_axis_in_cam` is not (motion about one axis only, e.g. a car on a plane).
+  bool rotation_unique = false;
+  Eigen::Vector3d unobservable_axis_in_cam = Eigen::Vector3d::Zero();
+  // Metres per unit of the camera motions (similarity variant; 1 otherwise).
+  double scale = 1;
   std::string message;  // why not unique, or a summary
   colmap::Rigid3d cam_from_lidar;
   int num_motions = 0;            // used
@@ -43,5 +50,19 @@ struct HandEyeResult {
 
 HandEyeResult SolveHandEye(const std::vector<HandEyeMotion>& motions,
                            const HandEyeOptions& options);
+
+// The similarity variant for camera motions known up to scale (a monocular model): A_k = (R_A, a_k)
+// with metric translation s a_k, so (R_A - I) t_X + s a_k = R_X t_B, linear in (t_X, s). When all
+// rotation axes are parallel (planar driving), the rotation also uses the translation directions of the
+// motions that hardly rotate (a_k / |a_k| = R_X t_B / |t_B|), and the component of t_X along the common
+// axis, which no motion observes, is taken from `axis_translation_fallback` (e.g. the guess) and named
+// in the result.
+HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& motions,
+                                     const HandEyeOptions& options,
+                                     const Eigen::Vector3d& axis_translation_fallback);
+
+// Least-squares scale s of up-to-scale camera motions given cam_from_lidar: s a_k = R_X t_B - (R_A - I) t_X.
+// Throws if no motion translates.
+double HandEyeScale(const std::vector<HandEyeMotion>& motions, const colmap::Rigid3d& cam_from_lidar);
 
 }  // namespace colmap_lidar

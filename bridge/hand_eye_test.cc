@@ -54,5 +54,64 @@ TEST(HandEye, SaysWhyMotionAboutOneAxisOrNoneIsDegenerate) {
       << translations.message;
 }
 
+// A monocular model: camera translations in model units, `metres_per_unit` times smaller.
+std::vector<HandEyeMotion> UpToScale(std::vector<HandEyeMotion> motions, double metres_per_unit) {
+  for (HandEyeMotion& motion : motions) motion.cam_i_from_cam_j.translation /= metres_per_unit;
+  return motions;
+}
+
+TEST(SimilarityHandEye, RecoversScaleAndExtrinsicFromMotionsAboutTwoAxes) {
+  const HandEyeResult result = SolveSimilarityHandEye(
+      UpToScale(Conjugate({Motion(40, {0, 1, 0.05}, {1.2, 0.1, 0.4}),
+                           Motion(-70, {0.02, 1, -0.03}, {-0.8, 0.05, 1.1}),
+                           Motion(25, {1, 0.2, 0}, {0.1, -0.6, 0.3})}),
+                2.5),
+      HandEyeOptions(),
+      Eigen::Vector3d::Zero());
+  ASSERT_TRUE(result.unique) << result.message;
+  EXPECT_NEAR(result.scale, 2.5, 1e-9);
+  EXPECT_LT(result.cam_from_lidar.rotation.angularDistance(kCamFromLidar.rotation), 1e-9);
+  EXPECT_LT((result.cam_from_lidar.translation - kCamFromLidar.translation).norm(), 1e-9);
+  EXPECT_NEAR(HandEyeScale(UpToScale(Conjugate({Motion(3, {0, 1, 0}, {1.2, 0.1, 0.4})}), 2.5),
+                           kCamFromLidar),
+              2.5,
+              1e-9);
+}
+
+// A car on a plane: yaw about the camera's y axis only, and straight stretches. The rotation follows
+// from the yaw axis and the driving direction; the height (along y) is not observable and stays at the
+// fallback, and the result says so.
+TEST(SimilarityHandEye, PlanarDrivingRecoversRotationAndNamesTheAxis) {
+  const Eigen::Vector3d fallback(0.5, -0.2, 0.7);
+  const HandEyeResult result = SolveSimilarityHandEye(
+      UpToScale(Conjugate({Motion(12, {0, 1, 0}, {0.3, 0, 4.0}),
+                           Motion(-20, {0, 1, 0}, {-0.5, 0, 3.5}),
+                           Motion(0, {0, 1, 0}, {0.02, 0, 5.0}),
+                           Motion(0.5, {0, 1, 0}, {0.1, 0, 4.5})}),
+                0.8),
+      HandEyeOptions(),
+      fallback);
+  EXPECT_FALSE(result.unique);
+  ASSERT_TRUE(result.rotation_unique) << result.message;
+  EXPECT_NEAR(std::abs(result.unobservable_axis_in_cam.y()), 1, 1e-9);
+  EXPECT_NE(result.message.find("not observable"), std::string::npos) << result.message;
+  EXPECT_NEAR(result.scale, 0.8, 1e-6);
+  EXPECT_LT(result.cam_from_lidar.rotation.angularDistance(kCamFromLidar.rotation), 1e-6);
+  EXPECT_NEAR(result.cam_from_lidar.translation.x(), kCamFromLidar.translation.x(), 1e-6);
+  EXPECT_NEAR(result.cam_from_lidar.translation.z(), kCamFromLidar.translation.z(), 1e-6);
+  EXPECT_NEAR(result.cam_from_lidar.translation.y(), fallback.y(), 1e-9);
+}
+
+TEST(SimilarityHandEye, StraightDrivingIsDegenerate) {
+  const HandEyeResult result = SolveSimilarityHandEye(
+      UpToScale(Conjugate({Motion(0, {0, 1, 0}, {0, 0, 4.0}), Motion(0, {0, 1, 0}, {0, 0, 5.0})}),
+                0.8),
+      HandEyeOptions(),
+      Eigen::Vector3d::Zero());
+  EXPECT_FALSE(result.rotation_unique);
+  EXPECT_NE(result.message.find("degenerate"), std::string::npos) << result.message;
+  EXPECT_THROW(HandEyeScale({}, kCamFromLidar), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace colmap_lidar

@@ -153,11 +153,13 @@ void WriteRigAndLidarFrames(const StationDataset& dataset,
                             const std::vector<colmap::image_t>& image_ids,
                             const std::string& database_path) {
   ExtensionDatabase extension(database_path);
-  StereoRig rig;
-  rig.left_camera_id = camera_id;
-  rig.right_camera = dataset.rig.right;
-  rig.right_from_left = dataset.rig.right_from_left;
-  extension.WriteRig(rig);
+  if (dataset.rig.IsStereo()) {
+    StereoRig rig;
+    rig.left_camera_id = camera_id;
+    rig.right_camera = *dataset.rig.right;
+    rig.right_from_left = dataset.rig.right_from_left;
+    extension.WriteRig(rig);
+  }
   for (size_t i = 0; i < image_ids.size(); ++i) {
     LidarFrame frame;
     frame.image_id = image_ids[i];
@@ -186,7 +188,9 @@ bool DatasetImportOptions::Check() const {
 void CheckStationImages(const StationDataset& dataset) {
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
     CheckImage(dataset.stations[i], "left", dataset.LeftImagePath(i), dataset.rig.left);
-    CheckImage(dataset.stations[i], "right", dataset.RightImagePath(i), dataset.rig.right);
+    if (dataset.rig.IsStereo()) {
+      CheckImage(dataset.stations[i], "right", dataset.RightImagePath(i), *dataset.rig.right);
+    }
   }
 }
 

@@ -141,11 +141,16 @@ StationRig ReadRigJson(const std::string& path) {
   }
   StationRig rig;
   rig.left = ParseCamera(Require(root, "left", path, ""), path, "left");
-  rig.right = ParseCamera(Require(root, "right", path, ""), path, "right");
-  rig.right_from_left =
-      ParseRigid(Require(root, "right_from_left", path, ""), path, "right_from_left");
-  if (rig.BaselineMeters() < 1e-3) {
-    Fail(path, "'right_from_left.translation' gives a baseline below 1 mm");
+  const bool has_right = root.contains("right") && !root["right"].is_null();
+  if (has_right) {
+    rig.right = ParseCamera(root["right"], path, "right");
+    rig.right_from_left =
+        ParseRigid(Require(root, "right_from_left", path, ""), path, "right_from_left");
+    if (rig.BaselineMeters() < 1e-3) {
+      Fail(path, "'right_from_left.translation' gives a baseline below 1 mm");
+    }
+  } else if (root.contains("right_from_left")) {
+    Fail(path, "'right_from_left' without a 'right' camera (a monocular rig has neither)");
   }
   if (root.contains("cam_from_lidar_guess") && !root["cam_from_lidar_guess"].is_null()) {
     rig.cam_from_lidar_guess =
@@ -169,8 +174,10 @@ void WriteRigJson(const std::string& path, const StationRig& rig) {
       "(x_target = R x_source + t), rotation as a unit quaternion "
       "[qw, qx, qy, qz] (w first), translation in metres.";
   root["left"] = CameraToJson(rig.left);
-  root["right"] = CameraToJson(rig.right);
-  root["right_from_left"] = RigidToJson(rig.right_from_left);
+  if (rig.IsStereo()) {
+    root["right"] = CameraToJson(*rig.right);
+    root["right_from_left"] = RigidToJson(rig.right_from_left);
+  }
   if (rig.cam_from_lidar_guess) {
     root["cam_from_lidar_guess"] = RigidToJson(*rig.cam_from_lidar_guess);
   }
@@ -216,8 +223,15 @@ StationDataset ReadStationDataset(const std::string& root) {
   }
   std::sort(dataset.stations.begin(), dataset.stations.end());
   if (dataset.stations.empty()) Fail(left_dir.string(), "no .png images");
+  const fs::path right_dir = fs::path(root) / "images" / "right";
+  if (!dataset.rig.IsStereo() && fs::is_directory(right_dir)) {
+    Fail((fs::path(root) / "rig.json").string(),
+         "no 'right' camera, but " + right_dir.string() +
+             " exists: add the right camera and right_from_left for a stereo rig, or remove the "
+             "folder for a monocular one");
+  }
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
-    if (!fs::is_regular_file(dataset.RightImagePath(i))) {
+    if (dataset.rig.IsStereo() && !fs::is_regular_file(dataset.RightImagePath(i))) {
       Fail(dataset.RightImagePath(i), "missing right image of station " + dataset.stations[i]);
     }
     std::string cloud;

@@ -1,7 +1,7 @@
 // The station dataset format (docs/dataset_format.md):
 //
 //   DATASET/rig.json
-//   DATASET/images/left/<station>.png, DATASET/images/right/<station>.png
+//   DATASET/images/left/<station>.png, DATASET/images/right/<station>.png (stereo rigs only)
 //   DATASET/lidar/<station>.pcd (or .ply, KITTI .bin)       cloud in the station's LiDAR frame
 //   DATASET/ground_truth/{cam_from_world.txt, cam_from_lidar.txt, surface.ply, depth/<station>.bin}
 //
@@ -24,13 +24,18 @@ namespace colmap_lidar {
 
 struct StationRig {
   colmap::Camera left;
-  colmap::Camera right;
+  // Absent for a monocular rig (no "right" in rig.json, no images/right/): depth and scale then come
+  // from the LiDAR alone.
+  std::optional<colmap::Camera> right;
+  // Meaningful only with `right`.
   colmap::Rigid3d right_from_left;
   std::optional<colmap::Rigid3d> cam_from_lidar_guess;
   std::string lidar_model;         // e.g. "VLP-16"; empty if not given
   double lidar_range_noise_m = 0;  // 0 if not given
 
-  double BaselineMeters() const { return right_from_left.translation.norm(); }
+  bool IsStereo() const { return right.has_value(); }
+  // 0 for a monocular rig.
+  double BaselineMeters() const { return IsStereo() ? right_from_left.translation.norm() : 0.0; }
 };
 
 // Throws std::runtime_error naming the file and the offending key (missing key, unknown camera model,
@@ -52,7 +57,9 @@ struct StationDataset {
   bool HasGroundTruth() const;
 };
 
-// Reads and validates a dataset: rig.json, every left image has a right image and a cloud. Throws
+// Reads and validates a dataset: rig.json, every left image has a cloud and, for a stereo rig, a right
+// image; a monocular rig must not come with images/right/ (which would say rig.json lost its right
+// camera). Throws
 // std::runtime_error naming the missing or bad file.
 StationDataset ReadStationDataset(const std::string& root);
 

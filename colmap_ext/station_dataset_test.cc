@@ -59,7 +59,7 @@ TEST_F(StationDatasetTest, ReadsAValidDataset) {
   const StationDataset dataset = ReadStationDataset(dir_.Path().string());
   EXPECT_EQ(dataset.stations, (std::vector<std::string>{"000", "001"}));
   EXPECT_EQ(dataset.rig.left.ModelName(), "PINHOLE");
-  EXPECT_EQ(dataset.rig.right.params.size(), 8u);
+  EXPECT_EQ(dataset.rig.right->params.size(), 8u);
   EXPECT_DOUBLE_EQ(dataset.rig.BaselineMeters(), 0.38);
   ASSERT_TRUE(dataset.rig.cam_from_lidar_guess.has_value());
   // w first in the file: [0.5, -0.5, 0.5, -0.5] is w=0.5, x=-0.5, ...
@@ -73,7 +73,7 @@ TEST_F(StationDatasetTest, RigJsonRoundTrips) {
   const StationRig rig = ReadRigJson(dir_.File("rig.json"));
   WriteRigJson(dir_.File("copy.json"), rig);
   const StationRig copy = ReadRigJson(dir_.File("copy.json"));
-  EXPECT_EQ(copy.right.params, rig.right.params);
+  EXPECT_EQ(copy.right->params, rig.right->params);
   EXPECT_EQ(copy.lidar_model, "VLP-16");
   EXPECT_NEAR(
       copy.cam_from_lidar_guess->rotation.angularDistance(rig.cam_from_lidar_guess->rotation),

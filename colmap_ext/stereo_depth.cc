@@ -235,7 +235,13 @@ void ComputeDatasetStereoDepth(const StationDataset& dataset,
                                const std::string& output_path,
                                const StereoDepthOptions& options) {
   THROW_CHECK(options.Check());
-  const StereoRectifier rectifier(dataset.rig.left, dataset.rig.right, dataset.rig.right_from_left);
+  if (!dataset.rig.IsStereo()) {
+    throw std::runtime_error(dataset.root +
+                             "/rig.json describes a monocular rig (no 'right' camera): there is no "
+                             "stereo depth to compute");
+  }
+  const StereoRectifier rectifier(
+      dataset.rig.left, *dataset.rig.right, dataset.rig.right_from_left);
   int min_disparity = 0, num_disparities = 0;
   DisparityRange(rectifier, options, &min_disparity, &num_disparities);
   std::cout << "Stereo depth: " << dataset.stations.size() << " stations, "

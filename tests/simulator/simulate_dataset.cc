@@ -90,9 +90,10 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
   }
   const fs::path partial = output.string() + ".partial";
   fs::remove_all(partial);
-  for (const char* dir : {"images/left", "images/right", "lidar", "ground_truth/depth"}) {
+  for (const char* dir : {"images/left", "lidar", "ground_truth/depth"}) {
     fs::create_directories(partial / dir);
   }
+  if (!options.mono) fs::create_directories(partial / "images/right");
 
   const bool drive = motion == Motion::kDrive;
   StationRig rig = drive ? MakeDriveRig(options.image_scale) : MakeStereoRig(options.image_scale);
@@ -102,6 +103,10 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
         cam_from_lidar, options.guess_rotation_deg, options.guess_translation_m, options.seed + 1);
   }
   rig.lidar_range_noise_m = options.range_noise_m;
+  // Mono: the same left images and clouds as the stereo dataset of the same seed; the right camera is
+  // neither rendered nor described.
+  const StationRig stereo_rig = rig;
+  if (options.mono) rig.right.reset();
   WriteRigJson((partial / "rig.json").string(), rig);
 
   const std::vector<colmap::Rigid3d> stations =
@@ -127,10 +132,14 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
                RenderImage(frame_scene, rig.left, stations[i], image_options, &depth));
     WriteDepthMap((partial / "ground_truth/depth" / (name + ".bin")).string(), depth);
     image_options.seed += 1;
-    WriteImage(
-        (partial / "images/right" / (name + ".png")).string(),
-        RenderImage(
-            frame_scene, rig.right, rig.right_from_left * stations[i], image_options, nullptr));
+    if (!options.mono) {
+      WriteImage((partial / "images/right" / (name + ".png")).string(),
+                 RenderImage(frame_scene,
+                             *stereo_rig.right,
+                             stereo_rig.right_from_left * stations[i],
+                             image_options,
+                             nullptr));
+    }
 
     LidarOptions lidar_options;
     lidar_options.num_points = options.lidar_points;

@@ -16,6 +16,8 @@ struct SimulationOptions {
   std::string motion = "two_axes";
   // 1 = 1028x752 per camera, 4 = the 4112x3008 of Zhen et al. 2019
   double image_scale = 1.0;
+  // One camera: rig.json without "right", no images/right/ (a monocular dataset).
+  bool mono = false;
   // LiDAR rays per station
   size_t lidar_points = 1600000;
   double range_noise_m = 0.01;

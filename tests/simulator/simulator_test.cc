@@ -189,9 +189,9 @@ TEST_P(SimulatorImageTest, LeftAndRightImagesAgreeThroughTheTrueDepthAndBaseline
             z * rig.left.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5)).homogeneous();
         const double value = left.at<uint8_t>(row, col);
         const Eigen::Vector2d in_right =
-            rig.right.ImgFromCam((rig.right_from_left * point_in_left).hnormalized());
+            rig.right->ImgFromCam((rig.right_from_left * point_in_left).hnormalized());
         const Eigen::Vector2d in_right_wrong =
-            rig.right.ImgFromCam((wrong_baseline * point_in_left).hnormalized());
+            rig.right->ImgFromCam((wrong_baseline * point_in_left).hnormalized());
         const double r = Bilinear(right, in_right.x(), in_right.y());
         const double w = Bilinear(right, in_right_wrong.x(), in_right_wrong.y());
         if (r < 0 || w < 0) continue;
