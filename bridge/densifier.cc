@@ -165,14 +165,20 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   const colmap::Camera& camera = reconstruction.Camera(image.CameraId());
   const PinholeIntrinsics intrinsics = IntrinsicsOf(camera);
 
-  const std::string stereo_path = StereoDepthMapPath(depth_path, station);
-  cv::Mat stereo = ReadColmapDepthMap(stereo_path);
-  if (stereo.cols != static_cast<int>(original_camera.width) ||
-      stereo.rows != static_cast<int>(original_camera.height)) {
-    throw std::runtime_error("station " + station + ": the depth map " + stereo_path + " is " +
-                             std::to_string(stereo.cols) + "x" + std::to_string(stereo.rows) +
-                             " but the camera is " + std::to_string(original_camera.width) + "x" +
-                             std::to_string(original_camera.height));
+  // Without image depth (a monocular rig), fold 2 alone: every pixel is a hole for the LiDAR to fill.
+  cv::Mat stereo = cv::Mat::zeros(static_cast<int>(original_camera.height),
+                                  static_cast<int>(original_camera.width),
+                                  CV_32F);
+  if (!depth_path.empty()) {
+    const std::string stereo_path = StereoDepthMapPath(depth_path, station);
+    stereo = ReadColmapDepthMap(stereo_path);
+    if (stereo.cols != static_cast<int>(original_camera.width) ||
+        stereo.rows != static_cast<int>(original_camera.height)) {
+      throw std::runtime_error("station " + station + ": the depth map " + stereo_path + " is " +
+                               std::to_string(stereo.cols) + "x" + std::to_string(stereo.rows) +
+                               " but the camera is " + std::to_string(original_camera.width) +
+                               "x" + std::to_string(original_camera.height));
+    }
   }
   if (undistorter) stereo = undistorter->UndistortDepthMap(stereo);
   const Eigen::Map<const DepthImage> stereo_depth(stereo.ptr<float>(), stereo.rows, stereo.cols);
@@ -382,8 +388,15 @@ void PrintStation(size_t k, size_t num_stations, const StationDensification& sta
             << std::fixed << std::setprecision(1) << station.seconds << " s)" << std::endl;
 }
 
-nlohmann::json DensifierReport(const DensifierOptions& options, const DensifierSummary& summary) {
+nlohmann::json DensifierReport(const DensifierOptions& options,
+                               const DensifierSummary& summary,
+                               bool has_image_depth) {
   nlohmann::json report;
+  report["image_depth"] = has_image_depth
+                              ? "stereo"
+                              : "none: there is no image depth (no stereo depth maps, e.g. a "
+                                "monocular rig); every depth comes from the LiDAR, projected and "
+                                "densified within flat layers (fold 2 alone)";
   report["refine_with_lidar"] = options.refine_with_lidar;
   report["min_consistent_views"] = options.min_consistent_views;
   report["fused_voxel_size_m"] = options.fused_voxel_size_m;
@@ -427,6 +440,10 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
                          const std::string& output_path,
                          const DensifierOptions& options) {
   THROW_CHECK(options.Check());
+  if (depth_path.empty() && !options.refine_with_lidar) {
+    throw std::invalid_argument(
+        "no stereo depth maps and refine_with_lidar off: there would be no depth at all");
+  }
   const auto start = std::chrono::steady_clock::now();
   const std::vector<StationView> views = StationViews(input_model, dataset);
   std::map<colmap::camera_t, std::unique_ptr<CameraUndistorter>> undistorters;
@@ -436,7 +453,10 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
   const DenseWorkspace workspace(partial.Path());
   VoxelAccumulator lidar_map(options.lidar_map_voxel_size_m);
   std::cout << "densifier: " << views.size() << " stations, "
-            << (options.refine_with_lidar ? "LiDAR-refined" : "stereo only") << std::endl;
+            << (depth_path.empty()           ? "no image depth (LiDAR depth only, flat layers)"
+                : options.refine_with_lidar ? "LiDAR-refined"
+                                            : "stereo only")
+            << std::endl;
   for (size_t k = 0; k < views.size(); ++k) {
     const auto station_start = std::chrono::steady_clock::now();
     const colmap::camera_t camera_id = input_model.Image(views[k].image_id).CameraId();
@@ -479,7 +499,7 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
   workspace.WriteConfigs(names);
   summary.seconds = SecondsSince(start);
   WriteFileAtomically(partial.File("densifier.json"),
-                      DensifierReport(options, summary).dump(2) + "\n");
+                      DensifierReport(options, summary, !depth_path.empty()).dump(2) + "\n");
   partial.Commit();
   return summary;
 }

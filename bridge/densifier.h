@@ -67,6 +67,7 @@ struct DensifierSummary {
 };
 
 // Stations are the registered images named like the dataset's left images ("left/<station>.png").
+// `depth_path` empty: no image depth (a monocular rig); the LiDAR fills flat layers alone.
 // Throws std::runtime_error naming the station and file for a missing or mis-sized depth map, an
 // unreadable cloud or image; nothing is left at output_path then.
 DensifierSummary Densify(const colmap::Reconstruction& reconstruction,

@@ -188,11 +188,21 @@ HandEyeResult SolveHandEye(const std::vector<HandEyeMotion>& motions,
   return result;
 }
 
-HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& motions,
+HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& all_motions,
                                      const HandEyeOptions& options,
                                      const Eigen::Vector3d& axis_translation_fallback) {
   THROW_CHECK(options.Check());
   HandEyeResult result;
+  // A monocular model can be locally wrong (forward motion): motions whose camera and LiDAR rotation
+  // angles disagree are left out altogether.
+  std::vector<HandEyeMotion> motions;
+  for (const HandEyeMotion& motion : all_motions) {
+    if (std::abs(Eigen::AngleAxisd(motion.cam_i_from_cam_j.rotation).angle() -
+                 Eigen::AngleAxisd(motion.lidar_i_from_lidar_j.rotation).angle()) <=
+        options.max_axis_residual_deg * kDegToRad) {
+      motions.push_back(motion);
+    }
+  }
   RotationAxes axes = RotatingMotions(motions, options);
   result.num_motions = static_cast<int>(axes.motions.size());
   result.max_axis_angle_deg = MaxAngleBetweenLinesDeg(axes.in_cam);
@@ -203,7 +213,12 @@ HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& motions,
       result.message = DegenerateMessage(0, 0);
       return result;
     }
-    result.unobservable_axis_in_cam = axes.in_cam.front();
+    Eigen::Vector3d mean_axis = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < axes.in_cam.size(); ++k) {
+      const double sign = axes.in_cam[k].dot(axes.in_cam.front()) < 0 ? -1.0 : 1.0;
+      mean_axis += sign * axes.weights[k] * axes.in_cam[k];
+    }
+    result.unobservable_axis_in_cam = mean_axis.normalized();
     RotationAxes with_directions = axes;
     AddTranslationDirections(motions, options, colmap::Rigid3d(), &with_directions);
     if (MaxAngleBetweenLinesDeg(with_directions.in_cam) < options.min_axis_angle_deg) {
@@ -227,13 +242,16 @@ HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& motions,
   result.rotation_unique = true;
   std::ostringstream message;
   message << std::fixed << std::setprecision(1) << "similarity hand-eye from " << motions.size()
-          << " motion pairs (" << axes.motions.size() << " rotating, axes span "
+          << " of " << all_motions.size() << " motion pairs (" << axes.motions.size()
+          << " rotating, axes span "
           << result.max_axis_angle_deg << " deg): scale " << std::setprecision(4) << result.scale
           << ", axis fit " << std::setprecision(3) << result.rotation_rms_deg
           << " deg rms, translation residual " << 1000 * result.translation_rms_m << " mm rms";
-  if (!(result.scale > 0)) {
+  if (!(result.scale > 0) || result.rotation_rms_deg > options.max_axis_residual_deg) {
     result.rotation_unique = false;
-    result.message = message.str() + "; the scale is not positive (inconsistent motions)";
+    result.message = message.str() + "; inconsistent motions (" +
+                     (result.scale > 0 ? "the axes do not fit one rotation" : "no positive scale") +
+                     ")";
     return result;
   }
   result.unique = !planar;

@@ -1,6 +1,8 @@
 #include "bridge/joint_adjuster.h"
 
 #include "bridge/extrinsic_prior_cost.h"
+#include "bridge/landmark_lidar_plane_cost.h"
+#include "bridge/landmark_lidar_term.h"
 #include "bridge/lidar_pair_cost.h"
 #include "bridge/lidar_point_to_plane_cost.h"
 #include "colmap_ext/depth_prior_cost.h"
@@ -33,6 +35,12 @@ struct LidarObservation {
   colmap::image_t target = 0, source = 0;
   PointToPlaneObservation data;
   bool outlier = false;
+};
+
+// The observations of the association-dependent terms E_l and E_m, with their outlier flags.
+struct Associations {
+  std::vector<LidarObservation> lidar;
+  std::vector<LandmarkPlaneObservation> landmarks;
 };
 
 double TermCost(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& ids) {
@@ -95,6 +103,7 @@ struct JointProblem {
   size_t num_lidar_residuals = 0;
   // Residuals that compressed LiDAR blocks stand for beyond the rows they have.
   size_t num_hidden_residuals = 0;
+  std::vector<ceres::ResidualBlockId> landmark_ids;
   std::vector<ceres::ResidualBlockId> prior_ids;
 };
 
@@ -111,6 +120,8 @@ struct RunState {
         initial_translation(cam_from_lidar->translation),
         loss(MakeLoss(options.loss, options.loss_scale)),
         use_lidar(options.mode != JointMode::kStereoOnly && options.lidar_weight > 0),
+        use_landmark_lidar(options.mode != JointMode::kStereoOnly &&
+                           options.landmark_lidar_weight > 0),
         refine_extrinsic(options.mode == JointMode::kJoint) {}
 
   const JointAdjusterOptions& options;
@@ -122,10 +133,14 @@ struct RunState {
   // Owned here: COLMAP's problem does not take ownership of loss functions.
   std::unique_ptr<ceres::LossFunction> loss;
   const bool use_lidar;
+  const bool use_landmark_lidar;
   const bool refine_extrinsic;
   std::set<ImagePoint> depth_outliers;
   size_t num_reprojection_outliers = 0;
   size_t num_lidar_outliers = 0;
+  size_t num_landmark_outliers = 0;
+
+  bool UsesExtrinsic() const { return use_lidar || use_landmark_lidar; }
 
   double* ExtrinsicRotation() const { return cam_from_lidar->rotation.coeffs().data(); }
   double* ExtrinsicTranslation() const { return cam_from_lidar->translation.data(); }
@@ -272,8 +287,32 @@ void AddLidarBlocks(const RunState& state,
   }
 }
 
+// E_m for every associated landmark observation in force (the landmark and image still there).
+void AddLandmarkLidarBlocks(const RunState& state,
+                            const std::vector<LandmarkPlaneObservation>& observations,
+                            JointProblem* joint) {
+  ceres::Problem* problem = joint->problem.get();
+  const double sigma =
+      state.options.sigma_landmark_lidar_m / std::sqrt(state.options.landmark_lidar_weight);
+  for (const LandmarkPlaneObservation& observation : observations) {
+    if (observation.outlier || !state.reconstruction->ExistsPoint3D(observation.point3D_id)) {
+      continue;
+    }
+    const auto [rotation, translation] = PoseBlocks(state, problem, observation.image_id);
+    joint->landmark_ids.push_back(problem->AddResidualBlock(
+        LandmarkLidarPlaneCostFunctor::Create(
+            observation.point_in_lidar, observation.normal_in_lidar, sigma),
+        state.loss.get(),
+        {rotation,
+         translation,
+         state.reconstruction->Point3D(observation.point3D_id).xyz.data(),
+         state.ExtrinsicRotation(),
+         state.ExtrinsicTranslation()}));
+  }
+}
+
 std::unique_ptr<JointProblem> BuildProblem(const RunState& state,
-                                           const std::vector<LidarObservation>& observations) {
+                                           const Associations& associations) {
   auto joint = std::make_unique<JointProblem>();
   joint->ba_options = JointBundleAdjustmentOptions(state.options);
   joint->adjuster = std::make_unique<colmap::BundleAdjuster>(joint->ba_options, state.config);
@@ -283,9 +322,10 @@ std::unique_ptr<JointProblem> BuildProblem(const RunState& state,
   joint->problem->GetResidualBlocks(&all_ids);
   joint->reprojection_ids = all_ids;  // everything COLMAP added
   AddDepthPriorBlocks(state, joint.get());
-  if (state.use_lidar) {
-    AddExtrinsicBlocks(state, joint.get());
-    AddLidarBlocks(state, observations, joint.get());
+  if (state.UsesExtrinsic()) AddExtrinsicBlocks(state, joint.get());
+  if (state.use_lidar) AddLidarBlocks(state, associations.lidar, joint.get());
+  if (state.use_landmark_lidar) {
+    AddLandmarkLidarBlocks(state, associations.landmarks, joint.get());
   }
   return joint;
 }
@@ -296,9 +336,11 @@ SolveStats Solve(JointProblem* joint) {
   stats.reprojection.num_observations = joint->reprojection_ids.size();
   stats.depth.num_observations = joint->depth_ids.size();
   stats.lidar.num_observations = joint->num_lidar_residuals;
+  stats.landmark_lidar.num_observations = joint->landmark_ids.size();
   stats.reprojection.cost_before = TermCost(problem, joint->reprojection_ids);
   stats.depth.cost_before = TermCost(problem, joint->depth_ids);
   stats.lidar.cost_before = TermCost(problem, joint->lidar_ids);
+  stats.landmark_lidar.cost_before = TermCost(problem, joint->landmark_ids);
   const ceres::Solver::Options solver_options =
       joint->adjuster->SetUpSolverOptions(*problem, joint->ba_options.solver_options);
   ceres::Solver::Summary summary;
@@ -306,6 +348,7 @@ SolveStats Solve(JointProblem* joint) {
   stats.reprojection.cost_after = TermCost(problem, joint->reprojection_ids);
   stats.depth.cost_after = TermCost(problem, joint->depth_ids);
   stats.lidar.cost_after = TermCost(problem, joint->lidar_ids);
+  stats.landmark_lidar.cost_after = TermCost(problem, joint->landmark_ids);
   stats.num_iterations = static_cast<int>(summary.iterations.size());
   stats.seconds_per_iteration = MeanIterationSeconds(summary);
   stats.residual_blocks = static_cast<size_t>(summary.num_residual_blocks);
@@ -417,6 +460,25 @@ size_t FlagLidarOutliers(RunState* state, std::vector<LidarObservation>* observa
   return flagged;
 }
 
+// E_m observations beyond the absolute or the sigma gate get zero weight; returns how many new.
+size_t FlagLandmarkOutliers(RunState* state, std::vector<LandmarkPlaneObservation>* observations) {
+  const double gate =
+      std::min(state->options.max_landmark_plane_m,
+               state->options.max_landmark_plane_sigmas * state->options.sigma_landmark_lidar_m);
+  size_t flagged = 0;
+  for (LandmarkPlaneObservation& observation : *observations) {
+    if (observation.outlier) continue;
+    const double distance =
+        LandmarkPlaneDistance(observation, *state->reconstruction, *state->cam_from_lidar);
+    if (std::isnan(distance) || std::abs(distance) > gate) {
+      observation.outlier = true;
+      ++flagged;
+    }
+  }
+  state->num_landmark_outliers += flagged;
+  return flagged;
+}
+
 // Point-to-plane observations of every directed pair of the pose graph, contiguous per pair.
 std::vector<LidarObservation> Associate(const RunState& state, double max_distance) {
   const colmap::Reconstruction& reconstruction = *state.reconstruction;
@@ -458,12 +520,39 @@ std::vector<LidarObservation> Associate(const RunState& state, double max_distan
   return observations;
 }
 
+// Round `round`'s associations of E_l and E_m, with the gate halved per round down to the final one.
+void Reassociate(int round, int num_rounds, RunState* state, Associations* associations) {
+  const JointAdjusterOptions& options = state->options;
+  const double gate = std::max(options.association.max_distance,
+                               options.initial_association_distance_m * std::pow(0.5, round));
+  const auto start = std::chrono::steady_clock::now();
+  if (state->use_lidar) associations->lidar = Associate(*state, gate);
+  if (state->use_landmark_lidar) {
+    associations->landmarks = AssociateLandmarksWithLidar(*state->reconstruction,
+                                                          state->data.clouds,
+                                                          *state->cam_from_lidar,
+                                                          gate,
+                                                          options.association.max_curvature);
+  }
+  state->num_lidar_outliers = 0;
+  state->num_landmark_outliers = 0;
+  std::cout << "Round " << round + 1 << "/" << num_rounds << ": " << associations->lidar.size()
+            << " LiDAR point-to-plane observations, " << associations->landmarks.size()
+            << " landmark-to-LiDAR-plane observations (gate " << gate << " m, "
+            << SecondsSince(start) << " s)" << std::endl;
+}
+
 void PrintSolve(const SolveStats& stats, size_t changes) {
   std::cout << std::defaultfloat << std::setprecision(4) << "  solve " << stats.round << "."
             << stats.outlier_iteration << ": cost reprojection " << stats.reprojection.cost_before
             << " -> " << stats.reprojection.cost_after << ", depth " << stats.depth.cost_before
-            << " -> " << stats.depth.cost_after << ", lidar " << stats.lidar.cost_before << " -> "
-            << stats.lidar.cost_after << "; " << stats.num_iterations << " iterations, " << changes
+ << " -> " << stats.depth.cost_after << ", lidar " << stats.lidar.cost_before << " -> "
+            << stats.lidar.cost_after;
+  if (stats.landmark_lidar.num_observations > 0) {
+    std::cout << ", landmark-lidar " << stats.landmark_lidar.cost_before << " -> "
+              << stats.landmark_lidar.cost_after;
+  }
+  std::cout << "; " << stats.num_iterations << " iterations, " << changes
             << " outlier changes (depth priors: residual scale "
             << stats.depth_outliers.residual_scale << " sigma_d, out "
             << stats.depth_outliers.beyond_sigma << " beyond sigma, "
@@ -475,21 +564,23 @@ void PrintSolve(const SolveStats& stats, size_t changes) {
 // Solves until no outlier status changes (or the cap); `observations` keeps its outlier flags.
 void SolveWithOutliers(int round,
                        RunState* state,
-                       std::vector<LidarObservation>* observations,
+                       Associations* associations,
                        JointAdjustmentSummary* summary) {
   for (int iteration = 0; iteration < state->options.max_outlier_iterations; ++iteration) {
     const auto start = std::chrono::steady_clock::now();
-    std::unique_ptr<JointProblem> joint = BuildProblem(*state, *observations);
+    std::unique_ptr<JointProblem> joint = BuildProblem(*state, *associations);
     SolveStats stats = Solve(joint.get());
     joint.reset();  // before the reconstruction changes under it
     stats.round = round + 1;
     stats.outlier_iteration = iteration + 1;
     size_t changes = RemoveReprojectionOutliers(state);
     changes += UpdateDepthOutliers(state, &stats.depth_outliers);
-    changes += FlagLidarOutliers(state, observations);
+    changes += FlagLidarOutliers(state, &associations->lidar);
+    changes += FlagLandmarkOutliers(state, &associations->landmarks);
     stats.reprojection.num_outliers = state->num_reprojection_outliers;
     stats.depth.num_outliers = state->depth_outliers.size();
     stats.lidar.num_outliers = state->num_lidar_outliers;
+    stats.landmark_lidar.num_outliers = state->num_landmark_outliers;
     stats.seconds = SecondsSince(start);
     PrintSolve(stats, changes);
     summary->solves.push_back(stats);
@@ -497,7 +588,8 @@ void SolveWithOutliers(int round,
   }
 }
 
-// Clusters of residuals that share errors: a landmark's reprojections, an image's depth priors, a
+// Clusters of residuals that share errors: a landmark's reprojections and landmark-to-plane residuals,
+// an image's depth priors, a
 // directed LiDAR station pair; per cluster its station group keys (target, source image) for two-way
 // clustering of the LiDAR term ({-1, -1} otherwise). The weak extrinsic prior is not data and is left
 // out.
@@ -514,13 +606,15 @@ Clusters ResidualClusters(const colmap::Reconstruction& reconstruction, const Jo
   Clusters clusters;
   clusters.blocks.resize(landmark_cluster.size());
   std::vector<double*> blocks;
-  for (const ceres::ResidualBlockId id : joint.reprojection_ids) {
-    joint.problem->GetParameterBlocksForResidualBlock(id, &blocks);
-    for (const double* block : blocks) {
-      const auto it = landmark_cluster.find(block);
-      if (it != landmark_cluster.end()) {
-        clusters.blocks[it->second].push_back(id);
-        break;
+  for (const auto* ids : {&joint.reprojection_ids, &joint.landmark_ids}) {
+    for (const ceres::ResidualBlockId id : *ids) {
+      joint.problem->GetParameterBlocksForResidualBlock(id, &blocks);
+      for (const double* block : blocks) {
+        const auto it = landmark_cluster.find(block);
+        if (it != landmark_cluster.end()) {
+          clusters.blocks[it->second].push_back(id);
+          break;
+        }
       }
     }
   }
@@ -578,8 +672,8 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
   return uncertainty;
 }
 
-// The paper's perturbation curves: only E_l depends on T_e, so the total is the rest (constant) plus
-// the LiDAR term at the perturbed T_e. Offsets are true rotation angles about the camera axes.
+// The paper's perturbation curves: only E_l (and E_m) depend on T_e, so the total is the rest
+// (constant) plus those terms at the perturbed T_e. Offsets are true rotation angles about the camera axes.
 std::vector<PerturbationCurve> PerturbationCurves(const RunState& state, JointProblem* joint) {
   ceres::Problem* problem = joint->problem.get();
   const double rest =
@@ -602,7 +696,8 @@ std::vector<PerturbationCurve> PerturbationCurves(const RunState& state, JointPr
                                   optimum.rotation;
       }
       curve.offsets.push_back(offset);
-      curve.costs.push_back(rest + TermCost(problem, joint->lidar_ids));
+      curve.costs.push_back(rest + TermCost(problem, joint->lidar_ids) +
+                            TermCost(problem, joint->landmark_ids));
     }
     curves.push_back(curve);
   }
@@ -635,6 +730,10 @@ bool JointAdjusterOptions::Check() const {
   CHECK_OPTION_GT(sigma_lidar_m, 0);
   CHECK_OPTION_GE(depth_weight, 0);
   CHECK_OPTION_GE(lidar_weight, 0);
+  CHECK_OPTION_GE(landmark_lidar_weight, 0);
+  CHECK_OPTION_GT(sigma_landmark_lidar_m, 0);
+  CHECK_OPTION_GT(max_landmark_plane_m, 0);
+  CHECK_OPTION_GT(max_landmark_plane_sigmas, 0);
   CHECK_OPTION(loss == "none" || loss == "huber" || loss == "cauchy");
   CHECK_OPTION_GT(loss_scale, 0);
   CHECK_OPTION_GT(max_reprojection_error_px, 0);
@@ -668,31 +767,23 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
   state.config.SetConstantCamPose(image_ids.front());  // the gauge
 
   JointAdjustmentSummary summary;
-  std::vector<LidarObservation> observations;
-  const int num_rounds = state.use_lidar ? options_.num_association_rounds : 1;
+  Associations associations;
+  const int num_rounds = state.UsesExtrinsic() ? options_.num_association_rounds : 1;
   for (int round = 0; round < num_rounds; ++round) {
-    if (state.use_lidar) {
-      const double gate = std::max(options_.association.max_distance,
-                                   options_.initial_association_distance_m * std::pow(0.5, round));
-      const auto start = std::chrono::steady_clock::now();
-      observations = Associate(state, gate);
-      state.num_lidar_outliers = 0;
-      std::cout << "Round " << round + 1 << "/" << num_rounds << ": " << observations.size()
-                << " LiDAR point-to-plane observations (gate " << gate << " m, "
-                << SecondsSince(start) << " s)" << std::endl;
-    }
-    SolveWithOutliers(round, &state, &observations, &summary);
+    if (state.UsesExtrinsic()) Reassociate(round, num_rounds, &state, &associations);
+    SolveWithOutliers(round, &state, &associations, &summary);
   }
 
   // The uncertainty and the perturbation curves are evaluated on a problem rebuilt from the final
   // state: the last solve's problem may hold residuals of observations (even landmarks) removed after
   // it.
   summary.motion = AnalyseMotion(*reconstruction, options_.observability);
-  const std::unique_ptr<JointProblem> final_problem = BuildProblem(state, observations);
+  const std::unique_ptr<JointProblem> final_problem = BuildProblem(state, associations);
   summary.final_reprojection_residuals = final_problem->reprojection_ids.size();
   summary.final_depth_residuals = final_problem->depth_ids.size();
   summary.final_lidar_residuals = final_problem->num_lidar_residuals;
-  if (state.use_lidar) {
+  summary.final_landmark_lidar_residuals = final_problem->landmark_ids.size();
+  if (state.UsesExtrinsic()) {
     const auto start = std::chrono::steady_clock::now();
     summary.uncertainty = Uncertainty(state, *final_problem, summary.motion);
     summary.perturbation = PerturbationCurves(state, final_problem.get());

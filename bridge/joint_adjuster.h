@@ -12,6 +12,8 @@
 //   E_l = n^T (lidar_i_from_lidar_j p - q) / sigma_l,
 //   lidar_i_from_lidar_j = inverse(T_e) cam_from_world_i inverse(cam_from_world_j) T_e
 //   (bridge/lidar_point_to_plane_cost.h).
+// - Optional (not in the paper; on by default for a monocular rig): the landmark-to-LiDAR-plane
+//   residual E_m = n^T (lidar_i_from_world X - q) / sigma_m with w_m (bridge/landmark_lidar_plane_cost.h).
 // - E_f = COLMAP's reprojection residual in pixels (sigma_p = 1 px); E_d = the depth-prior residual
 //   (colmap_ext/depth_prior_cost.h), z-depth with sigma_d = d^2/(b f) sigma_p.
 // - Gauge: the first station's (smallest image_id's) pose is constant. Metric scale comes from the depth
@@ -59,6 +61,15 @@ struct JointAdjusterOptions {
   double depth_weight = 1.0;
   // w_l of E_l.
   double lidar_weight = 1.0;
+  // w_m of E_m, the landmark-to-LiDAR-plane term; 0 = off (the paper's cost). The pipeline turns it on
+  // for a monocular rig, where it gives the landmarks their metric depth.
+  double landmark_lidar_weight = 0.0;
+  // sigma_m of E_m: the landmark's triangulation and the LiDAR surface together.
+  double sigma_landmark_lidar_m = 0.02;
+  // E_m outliers: beyond this distance or beyond max_landmark_plane_sigmas * sigma_m (absolute and in
+  // sigma units), zero weight until none remain; re-associated each round with the LiDAR term's gate.
+  double max_landmark_plane_m = 0.1;
+  double max_landmark_plane_sigmas = 3.0;
   // Robust loss on every term: none | huber | cauchy (none in the paper). With a loss, each LiDAR
   // observation is its own residual block (the loss applies per observation); without, one block per
   // directed station pair.
@@ -135,7 +146,7 @@ struct DepthOutlierStats {
 struct SolveStats {
   int round = 0;
   int outlier_iteration = 0;
-  TermStats reprojection, depth, lidar;
+  TermStats reprojection, depth, lidar, landmark_lidar;
   DepthOutlierStats depth_outliers;
   int num_iterations = 0;
   // Size of the problem as Ceres saw it.
@@ -163,6 +174,7 @@ struct JointAdjustmentSummary {
   size_t final_reprojection_residuals = 0;
   size_t final_depth_residuals = 0;
   size_t final_lidar_residuals = 0;
+  size_t final_landmark_lidar_residuals = 0;
   ExtrinsicUncertainty uncertainty;
   MotionAnalysis motion;
   std::vector<PerturbationCurve> perturbation;

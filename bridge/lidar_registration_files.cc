@@ -111,21 +111,30 @@ std::vector<std::string> LargestLidarComponent(const std::vector<LidarPairRecord
   return largest;
 }
 
-std::map<std::string, Eigen::Vector3d> StationCameraPositions(
-    const std::string& registration_path, const colmap::Rigid3d& cam_from_lidar) {
+std::map<std::string, colmap::Rigid3d> LargestComponentLidarPoses(
+    const std::string& registration_path) {
   const std::filesystem::path folder(registration_path);
   const std::vector<LidarPairRecord> pairs = ReadLidarPairs((folder / "pairs.txt").string());
   const std::map<std::string, colmap::Rigid3d> world_from_lidar =
       ReadNamedPoses((folder / "lidar_poses.txt").string());
-  const Eigen::Vector3d camera_in_lidar = colmap::Inverse(cam_from_lidar).translation;
-  std::map<std::string, Eigen::Vector3d> positions;
+  std::map<std::string, colmap::Rigid3d> poses;
   for (const std::string& station : LargestLidarComponent(pairs)) {
     const auto pose = world_from_lidar.find(station);
     if (pose == world_from_lidar.end()) {
       throw std::runtime_error(registration_path + ": station " + station +
                                " is in pairs.txt but not in lidar_poses.txt");
     }
-    positions[station] = pose->second * camera_in_lidar;
+    poses.emplace(station, pose->second);
+  }
+  return poses;
+}
+
+std::map<std::string, Eigen::Vector3d> StationCameraPositions(
+    const std::string& registration_path, const colmap::Rigid3d& cam_from_lidar) {
+  const Eigen::Vector3d camera_in_lidar = colmap::Inverse(cam_from_lidar).translation;
+  std::map<std::string, Eigen::Vector3d> positions;
+  for (const auto& [station, world_from_lidar] : LargestComponentLidarPoses(registration_path)) {
+    positions[station] = world_from_lidar * camera_in_lidar;
   }
   return positions;
 }

@@ -56,6 +56,12 @@ std::vector<LidarPairRecord> ReadLidarPairs(const std::string& path);
 // lexicographically first station), sorted by name.
 std::vector<std::string> LargestLidarComponent(const std::vector<LidarPairRecord>& pairs);
 
+// world_from_lidar of every station of the largest component, in that component's world (its first
+// station's LiDAR frame), from `registration_path`/pairs.txt and lidar_poses.txt. Throws
+// std::runtime_error naming a missing file or a station missing from lidar_poses.txt.
+std::map<std::string, colmap::Rigid3d> LargestComponentLidarPoses(
+    const std::string& registration_path);
+
 // The camera position of every station of the largest component in that component's world (its first
 // station's LiDAR frame), from `registration_path`/pairs.txt and lidar_poses.txt (world_from_lidar):
 // world_from_lidar * inverse(cam_from_lidar) applied to the origin. Other components have worlds of

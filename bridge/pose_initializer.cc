@@ -86,6 +86,8 @@ void SolveCameraPoseGraph(const std::map<std::string, colmap::image_t>& image_of
 bool PoseInitializerOptions::Check() const {
   CHECK_OPTION(image_pairs.Check());
   CHECK_OPTION(hand_eye.Check());
+  CHECK_OPTION(similarity_hand_eye.Check());
+  CHECK_OPTION(mapping.Check());
   CHECK_OPTION_GT(sigma_rotation_deg, 0);
   CHECK_OPTION_GT(sigma_translation_m, 0);
   return true;
@@ -170,6 +172,88 @@ PoseInitialization InitializePoses(const std::string& database_path,
   return init;
 }
 
+namespace {
+
+// Metres per model unit: the median of prior depth / model depth over every landmark observation with a
+// depth prior.
+double DepthPriorScale(const std::string& database_path, const colmap::Reconstruction& model) {
+  const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
+  std::vector<double> ratios;
+  for (const colmap::image_t image_id : model.RegImageIds()) {
+    const colmap::Image& image = model.Image(image_id);
+    for (const DepthPrior& prior : extension.ReadDepthPriors(image_id)) {
+      if (prior.point2D_idx >= image.NumPoints2D()) {
+        throw std::runtime_error("the model's image " + image.Name() +
+                                 " does not match the database's keypoints");
+      }
+      const colmap::Point2D& point2D = image.Point2D(prior.point2D_idx);
+      if (!point2D.HasPoint3D()) continue;
+      const double depth = (image.CamFromWorld() * model.Point3D(point2D.point3D_id).xyz).z();
+      if (depth > 0) ratios.push_back(prior.depth / depth);
+    }
+  }
+  if (ratios.size() < 10) {
+    throw std::runtime_error("cannot rescale the model to metres: only " +
+                             std::to_string(ratios.size()) +
+                             " landmark observations carry a depth prior (run "
+                             "depth_prior_extractor on the model's database)");
+  }
+  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  return ratios[ratios.size() / 2];
+}
+
+// The model's relative motions paired with the LiDAR's over lidar_registrator's pairs.
+std::vector<HandEyeMotion> ModelMotions(const colmap::Reconstruction& model,
+                                        const std::map<std::string, colmap::image_t>& image_of_station,
+                                        const std::string& registration_path) {
+  std::vector<HandEyeMotion> motions;
+  if (registration_path.empty()) return motions;
+  for (const LidarPairRecord& pair :
+       ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
+    if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) continue;
+    const colmap::image_t i = image_of_station.at(pair.target);
+    const colmap::image_t j = image_of_station.at(pair.source);
+    motions.push_back(
+        {model.Image(i).CamFromWorld() * colmap::Inverse(model.Image(j).CamFromWorld()),
+         pair.target_from_source});
+  }
+  return motions;
+}
+
+// Monocular: the scale and cam_from_lidar from the similarity hand-eye, or from rig.json's guess with
+// the scale fitted to the LiDAR motions through it; planar motion keeps the guess's (or zero)
+// translation along the unobservable axis.
+double ChooseSimilarityExtrinsic(const std::vector<HandEyeMotion>& motions,
+                                 const StationDataset& dataset,
+                                 const PoseInitializerOptions& options,
+                                 PoseInitialization* init) {
+  const std::optional<colmap::Rigid3d>& guess = dataset.rig.cam_from_lidar_guess;
+  init->hand_eye = SolveSimilarityHandEye(
+      motions, options.similarity_hand_eye, guess ? guess->translation : Eigen::Vector3d::Zero());
+  if ((options.use_guess && guess) || (!init->hand_eye.rotation_unique && guess)) {
+    init->cam_from_lidar = *guess;
+    init->extrinsic_source = "rig.json guess, scale from the LiDAR motions";
+    if (!init->hand_eye.rotation_unique) {
+      init->extrinsic_source += " (hand-eye: " + init->hand_eye.message + ")";
+    }
+    return HandEyeScale(motions, *guess);
+  }
+  if (!init->hand_eye.rotation_unique) {
+    throw std::runtime_error("cannot initialise the scale and cam_from_lidar: " +
+                             init->hand_eye.message + "; add cam_from_lidar_guess to " +
+                             dataset.root + "/rig.json");
+  }
+  init->cam_from_lidar = init->hand_eye.cam_from_lidar;
+  init->extrinsic_source = "similarity hand-eye";
+  if (!init->hand_eye.unique) {
+    init->extrinsic_source += guess ? " (translation along the unobservable axis from the guess)"
+                                    : " (translation along the unobservable axis set to 0)";
+  }
+  return init->hand_eye.scale;
+}
+
+}  // namespace
+
 PoseInitialization InitializeFromModel(const std::string& database_path,
                                        const StationDataset& dataset,
                                        const std::string& registration_path,
@@ -178,60 +262,69 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
                                        double* scale) {
   THROW_CHECK(options.Check());
   THROW_CHECK_NOTNULL(model);
-  THROW_CHECK_GE(model->NumRegImages(), 2) << "the model has fewer than 2 "
-                                              "registered images";
-  const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
-  // Metres: the median of prior depth / model depth over every landmark observation with a prior.
-  std::vector<double> ratios;
+  THROW_CHECK_GE(model->NumRegImages(), 2) << "the model has fewer than 2 registered images";
   std::map<std::string, colmap::image_t> image_of_station;
   for (const colmap::image_t image_id : model->RegImageIds()) {
-    const colmap::Image& image = model->Image(image_id);
-    image_of_station[fs::path(image.Name()).stem().string()] = image_id;
-    for (const DepthPrior& prior : extension.ReadDepthPriors(image_id)) {
-      if (prior.point2D_idx >= image.NumPoints2D()) {
-        throw std::runtime_error("the model's image " + image.Name() +
-                                 " does not match the database's keypoints");
-      }
-      const colmap::Point2D& point2D = image.Point2D(prior.point2D_idx);
-      if (!point2D.HasPoint3D()) continue;
-      const double depth = (image.CamFromWorld() * model->Point3D(point2D.point3D_id).xyz).z();
-      if (depth > 0) ratios.push_back(prior.depth / depth);
-    }
+    image_of_station[fs::path(model->Image(image_id).Name()).stem().string()] = image_id;
   }
-  if (ratios.size() < 10) {
-    throw std::runtime_error("cannot rescale the model to metres: only " +
-                             std::to_string(ratios.size()) +
-                             " landmark observations carry a depth prior (run "
-                             "depth_prior_extractor on "
-                             "the model's database)");
-  }
-  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
-  *scale = ratios[ratios.size() / 2];
-  model->Transform(colmap::Sim3d(*scale, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()));
-
   PoseInitialization init;
-  std::vector<HandEyeMotion> motions;
-  if (!registration_path.empty()) {
-    for (const LidarPairRecord& pair :
-         ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
-      if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) {
-        continue;
-      }
-      const colmap::image_t i = image_of_station.at(pair.target);
-      const colmap::image_t j = image_of_station.at(pair.source);
-      motions.push_back(
-          {model->Image(i).CamFromWorld() * colmap::Inverse(model->Image(j).CamFromWorld()),
-           pair.target_from_source});
-      ++init.num_lidar_edges;
-    }
+  if (dataset.rig.IsStereo()) {
+    *scale = DepthPriorScale(database_path, *model);
+  } else {
+    *scale = ChooseSimilarityExtrinsic(
+        ModelMotions(*model, image_of_station, registration_path), dataset, options, &init);
   }
-  ChooseExtrinsic(motions, dataset, options, &init);
+  model->Transform(colmap::Sim3d(*scale, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()));
+  const std::vector<HandEyeMotion> motions =
+      ModelMotions(*model, image_of_station, registration_path);
+  init.num_lidar_edges = static_cast<int>(motions.size());
+  if (dataset.rig.IsStereo()) ChooseExtrinsic(motions, dataset, options, &init);
   for (const colmap::image_t image_id : model->RegImageIds()) {
     init.cam_from_world[image_id] = model->Image(image_id).CamFromWorld();
   }
-  for (const std::string& station : dataset.stations) {
-    if (!image_of_station.count(station)) init.unreachable.push_back("left/" + station + ".png");
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    if (!image_of_station.count(dataset.stations[i])) {
+      init.unreachable.push_back(dataset.LeftImageName(i));
+    }
   }
+  return init;
+}
+
+PoseInitialization InitializeMonocular(const std::string& database_path,
+                                       const StationDataset& dataset,
+                                       const std::string& registration_path,
+                                       const PoseInitializerOptions& options) {
+  THROW_CHECK(options.Check());
+  THROW_CHECK(!registration_path.empty())
+      << "a monocular dataset needs lidar_registrator's output (--registration_path)";
+  const std::map<std::string, colmap::Rigid3d> world_from_lidar =
+      LargestComponentLidarPoses(registration_path);
+  PoseInitialization init;
+  if (options.use_guess && dataset.rig.cam_from_lidar_guess) {
+    init.cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
+    init.extrinsic_source = "rig.json guess";
+  } else {
+    colmap::Reconstruction model = MapWithColmap(
+        database_path, (fs::path(dataset.root) / "images").string(), options.mapping);
+    std::map<std::string, colmap::image_t> model_image_of_station;
+    for (const colmap::image_t image_id : model.RegImageIds()) {
+      model_image_of_station[fs::path(model.Image(image_id).Name()).stem().string()] = image_id;
+    }
+    ChooseSimilarityExtrinsic(
+        ModelMotions(model, model_image_of_station, registration_path), dataset, options, &init);
+  }
+  const colmap::Database database(database_path);
+  for (const colmap::Image& image : database.ReadAllImages()) {
+    const std::string station = fs::path(image.Name()).stem().string();
+    const auto pose = world_from_lidar.find(station);
+    if (pose == world_from_lidar.end()) {
+      init.unreachable.push_back(image.Name());
+      continue;
+    }
+    init.cam_from_world[image.ImageId()] = init.cam_from_lidar * colmap::Inverse(pose->second);
+  }
+  init.num_lidar_edges = static_cast<int>(
+      ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string()).size());
   return init;
 }
 

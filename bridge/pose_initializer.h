@@ -7,10 +7,15 @@
 //    first station gives initial poses; a pose graph over all edges (Ceres) refines them. Stations that
 //    no edge reaches are reported and left out.
 // The world frame is the first station's camera frame; units are metres.
+//
+// A monocular dataset has no depth priors, so no metric image edges: it starts from COLMAP's own
+// incremental mapper (colmap_ext/incremental_mapping.h) and InitializeFromModel, whose scale and
+// cam_from_lidar then come from the similarity hand-eye with the LiDAR motions (or rig.json's guess).
 #pragma once
 
 #include "bridge/hand_eye.h"
 #include "bridge/image_pair_poses.h"
+#include "colmap_ext/incremental_mapping.h"
 #include "colmap_ext/station_dataset.h"
 
 #include "colmap/scene/reconstruction.h"
@@ -24,6 +29,18 @@ namespace colmap_lidar {
 struct PoseInitializerOptions {
   ImagePairPoseOptions image_pairs;
   HandEyeOptions hand_eye;
+  // The similarity hand-eye of a monocular rig: a driving platform turns by a few degrees between
+  // frames, so smaller rotations give axes (weighted by their angle) and the others their translation
+  // directions; a monocular model can be locally wrong, so camera and LiDAR rotation angles must agree
+  // closely.
+  HandEyeOptions similarity_hand_eye = [] {
+    HandEyeOptions options;
+    options.min_rotation_deg = 1.0;
+    options.max_axis_residual_deg = 0.5;
+    return options;
+  }();
+  // COLMAP's mapper, for a monocular dataset
+  IncrementalMappingOptions mapping;
   // false: hand-eye even when rig.json has a guess
   bool use_guess = true;
   // pose-graph edge weights
@@ -58,15 +75,29 @@ PoseInitialization InitializePoses(const std::string& database_path,
                                    const PoseInitializerOptions& options);
 
 // The existing-COLMAP-workflow variant: `model` (e.g. from `colmap mapper` on the same database) is
-// rescaled to metres in place by the median ratio of depth prior to model depth over its landmark
-// observations (`scale` returns the factor), and cam_from_lidar comes from the guess or hand-eye with
-// the model's relative poses as image motions. Stations the model did not register are listed.
+// rescaled to metres in place (`scale` returns the factor) and cam_from_lidar chosen:
+// - stereo rig: the scale is the median ratio of depth prior to model depth over its landmark
+//   observations; cam_from_lidar the guess or hand-eye with the model's relative poses as image motions;
+// - monocular rig: the similarity hand-eye gives both (or the guess, with the scale fitted to the LiDAR
+//   motions through it); planar motion names its unobservable axis in `hand_eye`.
+// Stations the model did not register are listed.
 PoseInitialization InitializeFromModel(const std::string& database_path,
                                        const StationDataset& dataset,
                                        const std::string& registration_path,
                                        const PoseInitializerOptions& options,
                                        colmap::Reconstruction* model,
                                        double* scale);
+
+// The monocular initialisation: cam_from_lidar from rig.json's guess (if allowed and present), else
+// from the similarity hand-eye between COLMAP's own incremental model of the database (mapped here)
+// and the LiDAR motions; then every station of the largest LiDAR component is placed through its
+// LiDAR pose, cam_from_world = cam_from_lidar * inverse(world_from_lidar): the LiDAR trajectory is
+// metric and, on forward motion, more reliable than a monocular model. Stations outside that
+// component are listed as unreachable.
+PoseInitialization InitializeMonocular(const std::string& database_path,
+                                       const StationDataset& dataset,
+                                       const std::string& registration_path,
+                                       const PoseInitializerOptions& options);
 
 // Writes a COLMAP sparse model with the initial poses and landmarks triangulated by COLMAP's own
 // triangulator (IncrementalMapperController::TriangulateReconstruction with the poses held fixed).

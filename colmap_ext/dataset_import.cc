@@ -204,8 +204,9 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
   THROW_CHECK(options.matcher != "spatial" || !options.station_positions.empty())
       << "the spatial matcher needs station positions (none came from the LiDAR registration)";
   THROW_CHECK(!dataset.stations.empty()) << "no stations in " << dataset.root;
-  std::cout << "Checking " << dataset.stations.size() << " stereo pairs of " << dataset.root
-            << std::endl;
+  std::cout << "Checking " << dataset.stations.size()
+            << (dataset.rig.IsStereo() ? " stereo pairs of " : " images (monocular rig) of ")
+            << dataset.root << std::endl;
   CheckStationImages(dataset);
 
   const std::string partial = database_path + ".import-partial";

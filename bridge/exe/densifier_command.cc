@@ -78,7 +78,9 @@ int RunDensifier(int argc, char** argv) {
   options.AddRequiredOption(
       "input_path", &paths.input_path, "refined sparse model (joint_adjuster)");
   options.AddRequiredOption("dataset_path", &dataset_path);
-  options.AddRequiredOption("depth_path", &paths.depth_path, "stereo_depth's output folder");
+  options.AddDefaultOption("depth_path",
+                           &paths.depth_path,
+                           "stereo_depth's output folder; empty (a monocular rig): LiDAR depth only");
   options.AddRequiredOption("output_path", &paths.output_path);
   options.AddDefaultOption("cam_from_lidar",
                            &paths.cam_from_lidar_path,

@@ -95,6 +95,7 @@ void WriteReport(const std::string& directory,
                       {"reprojection", TermJson(solve.reprojection)},
                       {"depth", TermJson(solve.depth)},
                       {"lidar", TermJson(solve.lidar)},
+                      {"landmark_lidar", TermJson(solve.landmark_lidar)},
                       {"depth_outliers",
                        {{"residual_scale", solve.depth_outliers.residual_scale},
                         {"beyond_sigma", solve.depth_outliers.beyond_sigma},
@@ -107,7 +108,9 @@ void WriteReport(const std::string& directory,
   report["solves"] = solves;
   report["final_problem"] = {{"reprojection_residuals", summary.final_reprojection_residuals},
                              {"depth_residuals", summary.final_depth_residuals},
-                             {"lidar_residuals", summary.final_lidar_residuals}};
+                             {"lidar_residuals", summary.final_lidar_residuals},
+                             {"landmark_lidar_residuals", summary.final_landmark_lidar_residuals}};
+  report["landmark_lidar_weight"] = options.landmark_lidar_weight;
   const ExtrinsicUncertainty& u = summary.uncertainty;
   nlohmann::json uncertainty = {{"computed", u.computed}, {"message", u.message}};
   if (u.computed) {
@@ -159,7 +162,8 @@ void WritePlots(const std::string& directory, const JointAdjustmentSummary& summ
   for (size_t k = 0; k < summary.solves.size(); ++k) {
     const SolveStats& s = summary.solves[k];
     total.x.push_back(static_cast<double>(k + 1));
-    total.y.push_back(s.reprojection.cost_after + s.depth.cost_after + s.lidar.cost_after);
+    total.y.push_back(s.reprojection.cost_after + s.depth.cost_after + s.lidar.cost_after +
+                      s.landmark_lidar.cost_after);
   }
   LinePlotOptions cost_options;
   cost_options.title = "Joint problem: cost after each solve";
@@ -226,6 +230,8 @@ bool JointAdjusterStepOptions::Check() {
   adjuster.hold_translation = ParseHeldAxes(hold_translation);
   CHECK_OPTION_GT(num_samples_per_pair, 0);
   adjuster.association.num_samples = static_cast<size_t>(num_samples_per_pair);
+  CHECK_OPTION(landmark_lidar_weight == -1 || landmark_lidar_weight >= 0);
+  if (landmark_lidar_weight >= 0) adjuster.landmark_lidar_weight = landmark_lidar_weight;
   return adjuster.Check() && data.Check();
 }
 
@@ -247,6 +253,12 @@ void AddJointAdjusterOptions(const std::string& prefix,
           &adjuster.max_depth_error_m,
           "absolute cap on top of the sigma gate; 0: off");
   add.Add("max_point_to_plane_m", &adjuster.max_point_to_plane_m);
+  add.Add("landmark_lidar_weight",
+          &options->landmark_lidar_weight,
+          "w_m of the landmark-to-LiDAR-plane term; -1: 1 for a monocular rig, 0 for stereo");
+  add.Add("sigma_landmark_lidar_m", &adjuster.sigma_landmark_lidar_m);
+  add.Add("max_landmark_plane_m", &adjuster.max_landmark_plane_m);
+  add.Add("max_landmark_plane_sigmas", &adjuster.max_landmark_plane_sigmas);
   add.Add("max_outlier_iterations", &adjuster.max_outlier_iterations);
   add.Add("num_association_rounds", &adjuster.num_association_rounds);
   add.Add("num_samples_per_pair", &options->num_samples_per_pair);
@@ -271,6 +283,13 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                           const JointAdjusterPaths& paths,
                           JointAdjusterStepOptions options) {
   THROW_CHECK(options.Check());
+  if (!dataset.rig.IsStereo() && options.adjuster.mode == JointMode::kStereoOnly) {
+    throw std::invalid_argument("--mode stereo_only needs a stereo rig; " + dataset.root +
+                                "/rig.json has one camera");
+  }
+  if (options.landmark_lidar_weight < 0) {
+    options.adjuster.landmark_lidar_weight = dataset.rig.IsStereo() ? 0.0 : 1.0;
+  }
   const auto start = std::chrono::steady_clock::now();
   THROW_CHECK(fs::is_directory(paths.input_path)) << "no sparse model folder " << paths.input_path;
   colmap::Reconstruction reconstruction;

@@ -28,6 +28,9 @@ void AddPoseInitializerOptions(const std::string& prefix,
           &options->use_guess,
           "use rig.json's cam_from_lidar_guess if present (0: hand-eye)");
   add.Add("min_pair_inliers", &options->image_pairs.min_inliers);
+  add.Add("min_model_size",
+          &options->mapping.min_model_size,
+          "monocular: smallest model COLMAP's mapper keeps");
   add.Add("sigma_rotation_deg", &options->sigma_rotation_deg, "pose-graph edge weight");
   add.Add("sigma_translation_m", &options->sigma_translation_m, "pose-graph edge weight");
 }
@@ -50,6 +53,10 @@ void WriteInitializationReport(const std::string& path,
   report["unreachable"] = init.unreachable;
   report["input_model"] = input_path;
   report["scale_to_metres"] = scale;
+  if (init.hand_eye.unobservable_axis_in_cam.squaredNorm() > 0) {
+    const Eigen::Vector3d& axis = init.hand_eye.unobservable_axis_in_cam;
+    report["hand_eye"]["unobservable_translation_axis_in_cam"] = {axis.x(), axis.y(), axis.z()};
+  }
   WriteFileAtomically(path, report.dump(2) + "\n");
 }
 
@@ -63,7 +70,13 @@ void RunPoseInitializerStep(const StationDataset& dataset,
   PartialOutputFolder partial(paths.output_path);
   PoseInitialization init;
   double scale = 1;
-  if (paths.input_path.empty()) {
+  if (paths.input_path.empty() && !dataset.rig.IsStereo()) {
+    std::cout << "Monocular dataset: stations placed through their LiDAR poses" << std::endl;
+    init = InitializeMonocular(paths.database_path, dataset, paths.registration_path, options);
+    scale = init.hand_eye.scale;
+    TriangulateInitialModel(
+        paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
+  } else if (paths.input_path.empty()) {
     init = InitializePoses(paths.database_path, dataset, paths.registration_path, options);
     std::cout << "Pose graph: " << init.num_image_edges << " image edges (A_c), "
               << init.num_lidar_edges << " LiDAR edges (A_l); " << init.cam_from_world.size()
@@ -175,10 +188,17 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
   const std::string joint = (ws / "sparse" / "joint").string();
   const std::string dense = (ws / "dense").string();
   const std::string evaluation = (ws / "evaluation").string();
+  // A monocular rig has no stereo steps and no stereo depth for the densifier.
+  const bool stereo_rig = dataset.rig.IsStereo();
   std::vector<PipelineStep> steps = {
-      {"import_dataset", [=, &dataset] { RunImportStep(dataset, database, options.import); }},
-      {"stereo_depth", [=, &dataset] { RunStereoDepthStep(dataset, stereo, options.stereo); }},
-      {"depth_prior_extractor", [=] { RunDepthPriorStep(database, stereo, options.depth_prior); }},
+      {"import_dataset", [=, &dataset] { RunImportStep(dataset, database, options.import); }}};
+  if (stereo_rig) {
+    steps.push_back(
+        {"stereo_depth", [=, &dataset] { RunStereoDepthStep(dataset, stereo, options.stereo); }});
+    steps.push_back({"depth_prior_extractor",
+                     [=] { RunDepthPriorStep(database, stereo, options.depth_prior); }});
+  }
+  std::vector<PipelineStep> back_end = {
       {"lidar_registrator",
        [=, &dataset] {
          RunLidarRegistratorStep(
@@ -194,9 +214,11 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
        }},
       {"densifier",
        [=, &dataset] {
-         RunDensifierStep(dataset, {joint, "", stereo, dense}, options.densifier);
+         RunDensifierStep(
+             dataset, {joint, "", stereo_rig ? stereo : "", dense}, options.densifier);
        }},
   };
+  steps.insert(steps.end(), back_end.begin(), back_end.end());
   if (!dataset.HasGroundTruth()) return steps;
   steps.push_back({"evaluate_calibration", [=, &dataset] {
                      RunEvaluateCalibrationStep(dataset.root, joint, "", evaluation, "rigid");

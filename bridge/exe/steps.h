@@ -120,6 +120,9 @@ struct JointAdjusterStepOptions {
   std::string mode = "joint";
   // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by Check().
   std::string hold_translation;
+  // w_m of the landmark-to-LiDAR-plane term; -1: 1 for a monocular rig, 0 for stereo (decided by
+  // RunJointAdjusterStep from the dataset); into `adjuster` by Check() when >= 0.
+  double landmark_lidar_weight = -1;
   // LiDAR samples per pair (int for the OptionManager); into `adjuster.association` by Check().
   int num_samples_per_pair = static_cast<int>(JointAdjusterOptions().association.num_samples);
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).

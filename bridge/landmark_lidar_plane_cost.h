@@ -1,0 +1,64 @@
+// The landmark-to-LiDAR-plane residual E_m, a term Zhen et al. 2019 do not have but that fits their
+// cost: it gives a monocular camera its depth and scale from the LiDAR. A landmark X seen in image i
+// should lie on station i's LiDAR surface; with q and n (unit) the nearest planar sample of station i's
+// cloud (lidar_i frame, re-associated every round like E_l):
+//
+//   E_m = n^T (lidar_i_from_world X - q) / sigma_m,   lidar_i_from_world = inverse(T_e) cam_i_from_world,
+//
+// so it constrains T_e = cam_from_lidar too. It is evaluated in camera i's frame, where it has the same
+// value: E_m = (R_e n)^T (cam_i_from_world X - T_e q) / sigma_m.
+//
+// Parameter blocks (COLMAP's): cam_i_from_world rotation [4] (Eigen quaternion, xyzw) and translation
+// [3], the landmark's xyz [3] (world frame), cam_from_lidar rotation [4] and translation [3].
+#pragma once
+
+#include "colmap/estimators/cost_functions.h"
+
+#include <Eigen/Core>
+#include <ceres/autodiff_cost_function.h>
+
+namespace colmap_lidar {
+
+class LandmarkLidarPlaneCostFunctor {
+ public:
+  LandmarkLidarPlaneCostFunctor(const Eigen::Vector3d& point_in_lidar_i,
+                                const Eigen::Vector3d& normal_in_lidar_i,
+                                double sigma)
+      : point_in_lidar_i_(point_in_lidar_i),
+        normal_in_lidar_i_(normal_in_lidar_i),
+        inverse_sigma_(1.0 / sigma) {}
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& point_in_lidar_i,
+                                     const Eigen::Vector3d& normal_in_lidar_i,
+                                     double sigma) {
+    return new ceres::AutoDiffCostFunction<LandmarkLidarPlaneCostFunctor, 1, 4, 3, 3, 4, 3>(
+        new LandmarkLidarPlaneCostFunctor(point_in_lidar_i, normal_in_lidar_i, sigma));
+  }
+
+  template <typename T>
+  bool operator()(const T* const cam_i_from_world_rotation,
+                  const T* const cam_i_from_world_translation,
+                  const T* const landmark_in_world,
+                  const T* const cam_from_lidar_rotation,
+                  const T* const cam_from_lidar_translation,
+                  T* residual) const {
+    using Vector3 = Eigen::Matrix<T, 3, 1>;
+    const auto cam_from_lidar_q = colmap::EigenQuaternionMap<T>(cam_from_lidar_rotation);
+    const Vector3 landmark_in_cam_i =
+        colmap::EigenQuaternionMap<T>(cam_i_from_world_rotation) *
+            colmap::EigenVector3Map<T>(landmark_in_world) +
+        colmap::EigenVector3Map<T>(cam_i_from_world_translation);
+    const Vector3 target_in_cam_i = cam_from_lidar_q * point_in_lidar_i_.cast<T>() +
+                                    colmap::EigenVector3Map<T>(cam_from_lidar_translation);
+    const Vector3 normal_in_cam_i = cam_from_lidar_q * normal_in_lidar_i_.cast<T>();
+    residual[0] = normal_in_cam_i.dot(landmark_in_cam_i - target_in_cam_i) * T(inverse_sigma_);
+    return true;
+  }
+
+ private:
+  const Eigen::Vector3d point_in_lidar_i_;
+  const Eigen::Vector3d normal_in_lidar_i_;
+  const double inverse_sigma_;
+};
+
+}  // namespace colmap_lidar
