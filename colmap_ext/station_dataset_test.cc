@@ -126,6 +126,29 @@ TEST_F(StationDatasetTest, MissingImageOrCloudNamesTheFile) {
   EXPECT_EQ(ReadStationDataset(dir_.Path().string()).cloud_paths[0], dir_.File("lidar/000.bin"));
 }
 
+// A monocular rig: no "right" in rig.json, no images/right/. It round-trips as monocular; a leftover
+// images/right/ folder or a right_from_left without a right camera is refused naming rig.json.
+TEST_F(StationDatasetTest, MonocularRigHasNoRightCamera) {
+  json mono = ValidRig();
+  mono.erase("right");
+  mono.erase("right_from_left");
+  WriteRig(mono);
+  ExpectError("rig.json", "images/right");
+  fs::remove_all(dir_.Path() / "images/right");
+  const StationDataset dataset = ReadStationDataset(dir_.Path().string());
+  EXPECT_FALSE(dataset.rig.IsStereo());
+  EXPECT_EQ(dataset.rig.BaselineMeters(), 0.0);
+  EXPECT_EQ(dataset.stations.size(), 2u);
+  WriteRigJson(dir_.File("copy.json"), dataset.rig);
+  EXPECT_FALSE(ReadRigJson(dir_.File("copy.json")).IsStereo());
+  std::ifstream copy(dir_.File("copy.json"));
+  EXPECT_FALSE(json::parse(copy).contains("right_from_left"));
+
+  mono["right_from_left"] = ValidRig()["right_from_left"];
+  WriteRig(mono);
+  ExpectError("rig.json", "'right_from_left' without a 'right' camera");
+}
+
 TEST_F(StationDatasetTest, PoseFilesRoundTripWithWFirst) {
   const colmap::Rigid3d pose(
       Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized())),

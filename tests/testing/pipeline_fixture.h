@@ -40,8 +40,10 @@ inline std::string Simulate(const std::string& output_path,
                             int num_stations,
                             double image_scale,
                             size_t lidar_points,
-                            bool write_guess) {
+                            bool write_guess,
+                            bool mono = false) {
   sim::SimulationOptions options;
+  options.mono = mono;
   options.output_path = output_path;
   options.scene = scene;
   options.num_stations = num_stations;
