@@ -101,22 +101,6 @@ colmap::Rigid3d TrueCamFromLidar() {
                          Eigen::Vector3d(0.19, -0.25, -0.05));
 }
 
-colmap::Rigid3d PerturbPose(const colmap::Rigid3d& truth,
-                            double rotation_deg,
-                            double translation_m,
-                            uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> normal;
-  const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-  const Eigen::Vector3d shift = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-  colmap::Rigid3d perturbed = truth;
-  perturbed.rotation =
-      (Eigen::Quaterniond(Eigen::AngleAxisd(rotation_deg * kDegToRad, axis)) * truth.rotation)
-          .normalized();
-  perturbed.translation += translation_m * shift;
-  return perturbed;
-}
-
 std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
                                           int num_stations,
                                           Motion motion,

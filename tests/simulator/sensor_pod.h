@@ -3,6 +3,7 @@
 // Transforms are target_from_source; quaternions are Eigen (xyzw storage) in memory.
 #pragma once
 
+#include "colmap_ext/pose_perturbation.h"
 #include "colmap_ext/station_dataset.h"
 #include "tests/simulator/scene.h"
 
@@ -37,12 +38,7 @@ StationRig MakeStereoRig(double image_scale);
 // mounted with a small, generic misalignment.
 colmap::Rigid3d TrueCamFromLidar();
 
-// `truth` rotated by `rotation_deg` about a random axis and shifted by `translation_m` in a random
-// direction (seeded).
-colmap::Rigid3d PerturbPose(const colmap::Rigid3d& truth,
-                            double rotation_deg,
-                            double translation_m,
-                            uint64_t seed);
+using colmap_lidar::PerturbPose;  // colmap_ext/pose_perturbation.h
 
 // cam_from_world of the left camera of each station, 2-3 m from the structure and looking at it; for
 // kDrive, of the forward camera at 1.65 m above the street at each frame's mid-sweep time.
