@@ -30,6 +30,10 @@ CalibrationEvaluation EvaluateCalibration(
   result.cam_from_lidar_translation_error_mm =
       result.cam_from_lidar_translation_error_in_cam_mm.norm();
 
+  if (true_cam_from_world.empty()) {
+    result.alignment = "none";  // no true poses (a KITTI drive): the extrinsic only
+    return result;
+  }
   std::vector<std::string> names;
   std::vector<const colmap::Image*> images;
   std::map<std::string, const colmap::Image*> by_station;

@@ -34,6 +34,8 @@ struct CalibrationEvaluation {
 // Rotation angle between two rotations and distance between translations of two transforms.
 double RotationErrorDeg(const colmap::Rigid3d& a, const colmap::Rigid3d& b);
 
+// With no true poses (`true_cam_from_world` empty, e.g. a KITTI drive), only the extrinsic is
+// evaluated: alignment "none", no station errors.
 CalibrationEvaluation EvaluateCalibration(
     const colmap::Rigid3d& true_cam_from_lidar,
     const colmap::Rigid3d& estimated_cam_from_lidar,

@@ -1,5 +1,6 @@
 #include "bridge/joint_adjuster.h"
 
+#include "bridge/extrinsic_hold_cost.h"
 #include "bridge/extrinsic_prior_cost.h"
 #include "bridge/landmark_lidar_plane_cost.h"
 #include "bridge/landmark_lidar_term.h"
@@ -23,6 +24,7 @@
 #include <iostream>
 #include <memory>
 #include <set>
+#include <sstream>
 
 namespace colmap_lidar {
 namespace {
@@ -117,6 +119,7 @@ struct RunState {
         data(data),
         reconstruction(reconstruction),
         cam_from_lidar(cam_from_lidar),
+        initial_rotation(cam_from_lidar->rotation),
         initial_translation(cam_from_lidar->translation),
         loss(MakeLoss(options.loss, options.loss_scale)),
         use_lidar(options.mode != JointMode::kStereoOnly && options.lidar_weight > 0),
@@ -129,7 +132,11 @@ struct RunState {
   colmap::Reconstruction* reconstruction;
   colmap::Rigid3d* cam_from_lidar;
   colmap::BundleAdjustmentConfig config;
+  const Eigen::Quaterniond initial_rotation;
   const Eigen::Vector3d initial_translation;
+  // Projections onto the directions of T_e held at their initial value (zero: none held).
+  Eigen::Matrix3d held_rotation = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d held_translation = Eigen::Matrix3d::Zero();
   // Owned here: COLMAP's problem does not take ownership of loss functions.
   std::unique_ptr<ceres::LossFunction> loss;
   const bool use_lidar;
@@ -233,6 +240,19 @@ void AddExtrinsicBlocks(const RunState& state, JointProblem* joint) {
     problem->SetParameterBlockConstant(translation);
   } else if (!held.empty()) {
     colmap::SetSubsetManifold(3, held, problem, translation);
+  }
+  if (state.refine_extrinsic &&
+      (state.held_rotation.squaredNorm() > 0 || state.held_translation.squaredNorm() > 0)) {
+    constexpr double kHoldSigma = 1e-7;  // [rad], [m]: effectively constant
+    joint->prior_ids.push_back(
+        problem->AddResidualBlock(ExtrinsicHoldCostFunctor::Create(state.initial_rotation,
+                                                                   state.initial_translation,
+                                                                   state.held_rotation,
+                                                                   state.held_translation,
+                                                                   kHoldSigma),
+                                  nullptr,
+                                  rotation,
+                                  translation));
   }
   if (state.refine_extrinsic && held.size() < 3 && state.options.extrinsic_prior_sigma_m > 0) {
     joint->prior_ids.push_back(problem->AddResidualBlock(
@@ -705,6 +725,38 @@ std::vector<PerturbationCurve> PerturbationCurves(const RunState& state, JointPr
   return curves;
 }
 
+// The directions of T_e whose standard deviation exceeds observability's thresholds, per block
+// (rotation [deg], translation [mm]) of the covariance, as projections and in words.
+struct HeldDirections {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d translation = Eigen::Matrix3d::Zero();
+  std::vector<std::string> names;
+};
+
+HeldDirections UnobservableDirections(const ExtrinsicUncertainty& uncertainty,
+                                      const ObservabilityOptions& options) {
+  HeldDirections held;
+  for (int block = 0; block < 2; ++block) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(
+        uncertainty.covariance.block<3, 3>(3 * block, 3 * block));
+    const double threshold =
+        block == 0 ? options.unobservable_rotation_deg : options.unobservable_translation_mm;
+    for (int k = 0; k < 3; ++k) {
+      const double sigma = std::sqrt(std::max(0.0, solver.eigenvalues()[k]));
+      if (!(sigma > threshold)) continue;
+      const Eigen::Vector3d direction = solver.eigenvectors().col(k);
+      (block == 0 ? held.rotation : held.translation) += direction * direction.transpose();
+      std::ostringstream name;
+      name << std::fixed << std::setprecision(2) << (block == 0 ? "rotation about" : "translation along")
+           << " the camera-frame direction (" << direction.x() << ", " << direction.y() << ", "
+           << direction.z() << "), sigma " << std::setprecision(3) << sigma
+           << (block == 0 ? " deg" : " mm");
+      held.names.push_back(name.str());
+    }
+  }
+  return held;
+}
+
 }  // namespace
 
 JointMode JointModeFromName(const std::string& name) {
@@ -754,15 +806,16 @@ JointAdjuster::JointAdjuster(const JointAdjusterOptions& options) : options_(opt
   THROW_CHECK(options_.Check());
 }
 
-JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
-                                          colmap::Reconstruction* reconstruction,
-                                          colmap::Rigid3d* cam_from_lidar) const {
-  THROW_CHECK_NOTNULL(reconstruction);
-  THROW_CHECK_NOTNULL(cam_from_lidar);
+JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
+                                              colmap::Reconstruction* reconstruction,
+                                              colmap::Rigid3d* cam_from_lidar,
+                                              const Eigen::Matrix3d& held_rotation,
+                                              const Eigen::Matrix3d& held_translation) const {
   std::vector<colmap::image_t> image_ids = reconstruction->RegImageIds();
-  THROW_CHECK_GE(image_ids.size(), 2) << "the joint problem needs at least 2 registered images";
   std::sort(image_ids.begin(), image_ids.end());
   RunState state(options_, data, reconstruction, cam_from_lidar);
+  state.held_rotation = held_rotation;
+  state.held_translation = held_translation;
   for (const colmap::image_t image_id : image_ids) state.config.AddImage(image_id);
   state.config.SetConstantCamPose(image_ids.front());  // the gauge
 
@@ -791,6 +844,36 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
               << std::endl;
   }
   return summary;
+}
+
+JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
+                                          colmap::Reconstruction* reconstruction,
+                                          colmap::Rigid3d* cam_from_lidar) const {
+  THROW_CHECK_NOTNULL(reconstruction);
+  THROW_CHECK_NOTNULL(cam_from_lidar);
+  THROW_CHECK_GE(reconstruction->NumRegImages(), 2)
+      << "the joint problem needs at least 2 registered images";
+  const bool may_hold = options_.hold_unobservable && options_.mode == JointMode::kJoint;
+  const colmap::Reconstruction initial_reconstruction =
+      may_hold ? *reconstruction : colmap::Reconstruction();
+  const colmap::Rigid3d initial_extrinsic = *cam_from_lidar;
+  JointAdjustmentSummary summary = RunOnce(
+      data, reconstruction, cam_from_lidar, Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero());
+  if (!may_hold || !summary.uncertainty.computed) return summary;
+  const HeldDirections held = UnobservableDirections(summary.uncertainty, options_.observability);
+  if (held.names.empty()) return summary;
+  std::cout << "cam_from_lidar: " << held.names.size()
+            << " direction(s) unobservable; solving again from the start with them held at their "
+               "initial value"
+            << std::endl;
+  *reconstruction = initial_reconstruction;
+  *cam_from_lidar = initial_extrinsic;
+  JointAdjustmentSummary held_summary =
+      RunOnce(data, reconstruction, cam_from_lidar, held.rotation, held.translation);
+  held_summary.held_at_initial = held.names;
+  held_summary.solves.insert(
+      held_summary.solves.begin(), summary.solves.begin(), summary.solves.end());
+  return held_summary;
 }
 
 }  // namespace colmap_lidar

@@ -105,6 +105,10 @@ struct JointAdjusterOptions {
   // unobservable direction where it started instead of letting it drift; 0 = off. It is left out of the
   // uncertainty, so an unobservable direction is named whatever this sigma.
   double extrinsic_prior_sigma_m = 1.0;
+  // Never drift: when the solve finds directions of T_e unobservable (their standard deviation above
+  // observability's thresholds), the adjustment runs again from the initial state with those
+  // directions held at their initial value (bridge/extrinsic_hold_cost.h); the report names them.
+  bool hold_unobservable = true;
   int max_num_iterations = 100;
   ObservabilityOptions observability;
 
@@ -178,6 +182,9 @@ struct JointAdjustmentSummary {
   ExtrinsicUncertainty uncertainty;
   MotionAnalysis motion;
   std::vector<PerturbationCurve> perturbation;
+  // Directions of T_e held at their initial value after a first solve found them unobservable (empty:
+  // none); the solves of that first pass are in `solves` too, before those of the held pass.
+  std::vector<std::string> held_at_initial;
 };
 
 // Ceres' mean time per iteration (iteration 0, the initial evaluation, left out); 0 without iterations.
@@ -194,6 +201,13 @@ class JointAdjuster {
                              colmap::Rigid3d* cam_from_lidar) const;
 
  private:
+  // One adjustment with the given directions of T_e held (projections in the camera frame; zero: none).
+  JointAdjustmentSummary RunOnce(const JointProblemData& data,
+                                 colmap::Reconstruction* reconstruction,
+                                 colmap::Rigid3d* cam_from_lidar,
+                                 const Eigen::Matrix3d& held_rotation,
+                                 const Eigen::Matrix3d& held_translation) const;
+
   const JointAdjusterOptions options_;
 };
 

@@ -1,5 +1,6 @@
 #include "colmap_ext/kitti_import.h"
 
+#include "colmap_ext/atomic_file.h"
 #include "colmap_ext/kitti_calibration.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/pose_perturbation.h"
@@ -127,8 +128,8 @@ KittiImportSummary ImportKittiDrive(const KittiImportOptions& options) {
         left.cam_from_velo, options.guess_rotation_deg, options.guess_translation_m, options.seed);
   }
 
-  const fs::path partial = output.string() + ".partial";
-  fs::remove_all(partial);
+  PartialOutputFolder partial_folder(options.output_path);
+  const fs::path partial = partial_folder.Path();
   fs::create_directories(partial / "images" / "left");
   fs::create_directories(partial / "lidar");
   fs::create_directories(partial / "ground_truth");
@@ -156,8 +157,7 @@ KittiImportSummary ImportKittiDrive(const KittiImportOptions& options) {
                     " from the Velodyne: [I | K^-1 P_rect[:,3]] R_rect_00 [R|T]; "
                     "cam_from_lidar (x_cam = R x_lidar + t)",
                 left.cam_from_velo);
-  fs::remove_all(output);
-  fs::rename(partial, output);
+  partial_folder.Commit();
   KittiImportSummary summary;
   summary.num_frames = static_cast<int>(frames.size());
   summary.stereo = stereo;

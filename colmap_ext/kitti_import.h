@@ -42,7 +42,7 @@ struct KittiImportSummary {
   int width = 0, height = 0;
 };
 
-// Writes OUTPUT.partial and renames it to OUTPUT when complete. Throws std::runtime_error naming the
+// Writes OUTPUT.partial and renames it to OUTPUT when complete (nothing is left on failure). Throws std::runtime_error naming the
 // file (and key or line): a missing P_rect_0X, a frame without a cloud, a truncated .bin, an image of
 // another size than S_rect_0X, an existing output without `overwrite`.
 KittiImportSummary ImportKittiDrive(const KittiImportOptions& options);

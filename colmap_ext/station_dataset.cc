@@ -207,6 +207,10 @@ bool StationDataset::HasGroundTruth() const {
   return fs::is_regular_file(GroundTruthPath("cam_from_world.txt"));
 }
 
+bool StationDataset::HasReferenceExtrinsic() const {
+  return fs::is_regular_file(GroundTruthPath("cam_from_lidar.txt"));
+}
+
 StationDataset ReadStationDataset(const std::string& root) {
   if (!fs::is_directory(root)) Fail(root, "dataset directory does not exist");
   StationDataset dataset;

@@ -54,7 +54,10 @@ struct StationDataset {
   // "left/<station>.png" etc.: the image name as stored in COLMAP's database.
   std::string LeftImageName(size_t i) const;
   std::string GroundTruthPath(const std::string& name) const;
+  // ground_truth/cam_from_world.txt (true poses; the simulator writes them).
   bool HasGroundTruth() const;
+  // ground_truth/cam_from_lidar.txt (a reference extrinsic; import_kitti writes only this).
+  bool HasReferenceExtrinsic() const;
 };
 
 // Reads and validates a dataset: rig.json, every left image has a cloud and, for a stereo rig, a right

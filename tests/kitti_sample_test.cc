@@ -6,6 +6,7 @@
 // with the car's standstill as the relative motion, close the one 3-cycle, and refuse every pair across
 // places.
 #include "colmap_ext/kitti_calibration.h"
+#include "colmap_ext/station_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 
@@ -134,21 +135,31 @@ TEST(KittiSampleTest, DepthEdgesProjectOntoImageEdgesThroughTheImportedCalibrati
   if (!std::filesystem::is_directory(kSample)) {
     GTEST_SKIP() << "no KITTI sample at " << kSampleRoot;
   }
-  const KittiCamera camera = ReadKittiCamera(kSampleRoot + "/calibration", 0);
+  // Through the product's importer: `import_kitti --camera 0` (a monocular dataset, 6 frames).
+  testing::ScopedTempDir dir;
+  const auto run = testing::RunCommand(std::string(COLMAP_LIDAR_CLI_EXE) +
+                                       " import_kitti --kitti_path " + kSampleRoot +
+                                       " --calib_path " + kSampleRoot + "/calibration" +
+                                       " --output_path " + dir.File("dataset") + " --camera 0");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const StationDataset dataset = ReadStationDataset(dir.File("dataset"));
+  ASSERT_EQ(dataset.stations.size(), 6u);
+  EXPECT_FALSE(dataset.rig.IsStereo());
+  EXPECT_FALSE(dataset.rig.cam_from_lidar_guess);
+  KittiCamera camera;
+  camera.camera = dataset.rig.left;
+  camera.cam_from_velo = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
   std::vector<cv::Mat> distances;
   std::vector<std::vector<Eigen::Vector3d>> edge_points;
-  for (const char* frame :
-       {"0000000001", "0000000006", "0000000019", "0000000034", "0000000035", "0000000185"}) {
-    const cv::Mat image =
-        cv::imread(kSampleRoot + "/image_00/data/" + frame + ".png", cv::IMREAD_GRAYSCALE);
-    ASSERT_FALSE(image.empty()) << frame;
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    const cv::Mat image = cv::imread(dataset.LeftImagePath(i), cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(image.empty()) << dataset.LeftImagePath(i);
     ASSERT_EQ(image.cols, static_cast<int>(camera.camera.width));
     cv::Mat edges;
     cv::Canny(image, edges, 100, 200);
     distances.emplace_back();
     cv::distanceTransform(255 - edges, distances.back(), cv::DIST_L2, 3);
-    edge_points.push_back(
-        DepthEdgePoints(ReadKittiBin(kSample + "/" + std::string(frame) + ".bin"), 0.5));
+    edge_points.push_back(DepthEdgePoints(ReadKittiBin(dataset.cloud_paths[i]), 0.5));
   }
   const auto score = [&](int axis, double degrees) {
     const colmap::Rigid3d rotated(

@@ -49,6 +49,9 @@ const std::vector<Command>& Commands() {
        &RunImportDataset,
        "Import a station dataset into a COLMAP database (camera, SIFT, "
        "matches, rig, LiDAR frames)"},
+      {"import_kitti",
+       &RunImportKitti,
+       "Convert a KITTI raw drive into a station dataset (reference extrinsic as ground truth)"},
       {"stereo_depth", &RunStereoDepth, "SGM stereo depth maps per station in the left image grid"},
       {"depth_prior_extractor",
        &RunDepthPriorExtractor,

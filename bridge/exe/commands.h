@@ -17,6 +17,10 @@ int RunDatabaseInfo(int argc, char** argv);
 // exhaustive matching, our rig and lidar_frames rows (colmap_ext/dataset_import.h).
 int RunImportDataset(int argc, char** argv);
 
+// Converts a KITTI raw drive (images, Velodyne sweeps, calibration) into a station dataset
+// (colmap_ext/kitti_import.h).
+int RunImportKitti(int argc, char** argv);
+
 // SGM stereo depth per station in the original left image grid (colmap_ext/stereo_depth.h).
 int RunStereoDepth(int argc, char** argv);
 

@@ -177,7 +177,14 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
                                         ? (fs::path(input_path) / "cam_from_lidar.txt").string()
                                         : cam_from_lidar_path;
   const fs::path truth_dir = fs::path(dataset_path) / "ground_truth";
-  const auto true_cam_from_world = ReadNamedPoses((truth_dir / "cam_from_world.txt").string());
+  std::map<std::string, colmap::Rigid3d> true_cam_from_world;
+  if (fs::is_regular_file(truth_dir / "cam_from_world.txt")) {
+    true_cam_from_world = ReadNamedPoses((truth_dir / "cam_from_world.txt").string());
+  } else {
+    std::cout << "evaluate_calibration: no " << (truth_dir / "cam_from_world.txt").string()
+              << " (e.g. a KITTI drive): evaluating cam_from_lidar only, not the station poses"
+              << std::endl;
+  }
   const colmap::Rigid3d true_cam_from_lidar =
       ReadPoseFile((truth_dir / "cam_from_lidar.txt").string());
   const colmap::Rigid3d cam_from_lidar = ReadPoseFile(estimate_path);
@@ -197,25 +204,32 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
     metrics[std::string("cam_from_lidar_translation_error_") + "xyz"[k] + "_mm"] =
         result.cam_from_lidar_translation_error_in_cam_mm[k];
   }
-  metrics["pose_alignment"] = result.alignment;
-  metrics["pose_alignment_scale"] = result.alignment_scale;
-  metrics["num_stations_evaluated"] = result.num_stations_evaluated;
-  metrics["missing_stations"] = result.missing_stations;
-  metrics["pose_rotation_error_mean_deg"] = result.mean_rotation_error_deg;
-  metrics["pose_rotation_error_max_deg"] = result.max_rotation_error_deg;
-  metrics["pose_position_error_mean_mm"] = result.mean_position_error_mm;
-  metrics["pose_position_error_max_mm"] = result.max_position_error_mm;
-  for (const auto& [name, error] : result.position_error_mm) {
-    metrics["station_" + name + "_position_error_mm"] = error;
-    metrics["station_" + name + "_rotation_error_deg"] = result.rotation_error_deg.at(name);
+  if (result.alignment != "none") {
+    metrics["pose_alignment"] = result.alignment;
+    metrics["pose_alignment_scale"] = result.alignment_scale;
+    metrics["num_stations_evaluated"] = result.num_stations_evaluated;
+    metrics["missing_stations"] = result.missing_stations;
+    metrics["pose_rotation_error_mean_deg"] = result.mean_rotation_error_deg;
+    metrics["pose_rotation_error_max_deg"] = result.max_rotation_error_deg;
+    metrics["pose_position_error_mean_mm"] = result.mean_position_error_mm;
+    metrics["pose_position_error_max_mm"] = result.max_position_error_mm;
+    for (const auto& [name, error] : result.position_error_mm) {
+      metrics["station_" + name + "_position_error_mm"] = error;
+      metrics["station_" + name + "_rotation_error_deg"] = result.rotation_error_deg.at(name);
+    }
   }
   std::cout << std::fixed << std::setprecision(4) << "evaluate_calibration: cam_from_lidar error "
             << result.cam_from_lidar_rotation_error_deg << " deg, " << std::setprecision(2)
-            << result.cam_from_lidar_translation_error_mm << " mm; station poses ("
-            << result.alignment << " alignment, " << result.num_stations_evaluated
-            << " stations): mean " << result.mean_position_error_mm << " mm / "
-            << std::setprecision(4) << result.mean_rotation_error_deg << " deg, max "
-            << std::setprecision(2) << result.max_position_error_mm << " mm" << std::endl;
+            << result.cam_from_lidar_translation_error_mm << " mm";
+  if (result.alignment == "none") {
+    std::cout << " (against the dataset's reference; no true station poses)" << std::endl;
+  } else {
+    std::cout << "; station poses (" << result.alignment << " alignment, "
+              << result.num_stations_evaluated << " stations): mean "
+              << result.mean_position_error_mm << " mm / " << std::setprecision(4)
+              << result.mean_rotation_error_deg << " deg, max " << std::setprecision(2)
+              << result.max_position_error_mm << " mm" << std::endl;
+  }
   if (!result.missing_stations.empty()) {
     std::cout << "evaluate_calibration: " << result.missing_stations.size()
               << " stations of the truth are not in the model" << std::endl;
@@ -223,6 +237,7 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
   if (!output_path.empty()) {
     fs::create_directories(output_path);
     WriteFileAtomically((fs::path(output_path) / "metrics.json").string(), metrics.dump(2) + "\n");
+    if (result.alignment == "none") return;
     WritePoseFile((fs::path(output_path) / "truth_from_model.txt").string(),
                   "true_world_from_model_world by " + result.alignment +
                       " alignment of the camera centres (scale " +

@@ -134,6 +134,7 @@ void WriteReport(const std::string& directory,
   }
   report["uncertainty"] = uncertainty;
   report["unobservable"] = u.unobservable;
+  report["held_at_initial"] = summary.held_at_initial;
   report["motion"] = {{"stations", summary.motion.num_stations},
                       {"rotating_pairs", summary.motion.num_rotating_pairs},
                       {"max_axis_angle_deg", summary.motion.max_axis_angle_deg},
@@ -221,6 +222,9 @@ void PrintUncertainty(const JointAdjustmentSummary& summary) {
   for (const std::string& sentence : summary.uncertainty.unobservable) {
     std::cout << "UNOBSERVABLE: " << sentence << std::endl;
   }
+  for (const std::string& direction : summary.held_at_initial) {
+    std::cout << "HELD at the initial value: " << direction << std::endl;
+  }
 }
 
 }  // namespace
@@ -270,6 +274,9 @@ void AddJointAdjusterOptions(const std::string& prefix,
       "hold_translation", &options->hold_translation, "comma-separated camera axes, e.g. y or x,z");
   add.Add("max_num_iterations", &adjuster.max_num_iterations);
   add.Add("extrinsic_prior_sigma_m", &adjuster.extrinsic_prior_sigma_m);
+  add.Add("hold_unobservable",
+          &adjuster.hold_unobservable,
+          "solve again with unobservable directions of cam_from_lidar held at their initial value");
   add.Add("min_image_pair_inliers", &options->data.min_image_pair_inliers);
   add.Add("max_lidar_neighbors", &options->data.max_lidar_neighbors);
   add.Add("stereo_scale_sigma", &adjuster.observability.stereo_scale_sigma);

@@ -219,10 +219,15 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
        }},
   };
   steps.insert(steps.end(), back_end.begin(), back_end.end());
-  if (!dataset.HasGroundTruth()) return steps;
-  steps.push_back({"evaluate_calibration", [=, &dataset] {
-                     RunEvaluateCalibrationStep(dataset.root, joint, "", evaluation, "rigid");
-                   }});
+  // Evaluated: what the dataset's ground truth holds (a KITTI drive: the reference extrinsic only).
+  if (dataset.HasReferenceExtrinsic()) {
+    steps.push_back({"evaluate_calibration", [=, &dataset] {
+                       RunEvaluateCalibrationStep(dataset.root, joint, "", evaluation, "rigid");
+                     }});
+  }
+  if (!dataset.HasGroundTruth() || !fs::is_regular_file(dataset.GroundTruthPath("surface.ply"))) {
+    return steps;
+  }
   steps.push_back({"evaluate_model", [=, &dataset] {
                      RunEvaluateModelStep((fs::path(dense) / "fused.ply").string(),
                                           dataset.GroundTruthPath("surface.ply"),

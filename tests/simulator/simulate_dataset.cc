@@ -3,6 +3,7 @@
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
+#include "tests/simulator/kitti_layout.h"
 #include "tests/simulator/renderer.h"
 #include "tests/simulator/scene.h"
 #include "tests/simulator/sensor_pod.h"
@@ -76,6 +77,7 @@ bool SimulationOptions::Check() const {
   CHECK_OPTION_GE(guess_rotation_deg, 0);
   CHECK_OPTION_GE(guess_translation_m, 0);
   CHECK_OPTION_GT(surface_spacing_m, 1e-4);
+  CHECK_OPTION(layout == "dataset" || layout == "kitti");
   return true;
 }
 
@@ -103,6 +105,8 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
         cam_from_lidar, options.guess_rotation_deg, options.guess_translation_m, options.seed + 1);
   }
   rig.lidar_range_noise_m = options.range_noise_m;
+  // KITTI's images are rectified: the right camera is not turned against the left one.
+  if (options.layout == "kitti") rig.right_from_left.rotation = Eigen::Quaterniond::Identity();
   // Mono: the same left images and clouds as the stereo dataset of the same seed; the right camera is
   // neither rendered nor described.
   const StationRig stereo_rig = rig;
@@ -164,6 +168,13 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
   WritePointCloud((partial / "ground_truth/surface.ply").string(), surface);
   result.num_surface_points = surface.Size();
 
+  if (options.layout == "kitti") {
+    const fs::path kitti_partial = output.string() + ".kitti.partial";
+    fs::remove_all(kitti_partial);
+    WriteKittiLayout(partial.string(), kitti_partial.string());
+    fs::remove_all(partial);
+    fs::rename(kitti_partial, partial);
+  }
   if (fs::exists(output)) fs::remove_all(output);
   fs::rename(partial, output);
   result.num_stations = static_cast<int>(stations.size());
