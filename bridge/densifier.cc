@@ -166,9 +166,8 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   const PinholeIntrinsics intrinsics = IntrinsicsOf(camera);
 
   // Without image depth (a monocular rig), fold 2 alone: every pixel is a hole for the LiDAR to fill.
-  cv::Mat stereo = cv::Mat::zeros(static_cast<int>(original_camera.height),
-                                  static_cast<int>(original_camera.width),
-                                  CV_32F);
+  cv::Mat stereo = cv::Mat::zeros(
+      static_cast<int>(original_camera.height), static_cast<int>(original_camera.width), CV_32F);
   if (!depth_path.empty()) {
     const std::string stereo_path = StereoDepthMapPath(depth_path, station);
     stereo = ReadColmapDepthMap(stereo_path);
@@ -176,8 +175,8 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
         stereo.rows != static_cast<int>(original_camera.height)) {
       throw std::runtime_error("station " + station + ": the depth map " + stereo_path + " is " +
                                std::to_string(stereo.cols) + "x" + std::to_string(stereo.rows) +
-                               " but the camera is " + std::to_string(original_camera.width) +
-                               "x" + std::to_string(original_camera.height));
+                               " but the camera is " + std::to_string(original_camera.width) + "x" +
+                               std::to_string(original_camera.height));
     }
   }
   if (undistorter) stereo = undistorter->UndistortDepthMap(stereo);
@@ -453,7 +452,7 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
   const DenseWorkspace workspace(partial.Path());
   VoxelAccumulator lidar_map(options.lidar_map_voxel_size_m);
   std::cout << "densifier: " << views.size() << " stations, "
-            << (depth_path.empty()           ? "no image depth (LiDAR depth only, flat layers)"
+            << (depth_path.empty()          ? "no image depth (LiDAR depth only, flat layers)"
                 : options.refine_with_lidar ? "LiDAR-refined"
                                             : "stereo only")
             << std::endl;

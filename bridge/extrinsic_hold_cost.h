@@ -50,8 +50,8 @@ class ExtrinsicHoldCostFunctor {
                   const T* const cam_from_lidar_translation,
                   T* residuals) const {
     using Vector3 = Eigen::Matrix<T, 3, 1>;
-    const Eigen::Quaternion<T> delta =
-        colmap::EigenQuaternionMap<T>(cam_from_lidar_rotation) * initial_rotation_inverse_.cast<T>();
+    const Eigen::Quaternion<T> delta = colmap::EigenQuaternionMap<T>(cam_from_lidar_rotation) *
+                                       initial_rotation_inverse_.cast<T>();
     const T delta_wxyz[4] = {delta.w(), delta.x(), delta.y(), delta.z()};
     Vector3 rotation_vector;
     ceres::QuaternionToAngleAxis(delta_wxyz, rotation_vector.data());

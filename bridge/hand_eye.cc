@@ -50,8 +50,8 @@ double MaxAngleBetweenLinesDeg(const std::vector<Eigen::Vector3d>& directions) {
   double max_angle = 0;
   for (size_t i = 0; i < directions.size(); ++i) {
     for (size_t j = i + 1; j < directions.size(); ++j) {
-      max_angle = std::max(
-          max_angle, std::acos(std::min(1.0, std::abs(directions[i].dot(directions[j])))));
+      max_angle =
+          std::max(max_angle, std::acos(std::min(1.0, std::abs(directions[i].dot(directions[j])))));
     }
   }
   return max_angle / kDegToRad;
@@ -105,8 +105,7 @@ void AddTranslationDirections(const std::vector<HandEyeMotion>& motions,
         motion.lidar_i_from_lidar_j.translation -
         cam_from_lidar.rotation.inverse() *
             ((a.toRotationMatrix() - Eigen::Matrix3d::Identity()) * cam_from_lidar.translation);
-    if (a.angle() >= options.min_rotation_deg * kDegToRad || t_a.norm() == 0 ||
-        t_b.norm() < 0.1) {
+    if (a.angle() >= options.min_rotation_deg * kDegToRad || t_a.norm() == 0 || t_b.norm() < 0.1) {
       continue;
     }
     axes->in_cam.push_back(t_a.normalized());
@@ -135,8 +134,7 @@ Eigen::Vector3d SolveTranslationAndScale(const std::vector<HandEyeMotion>& motio
   Eigen::VectorXd rhs(3 * motions.size());
   for (size_t k = 0; k < motions.size(); ++k) {
     const colmap::Rigid3d& a = motions[k].cam_i_from_cam_j;
-    const Eigen::Matrix3d r_a_minus_i =
-        a.rotation.toRotationMatrix() - Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d r_a_minus_i = a.rotation.toRotationMatrix() - Eigen::Matrix3d::Identity();
     lhs.block(3 * k, 0, 3, num_free) = r_a_minus_i * basis.leftCols(num_free);
     lhs.block<3, 1>(3 * k, num_free) = a.translation;
     rhs.segment<3>(3 * k) =
@@ -243,10 +241,10 @@ HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& all_motio
   std::ostringstream message;
   message << std::fixed << std::setprecision(1) << "similarity hand-eye from " << motions.size()
           << " of " << all_motions.size() << " motion pairs (" << axes.motions.size()
-          << " rotating, axes span "
-          << result.max_axis_angle_deg << " deg): scale " << std::setprecision(4) << result.scale
-          << ", axis fit " << std::setprecision(3) << result.rotation_rms_deg
-          << " deg rms, translation residual " << 1000 * result.translation_rms_m << " mm rms";
+          << " rotating, axes span " << result.max_axis_angle_deg << " deg): scale "
+          << std::setprecision(4) << result.scale << ", axis fit " << std::setprecision(3)
+          << result.rotation_rms_deg << " deg rms, translation residual "
+          << 1000 * result.translation_rms_m << " mm rms";
   if (!(result.scale > 0) || result.rotation_rms_deg > options.max_axis_residual_deg) {
     result.rotation_unique = false;
     result.message = message.str() + "; inconsistent motions (" +
@@ -256,14 +254,15 @@ HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& all_motio
   }
   result.unique = !planar;
   if (planar) {
-    message << "; rotation about one axis only (camera " << std::setprecision(2)
-            << axis.transpose() << "): the translation along it is not observable from motion";
+    message << "; rotation about one axis only (camera " << std::setprecision(2) << axis.transpose()
+            << "): the translation along it is not observable from motion";
   }
   result.message = message.str();
   return result;
 }
 
-double HandEyeScale(const std::vector<HandEyeMotion>& motions, const colmap::Rigid3d& cam_from_lidar) {
+double HandEyeScale(const std::vector<HandEyeMotion>& motions,
+                    const colmap::Rigid3d& cam_from_lidar) {
   double numerator = 0, denominator = 0;
   for (const HandEyeMotion& motion : motions) {
     const colmap::Rigid3d& a = motion.cam_i_from_cam_j;

@@ -63,6 +63,7 @@ HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& motions,
 
 // Least-squares scale s of up-to-scale camera motions given cam_from_lidar: s a_k = R_X t_B - (R_A - I) t_X.
 // Throws if no motion translates.
-double HandEyeScale(const std::vector<HandEyeMotion>& motions, const colmap::Rigid3d& cam_from_lidar);
+double HandEyeScale(const std::vector<HandEyeMotion>& motions,
+                    const colmap::Rigid3d& cam_from_lidar);
 
 }  // namespace colmap_lidar

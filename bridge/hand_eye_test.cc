@@ -61,13 +61,13 @@ std::vector<HandEyeMotion> UpToScale(std::vector<HandEyeMotion> motions, double 
 }
 
 TEST(SimilarityHandEye, RecoversScaleAndExtrinsicFromMotionsAboutTwoAxes) {
-  const HandEyeResult result = SolveSimilarityHandEye(
-      UpToScale(Conjugate({Motion(40, {0, 1, 0.05}, {1.2, 0.1, 0.4}),
-                           Motion(-70, {0.02, 1, -0.03}, {-0.8, 0.05, 1.1}),
-                           Motion(25, {1, 0.2, 0}, {0.1, -0.6, 0.3})}),
-                2.5),
-      HandEyeOptions(),
-      Eigen::Vector3d::Zero());
+  const HandEyeResult result =
+      SolveSimilarityHandEye(UpToScale(Conjugate({Motion(40, {0, 1, 0.05}, {1.2, 0.1, 0.4}),
+                                                  Motion(-70, {0.02, 1, -0.03}, {-0.8, 0.05, 1.1}),
+                                                  Motion(25, {1, 0.2, 0}, {0.1, -0.6, 0.3})}),
+                                       2.5),
+                             HandEyeOptions(),
+                             Eigen::Vector3d::Zero());
   ASSERT_TRUE(result.unique) << result.message;
   EXPECT_NEAR(result.scale, 2.5, 1e-9);
   EXPECT_LT(result.cam_from_lidar.rotation.angularDistance(kCamFromLidar.rotation), 1e-9);
@@ -83,14 +83,14 @@ TEST(SimilarityHandEye, RecoversScaleAndExtrinsicFromMotionsAboutTwoAxes) {
 // fallback, and the result says so.
 TEST(SimilarityHandEye, PlanarDrivingRecoversRotationAndNamesTheAxis) {
   const Eigen::Vector3d fallback(0.5, -0.2, 0.7);
-  const HandEyeResult result = SolveSimilarityHandEye(
-      UpToScale(Conjugate({Motion(12, {0, 1, 0}, {0.3, 0, 4.0}),
-                           Motion(-20, {0, 1, 0}, {-0.5, 0, 3.5}),
-                           Motion(0, {0, 1, 0}, {0.02, 0, 5.0}),
-                           Motion(0.5, {0, 1, 0}, {0.1, 0, 4.5})}),
-                0.8),
-      HandEyeOptions(),
-      fallback);
+  const HandEyeResult result =
+      SolveSimilarityHandEye(UpToScale(Conjugate({Motion(12, {0, 1, 0}, {0.3, 0, 4.0}),
+                                                  Motion(-20, {0, 1, 0}, {-0.5, 0, 3.5}),
+                                                  Motion(0, {0, 1, 0}, {0.02, 0, 5.0}),
+                                                  Motion(0.5, {0, 1, 0}, {0.1, 0, 4.5})}),
+                                       0.8),
+                             HandEyeOptions(),
+                             fallback);
   EXPECT_FALSE(result.unique);
   ASSERT_TRUE(result.rotation_unique) << result.message;
   EXPECT_NEAR(std::abs(result.unobservable_axis_in_cam.y()), 1, 1e-9);

@@ -566,7 +566,7 @@ void PrintSolve(const SolveStats& stats, size_t changes) {
   std::cout << std::defaultfloat << std::setprecision(4) << "  solve " << stats.round << "."
             << stats.outlier_iteration << ": cost reprojection " << stats.reprojection.cost_before
             << " -> " << stats.reprojection.cost_after << ", depth " << stats.depth.cost_before
- << " -> " << stats.depth.cost_after << ", lidar " << stats.lidar.cost_before << " -> "
+            << " -> " << stats.depth.cost_after << ", lidar " << stats.lidar.cost_before << " -> "
             << stats.lidar.cost_after;
   if (stats.landmark_lidar.num_observations > 0) {
     std::cout << ", landmark-lidar " << stats.landmark_lidar.cost_before << " -> "
@@ -747,7 +747,8 @@ HeldDirections UnobservableDirections(const ExtrinsicUncertainty& uncertainty,
       const Eigen::Vector3d direction = solver.eigenvectors().col(k);
       (block == 0 ? held.rotation : held.translation) += direction * direction.transpose();
       std::ostringstream name;
-      name << std::fixed << std::setprecision(2) << (block == 0 ? "rotation about" : "translation along")
+      name << std::fixed << std::setprecision(2)
+           << (block == 0 ? "rotation about" : "translation along")
            << " the camera-frame direction (" << direction.x() << ", " << direction.y() << ", "
            << direction.z() << "), sigma " << std::setprecision(3) << sigma
            << (block == 0 ? " deg" : " mm");

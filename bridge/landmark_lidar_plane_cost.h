@@ -44,10 +44,9 @@ class LandmarkLidarPlaneCostFunctor {
                   T* residual) const {
     using Vector3 = Eigen::Matrix<T, 3, 1>;
     const auto cam_from_lidar_q = colmap::EigenQuaternionMap<T>(cam_from_lidar_rotation);
-    const Vector3 landmark_in_cam_i =
-        colmap::EigenQuaternionMap<T>(cam_i_from_world_rotation) *
-            colmap::EigenVector3Map<T>(landmark_in_world) +
-        colmap::EigenVector3Map<T>(cam_i_from_world_translation);
+    const Vector3 landmark_in_cam_i = colmap::EigenQuaternionMap<T>(cam_i_from_world_rotation) *
+                                          colmap::EigenVector3Map<T>(landmark_in_world) +
+                                      colmap::EigenVector3Map<T>(cam_i_from_world_translation);
     const Vector3 target_in_cam_i = cam_from_lidar_q * point_in_lidar_i_.cast<T>() +
                                     colmap::EigenVector3Map<T>(cam_from_lidar_translation);
     const Vector3 normal_in_cam_i = cam_from_lidar_q * normal_in_lidar_i_.cast<T>();

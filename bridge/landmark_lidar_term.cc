@@ -56,9 +56,8 @@ double LandmarkPlaneDistance(const LandmarkPlaneObservation& observation,
     return std::numeric_limits<double>::quiet_NaN();
   }
   const Eigen::Vector3d landmark_in_lidar =
-      colmap::Inverse(cam_from_lidar) *
-      (reconstruction.Image(observation.image_id).CamFromWorld() *
-       reconstruction.Point3D(observation.point3D_id).xyz);
+      colmap::Inverse(cam_from_lidar) * (reconstruction.Image(observation.image_id).CamFromWorld() *
+                                         reconstruction.Point3D(observation.point3D_id).xyz);
   return observation.normal_in_lidar.dot(landmark_in_lidar - observation.point_in_lidar);
 }
 

@@ -203,9 +203,10 @@ double DepthPriorScale(const std::string& database_path, const colmap::Reconstru
 }
 
 // The model's relative motions paired with the LiDAR's over lidar_registrator's pairs.
-std::vector<HandEyeMotion> ModelMotions(const colmap::Reconstruction& model,
-                                        const std::map<std::string, colmap::image_t>& image_of_station,
-                                        const std::string& registration_path) {
+std::vector<HandEyeMotion> ModelMotions(
+    const colmap::Reconstruction& model,
+    const std::map<std::string, colmap::image_t>& image_of_station,
+    const std::string& registration_path) {
   std::vector<HandEyeMotion> motions;
   if (registration_path.empty()) return motions;
   for (const LidarPairRecord& pair :
@@ -239,9 +240,9 @@ double ChooseSimilarityExtrinsic(const std::vector<HandEyeMotion>& motions,
     return HandEyeScale(motions, *guess);
   }
   if (!init->hand_eye.rotation_unique) {
-    throw std::runtime_error("cannot initialise the scale and cam_from_lidar: " +
-                             init->hand_eye.message + "; add cam_from_lidar_guess to " +
-                             dataset.root + "/rig.json");
+    throw std::runtime_error(
+        "cannot initialise the scale and cam_from_lidar: " + init->hand_eye.message +
+        "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
   }
   init->cam_from_lidar = init->hand_eye.cam_from_lidar;
   init->extrinsic_source = "similarity hand-eye";
@@ -304,8 +305,8 @@ PoseInitialization InitializeMonocular(const std::string& database_path,
     init.cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
     init.extrinsic_source = "rig.json guess";
   } else {
-    colmap::Reconstruction model = MapWithColmap(
-        database_path, (fs::path(dataset.root) / "images").string(), options.mapping);
+    colmap::Reconstruction model =
+        MapWithColmap(database_path, (fs::path(dataset.root) / "images").string(), options.mapping);
     std::map<std::string, colmap::image_t> model_image_of_station;
     for (const colmap::image_t image_id : model.RegImageIds()) {
       model_image_of_station[fs::path(model.Image(image_id).Name()).stem().string()] = image_id;
@@ -323,8 +324,8 @@ PoseInitialization InitializeMonocular(const std::string& database_path,
     }
     init.cam_from_world[image.ImageId()] = init.cam_from_lidar * colmap::Inverse(pose->second);
   }
-  init.num_lidar_edges = static_cast<int>(
-      ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string()).size());
+  init.num_lidar_edges =
+      static_cast<int>(ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string()).size());
   return init;
 }
 

@@ -137,10 +137,10 @@ TEST(KittiSampleTest, DepthEdgesProjectOntoImageEdgesThroughTheImportedCalibrati
   }
   // Through the product's importer: `import_kitti --camera 0` (a monocular dataset, 6 frames).
   testing::ScopedTempDir dir;
-  const auto run = testing::RunCommand(std::string(COLMAP_LIDAR_CLI_EXE) +
-                                       " import_kitti --kitti_path " + kSampleRoot +
-                                       " --calib_path " + kSampleRoot + "/calibration" +
-                                       " --output_path " + dir.File("dataset") + " --camera 0");
+  const auto run =
+      testing::RunCommand(std::string(COLMAP_LIDAR_CLI_EXE) + " import_kitti --kitti_path " +
+                          kSampleRoot + " --calib_path " + kSampleRoot + "/calibration" +
+                          " --output_path " + dir.File("dataset") + " --camera 0");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const StationDataset dataset = ReadStationDataset(dir.File("dataset"));
   ASSERT_EQ(dataset.stations.size(), 6u);

@@ -27,7 +27,8 @@ TEST(PipelineMonoTest, StationsCalibrateWithoutAGuessOrAStereoPair) {
       testing::Simulate(dir.File("dataset"), "t_specimen", 8, 1.0, 300000, false, true);
   ASSERT_FALSE(ReadStationDataset(dataset).rig.IsStereo());
   const std::string ws = dir.File("ws");
-  const auto run = RunCommand(kCli + " pipeline --dataset_path " + dataset + " --workspace_path " + ws);
+  const auto run =
+      RunCommand(kCli + " pipeline --dataset_path " + dataset + " --workspace_path " + ws);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::cout << run.output.substr(run.output.find("== Pipeline summary")) << std::endl;
   EXPECT_FALSE(fs::exists(ws + "/stereo"));
@@ -56,8 +57,8 @@ TEST(PipelineMonoTest, StationsCalibrateWithoutAGuessOrAStereoPair) {
 
   // stereo_only has nothing to work with.
   const auto stereo_only =
-      RunCommand(kCli + " joint_adjuster --database_path " + ws + "/database.db --input_path " + ws +
-                 "/sparse/initial --dataset_path " + dataset + " --output_path " +
+      RunCommand(kCli + " joint_adjuster --database_path " + ws + "/database.db --input_path " +
+                 ws + "/sparse/initial --dataset_path " + dataset + " --output_path " +
                  dir.File("stereo_only") + " --mode stereo_only");
   EXPECT_NE(stereo_only.exit_code, 0);
   EXPECT_NE(stereo_only.output.find("needs a stereo rig"), std::string::npos) << stereo_only.output;

@@ -78,9 +78,10 @@ int RunDensifier(int argc, char** argv) {
   options.AddRequiredOption(
       "input_path", &paths.input_path, "refined sparse model (joint_adjuster)");
   options.AddRequiredOption("dataset_path", &dataset_path);
-  options.AddDefaultOption("depth_path",
-                           &paths.depth_path,
-                           "stereo_depth's output folder; empty (a monocular rig): LiDAR depth only");
+  options.AddDefaultOption(
+      "depth_path",
+      &paths.depth_path,
+      "stereo_depth's output folder; empty (a monocular rig): LiDAR depth only");
   options.AddRequiredOption("output_path", &paths.output_path);
   options.AddDefaultOption("cam_from_lidar",
                            &paths.cam_from_lidar_path,

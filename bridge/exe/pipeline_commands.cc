@@ -214,8 +214,7 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
        }},
       {"densifier",
        [=, &dataset] {
-         RunDensifierStep(
-             dataset, {joint, "", stereo_rig ? stereo : "", dense}, options.densifier);
+         RunDensifierStep(dataset, {joint, "", stereo_rig ? stereo : "", dense}, options.densifier);
        }},
   };
   steps.insert(steps.end(), back_end.begin(), back_end.end());

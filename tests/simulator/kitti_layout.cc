@@ -46,15 +46,17 @@ Eigen::Matrix<double, 3, 4> ProjectionMatrix(const colmap::Camera& camera,
 
 KittiCalibrationFiles CalibrationOf(const StationDataset& dataset) {
   const StationRig& rig = dataset.rig;
-  const colmap::Rigid3d cam_from_lidar = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  const colmap::Rigid3d cam_from_lidar =
+      ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
   // Camera 2 sits 6 cm left of camera 0 in KITTI (P_rect_02[:,3] / fx ~ 0.06 m).
   const Eigen::Vector3d offset_2(0.0599, -0.0003, 0.0027);
-  const Eigen::Vector3d baseline = rig.IsStereo() ? rig.right_from_left.translation
-                                                  : Eigen::Vector3d(-0.54, 0, 0);
+  const Eigen::Vector3d baseline =
+      rig.IsStereo() ? rig.right_from_left.translation : Eigen::Vector3d(-0.54, 0, 0);
   if (rig.IsStereo() &&
       rig.right_from_left.rotation.angularDistance(Eigen::Quaterniond::Identity()) > 1e-12) {
-    throw std::invalid_argument("KITTI's layout needs a rectified pair (right_from_left rotation "
-                                "identity)");
+    throw std::invalid_argument(
+        "KITTI's layout needs a rectified pair (right_from_left rotation "
+        "identity)");
   }
   KittiCalibrationFiles files;
   files.width = static_cast<int>(rig.left.width);

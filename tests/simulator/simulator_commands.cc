@@ -24,7 +24,8 @@ int RunSimulateDataset(int argc, char** argv) {
       "image_scale", &options.image_scale, "1 = 1028x752 per camera, 4 = 4112x3008");
   manager.AddDefaultOption(
       "layout", &options.layout, "dataset | kitti (KITTI raw's folders and calibration files)");
-  manager.AddDefaultOption("mono", &options.mono, "one camera: no right images, no 'right' in rig.json");
+  manager.AddDefaultOption(
+      "mono", &options.mono, "one camera: no right images, no 'right' in rig.json");
   manager.AddDefaultOption("lidar_points", &lidar_points, "LiDAR rays per station");
   manager.AddDefaultOption("range_noise_m", &options.range_noise_m);
   manager.AddDefaultOption("pixel_noise", &options.pixel_noise, "grey levels");
