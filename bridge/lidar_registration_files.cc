@@ -139,4 +139,13 @@ std::map<std::string, Eigen::Vector3d> StationCameraPositions(
   return positions;
 }
 
+StationDataset WithDeskewedClouds(StationDataset dataset, const std::string& registration_path) {
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    const std::filesystem::path deskewed =
+        std::filesystem::path(registration_path) / "deskewed" / (dataset.stations[i] + ".pcd");
+    if (std::filesystem::is_regular_file(deskewed)) dataset.cloud_paths[i] = deskewed.string();
+  }
+  return dataset;
+}
+
 }  // namespace colmap_lidar

@@ -13,6 +13,8 @@
 // only the first ten columns are read too (the quality columns then keep their defaults).
 #pragma once
 
+#include "colmap_ext/station_dataset.h"
+
 #include "colmap/geometry/rigid3.h"
 
 #include <map>
@@ -68,5 +70,9 @@ std::map<std::string, colmap::Rigid3d> LargestComponentLidarPoses(
 // their own, so their stations are left out. Throws std::runtime_error naming a missing file.
 std::map<std::string, Eigen::Vector3d> StationCameraPositions(
     const std::string& registration_path, const colmap::Rigid3d& cam_from_lidar);
+
+// `dataset` with each station's cloud replaced by `registration_path`/deskewed/<station>.pcd where
+// lidar_registrator --deskew_sweeps 1 wrote one.
+StationDataset WithDeskewedClouds(StationDataset dataset, const std::string& registration_path);
 
 }  // namespace colmap_lidar

@@ -301,5 +301,17 @@ TEST_F(StreetDriveTest, SequentialRegistrationKeepsNoWrongEdge) {
   EXPECT_LE(SummaryValue(output, "worst_cycle_translation_m"), 0.04);
 }
 
+// The sweeps are smeared by the car's motion (0.5-1 m per sweep); de-skewed with the motion of a first
+// registration and registered again, the edges come closer to the mid-sweep truth. Measured: worst
+// edge 3.1 cm -> 1.0 cm.
+TEST_F(StreetDriveTest, DeskewedSweepsRegisterCloserToTheTruth) {
+  double worst_raw_m = 0, worst_deskewed_m = 0;
+  RegisterAndCheck(" --sequential 3", &worst_raw_m);
+  const std::string output =
+      RegisterAndCheck(" --sequential 3 --deskew_sweeps 1", &worst_deskewed_m);
+  EXPECT_NE(output.find("components 1\n"), std::string::npos);
+  EXPECT_LT(worst_deskewed_m, 0.5 * worst_raw_m);
+}
+
 }  // namespace
 }  // namespace colmap_lidar

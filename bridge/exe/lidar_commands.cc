@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace colmap_lidar {
@@ -100,7 +101,7 @@ bool LidarRegistratorStepOptions::Check() {
   CHECK_OPTION_GE(sequential, 0);
   graph.max_neighbors = static_cast<size_t>(max_neighbors);
   graph.sequential = static_cast<size_t>(sequential);
-  return true;
+  return sweep_timing.Check();
 }
 
 void AddLidarRegistratorOptions(const std::string& prefix,
@@ -128,7 +129,102 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("max_cycle_translation_m", &options->graph.cycles.max_translation_m);
   add.Add("max_cycle_rotation_deg", &options->graph.cycles.max_rotation_deg);
   add.Add("robust_loss_sigmas", &options->graph.robust_loss_sigmas);
+  add.Add("deskew_sweeps",
+          &options->deskew_sweeps,
+          "sweeps of a moving platform: de-skew them with the registered motion, register again");
+  add.Add("sweep_start_azimuth_deg",
+          &options->sweep_timing.start_azimuth_deg,
+          "where a revolution starts (LiDAR frame; 180: behind)");
+  add.Add("sweep_counter_clockwise", &options->sweep_timing.counter_clockwise);
 }
+
+namespace {
+
+// Reads, optionally de-skews (motion per sweep given), prepares and registers the clouds; prints
+// progress. With `deskewed_path`, each de-skewed cloud is written there as <station>.pcd.
+LidarGraph RegisterClouds(const std::vector<fs::path>& files,
+                          const LidarRegistratorStepOptions& options,
+                          const std::vector<SweepMotion>* sweep_motions,
+                          const std::string& deskewed_path,
+                          const std::chrono::steady_clock::time_point& start) {
+  std::vector<std::unique_ptr<StationCloud>> stations;
+  for (size_t i = 0; i < files.size(); ++i) {
+    CloudReadStats stats;
+    PointCloud raw = ReadPointCloud(files[i].string(), &stats);
+    if (sweep_motions != nullptr) {
+      raw = DeskewSweep(raw, (*sweep_motions)[i], options.sweep_timing);
+      WritePointCloud((fs::path(deskewed_path) / (files[i].stem().string() + ".pcd")).string(),
+                      raw);
+    }
+    stations.push_back(PrepareStationCloud(raw, options.cloud));
+    std::cout << "lidar_registrator: " << files[i].stem().string() << ": " << raw.Size()
+              << " points (" << stats.num_dropped_non_finite << " non-finite dropped"
+              << (sweep_motions ? ", de-skewed" : "") << "), " << stations.back()->cloud.Size()
+              << " after voxel " << options.cloud.voxel_size << " m, "
+              << stations.back()->features.size() << " BSC features [" << std::fixed
+              << std::setprecision(1) << SecondsSince(start) << " s]" << std::defaultfloat
+              << std::setprecision(6) << std::endl;
+  }
+  std::vector<const StationCloud*> pointers;
+  for (const auto& s : stations) pointers.push_back(s.get());
+  return RegisterAllStations(pointers, options.graph, [&](size_t done, size_t total) {
+    if (done % 10 == 0 || done == total) {
+      std::cout << "lidar_registrator: registered " << done << "/" << total << " pairs ["
+                << std::fixed << std::setprecision(1) << SecondsSince(start) << " s]"
+                << std::defaultfloat << std::setprecision(6) << std::endl;
+    }
+  });
+}
+
+// Frames apart: the difference of two numeric names (KITTI's %010d, possibly imported with a step),
+// else 1.
+double FramesApart(const std::string& a, const std::string& b) {
+  try {
+    size_t used_a = 0, used_b = 0;
+    const long long index_a = std::stoll(a, &used_a), index_b = std::stoll(b, &used_b);
+    if (used_a == a.size() && used_b == b.size() && index_a != index_b) {
+      return static_cast<double>(index_b - index_a);
+    }
+  } catch (const std::exception&) {
+  }
+  return 1.0;
+}
+
+// The motion per frame from station i to station j (their registered poses, divided by the frames
+// between them), or nullopt when they are not in one component.
+std::optional<Eigen::Isometry3d> MotionPerFrame(const std::vector<std::string>& names,
+                                                const LidarGraph& graph,
+                                                size_t i,
+                                                size_t j) {
+  if (j >= names.size() || graph.component[i] != graph.component[j]) return std::nullopt;
+  const Eigen::Isometry3d i_from_j =
+      graph.world_from_lidar[i].inverse() * graph.world_from_lidar[j];
+  const double per_frame = 1.0 / std::abs(FramesApart(names[i], names[j]));
+  const Eigen::AngleAxisd rotation(i_from_j.rotation());
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  motion.linear() =
+      Eigen::AngleAxisd(per_frame * rotation.angle(), rotation.axis()).toRotationMatrix();
+  motion.translation() = per_frame * i_from_j.translation();
+  return motion;
+}
+
+// Each station's sweep motion from its neighbours in name order (one missing: the other mirrored;
+// both: none).
+std::vector<SweepMotion> SweepMotions(const std::vector<std::string>& names,
+                                      const LidarGraph& graph) {
+  std::vector<SweepMotion> motions(names.size());
+  for (size_t i = 0; i < names.size(); ++i) {
+    const auto next = MotionPerFrame(names, graph, i, i + 1);
+    const auto previous = i > 0 ? MotionPerFrame(names, graph, i, i - 1) : std::nullopt;
+    if (next) motions[i].mid_from_next_mid = *next;
+    if (previous) motions[i].mid_from_previous_mid = *previous;
+    if (next && !previous) motions[i].mid_from_previous_mid = next->inverse();
+    if (previous && !next) motions[i].mid_from_next_mid = previous->inverse();
+  }
+  return motions;
+}
+
+}  // namespace
 
 void RunLidarRegistratorStep(const std::string& lidar_path,
                              const std::string& output_path,
@@ -137,29 +233,18 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
   const std::vector<fs::path> files = StationCloudFiles(lidar_path);
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::string> names;
-  std::vector<std::unique_ptr<StationCloud>> stations;
-  for (const fs::path& file : files) {
-    CloudReadStats stats;
-    const PointCloud raw = ReadPointCloud(file.string(), &stats);
-    stations.push_back(PrepareStationCloud(raw, options.cloud));
-    names.push_back(file.stem().string());
-    std::cout << "lidar_registrator: " << names.back() << ": " << raw.Size() << " points ("
-              << stats.num_dropped_non_finite << " non-finite dropped), "
-              << stations.back()->cloud.Size() << " after voxel " << options.cloud.voxel_size
-              << " m, " << stations.back()->features.size() << " BSC features [" << std::fixed
-              << std::setprecision(1) << SecondsSince(start) << " s]" << std::defaultfloat
-              << std::setprecision(6) << std::endl;
+  for (const fs::path& file : files) names.push_back(file.stem().string());
+  const fs::path deskewed_path = fs::path(output_path) / "deskewed";
+  fs::remove_all(deskewed_path);
+  LidarGraph graph = RegisterClouds(files, options, nullptr, "", start);
+  if (options.deskew_sweeps) {
+    std::cout << "lidar_registrator: de-skewing every sweep with the registered motion and "
+                 "registering again"
+              << std::endl;
+    const std::vector<SweepMotion> motions = SweepMotions(names, graph);
+    fs::create_directories(deskewed_path);
+    graph = RegisterClouds(files, options, &motions, deskewed_path.string(), start);
   }
-  std::vector<const StationCloud*> pointers;
-  for (const auto& s : stations) pointers.push_back(s.get());
-  const LidarGraph graph =
-      RegisterAllStations(pointers, options.graph, [&](size_t done, size_t total) {
-        if (done % 10 == 0 || done == total) {
-          std::cout << "lidar_registrator: registered " << done << "/" << total << " pairs ["
-                    << std::fixed << std::setprecision(1) << SecondsSince(start) << " s]"
-                    << std::defaultfloat << std::setprecision(6) << std::endl;
-        }
-      });
 
   fs::create_directories(output_path);
   WritePairsAndPoses(output_path, names, graph);

@@ -1,6 +1,7 @@
 // pose_initializer and pipeline: from raw stations to a metric sparse model with cam_from_lidar.
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
+#include "bridge/lidar_registration_files.h"
 #include "bridge/pose_initializer.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
@@ -210,11 +211,14 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
        }},
       {"joint_adjuster",
        [=, &dataset] {
-         RunJointAdjusterStep(dataset, {database, initial, "", joint}, options.joint);
+         RunJointAdjusterStep(
+             WithDeskewedClouds(dataset, lidar), {database, initial, "", joint}, options.joint);
        }},
       {"densifier",
        [=, &dataset] {
-         RunDensifierStep(dataset, {joint, "", stereo_rig ? stereo : "", dense}, options.densifier);
+         RunDensifierStep(WithDeskewedClouds(dataset, lidar),
+                          {joint, "", stereo_rig ? stereo : "", dense},
+                          options.densifier);
        }},
   };
   steps.insert(steps.end(), back_end.begin(), back_end.end());

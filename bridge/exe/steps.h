@@ -18,6 +18,7 @@
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/stereo_depth.h"
 #include "lidar/lidar_pose_graph.h"
+#include "lidar/sweep_deskew.h"
 #include "lidar/model_evaluation.h"
 #include "lidar/station_cloud.h"
 
@@ -86,6 +87,11 @@ struct LidarRegistratorStepOptions {
   // Parsed as int (the OptionManager has no size_t); copied into `graph` by Check().
   int max_neighbors = 0;
   int sequential = 0;
+  // Sweeps of a moving platform (frames in name order): register, de-skew every sweep with the motion
+  // to its neighbour (lidar/sweep_deskew.h), write OUTPUT/deskewed/<station>.pcd and register again;
+  // the later steps of `pipeline` use the de-skewed clouds.
+  bool deskew_sweeps = false;
+  SweepTimingOptions sweep_timing;
 
   // Validates and copies max_neighbors and sequential into `graph`.
   bool Check();

@@ -1,0 +1,47 @@
+// Motion compensation ("de-skewing") of a rotating LiDAR's sweep taken from a moving platform (a car,
+// a backpack). A sweep's points are measured over one revolution while the platform moves; read as one
+// rigid cloud they are smeared by the motion (at 10 m/s and 10 Hz, up to 0.5 m either side of the
+// sweep's middle). Each point is moved into the LiDAR frame at the middle of the sweep (fraction 0.5,
+// where KITTI and the simulator take the frame's pose and trigger the camera), assuming constant
+// velocity within each half of the sweep:
+//
+//   point_in_mid = mid_from_lidar(s) point,  s = fraction - 0.5,
+//   mid_from_lidar(s) = (AngleAxis(|s| theta, axis), |s| t),  (theta, axis, t) of mid_from_next_mid
+//   for s >= 0 (the next sweep's middle in this one's) and of mid_from_previous_mid for s < 0,
+//
+// where a point's fraction follows from its azimuth atan2(y, x) in the LiDAR frame: the revolution
+// starts at `start_azimuth_deg` and turns counter-clockwise (about +z) unless told otherwise.
+// Eigen-only header.
+#pragma once
+
+#include "lidar/point_cloud.h"
+
+#include <Eigen/Geometry>
+
+namespace colmap_lidar {
+
+struct SweepTimingOptions {
+  // Azimuth [deg] (LiDAR frame, x forward, y left) where a revolution starts; 180: behind the
+  // platform, so that the middle of the sweep looks forward (KITTI, the simulator).
+  double start_azimuth_deg = 180;
+  bool counter_clockwise = true;
+
+  bool Check() const;
+};
+
+// The fraction [0, 1) of the revolution at which a point in the LiDAR frame was measured.
+double SweepFraction(const Eigen::Vector3d& point_in_lidar, const SweepTimingOptions& options);
+
+// Where a sweep began and ended: the middles of its neighbours in its own middle's frame. With one
+// neighbour only, the other is its mirror (constant velocity).
+struct SweepMotion {
+  Eigen::Isometry3d mid_from_previous_mid = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d mid_from_next_mid = Eigen::Isometry3d::Identity();
+};
+
+// The sweep in the LiDAR frame at its middle; normals are not carried (they change with the points).
+PointCloud DeskewSweep(const PointCloud& sweep,
+                       const SweepMotion& motion,
+                       const SweepTimingOptions& options);
+
+}  // namespace colmap_lidar

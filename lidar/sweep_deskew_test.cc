@@ -1,0 +1,94 @@
+#include "lidar/sweep_deskew.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace colmap_lidar {
+namespace {
+
+Eigen::Isometry3d Motion(double yaw_deg, const Eigen::Vector3d& translation) {
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  motion.linear() =
+      Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d(0.05, 0.1, 1).normalized())
+          .toRotationMatrix();
+  motion.translation() = translation;
+  return motion;
+}
+
+// A car speeding up and turning: the previous sweep's middle 0.8 m behind (2 deg of yaw), the next one
+// 1 m ahead (3 deg).
+SweepMotion CarMotion() {
+  SweepMotion motion;
+  motion.mid_from_previous_mid = Motion(-2, Eigen::Vector3d(-0.8, -0.05, 0.0));
+  motion.mid_from_next_mid = Motion(3, Eigen::Vector3d(1.0, 0.08, 0.01));
+  return motion;
+}
+
+// The LiDAR's pose at `fraction` of the sweep, in the frame of the sweep's middle: uniform motion
+// within each half, from halfway to the previous middle to halfway to the next.
+Eigen::Isometry3d MidFromLidarAt(double fraction) {
+  const double s = fraction - 0.5;
+  const Eigen::Isometry3d& neighbour =
+      s < 0 ? CarMotion().mid_from_previous_mid : CarMotion().mid_from_next_mid;
+  const Eigen::AngleAxisd rotation(neighbour.rotation());
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() =
+      Eigen::AngleAxisd(std::abs(s) * rotation.angle(), rotation.axis()).toRotationMatrix();
+  pose.translation() = std::abs(s) * neighbour.translation();
+  return pose;
+}
+
+// A sweep of points on walls 4-20 m around, each measured at the fraction of its azimuth in the
+// moving LiDAR frame; returns the sweep and the same points in the mid frame.
+void MakeSweep(PointCloud* sweep, std::vector<Eigen::Vector3d>* points_in_mid) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int k = 0; k < 20000; ++k) {
+    const double fraction = unit(rng);
+    const double azimuth = M_PI + 2 * M_PI * fraction;  // starts behind, counter-clockwise
+    const double range = 4 + 16 * unit(rng);
+    const Eigen::Vector3d point_in_lidar(
+        range * std::cos(azimuth), range * std::sin(azimuth), -1.5 + 3 * unit(rng));
+    sweep->points.push_back(point_in_lidar);
+    points_in_mid->push_back(MidFromLidarAt(fraction) * point_in_lidar);
+  }
+}
+
+TEST(SweepDeskew, FractionFollowsTheAzimuthFromTheStart) {
+  const SweepTimingOptions options;
+  EXPECT_NEAR(SweepFraction(Eigen::Vector3d(-1, -1e-9, 0), options), 0.0, 1e-6);
+  EXPECT_NEAR(SweepFraction(Eigen::Vector3d(0, -1, 0), options), 0.25, 1e-12);
+  EXPECT_NEAR(SweepFraction(Eigen::Vector3d(1, 0, 0), options), 0.5, 1e-12);
+  EXPECT_NEAR(SweepFraction(Eigen::Vector3d(0, 1, 0), options), 0.75, 1e-12);
+  SweepTimingOptions clockwise;
+  clockwise.counter_clockwise = false;
+  EXPECT_NEAR(SweepFraction(Eigen::Vector3d(0, 1, 0), clockwise), 0.25, 1e-12);
+}
+
+// The de-skewed points are where they were at the middle of the sweep, to floating-point precision (the
+// motion is exactly the model undone, each half with its own neighbour); the raw sweep is smeared by up
+// to half the motion per sweep.
+TEST(SweepDeskew, UndoesTheMotionOfEachHalfSweep) {
+  PointCloud sweep;
+  std::vector<Eigen::Vector3d> truth;
+  MakeSweep(&sweep, &truth);
+  sweep.intensities.assign(sweep.Size(), 7.f);
+  const PointCloud deskewed = DeskewSweep(sweep, CarMotion(), SweepTimingOptions());
+  ASSERT_EQ(deskewed.Size(), sweep.Size());
+  EXPECT_EQ(deskewed.intensities, sweep.intensities);
+  double worst_raw = 0, worst_deskewed = 0;
+  for (size_t i = 0; i < sweep.Size(); ++i) {
+    worst_raw = std::max(worst_raw, (sweep.points[i] - truth[i]).norm());
+    worst_deskewed = std::max(worst_deskewed, (deskewed.points[i] - truth[i]).norm());
+  }
+  EXPECT_GT(worst_raw, 0.5);
+  EXPECT_LT(worst_deskewed, 1e-9);
+  // Without motion nothing moves.
+  const PointCloud still = DeskewSweep(sweep, SweepMotion(), SweepTimingOptions());
+  EXPECT_EQ(still.points, sweep.points);
+}
+
+}  // namespace
+}  // namespace colmap_lidar
