@@ -65,5 +65,53 @@ TEST(PipelineMonoTest, StationsCalibrateWithoutAGuessOrAStereoPair) {
   EXPECT_FALSE(fs::exists(dir.File("stereo_only")));
 }
 
+// A car: 20 frames of the simulated street written in KITTI raw's layout (one camera), imported with
+// import_kitti and its seeded guess (3 deg / 5 cm off the reference), then the pipeline with sequential
+// matching and de-skewed sweeps. The drive hardly turns, so most of cam_from_lidar's translation is
+// unobservable: it must be held at the guess, never drift (before holding: 97-140 mm off). Measured:
+// rotation 0.097 deg, the forward (camera z) translation 1.6 mm, the held translation 47.6 mm off (the
+// guess: 50 mm), 2 directions held; evaluation of the extrinsic only (a drive has no true poses).
+TEST(PipelineMonoTest, KittiLayoutDriveHoldsWhatItCannotSee) {
+  testing::ScopedTempDir dir;
+  sim::SimulationOptions drive;
+  drive.scene = "street";
+  drive.motion = "drive";
+  drive.layout = "kitti";
+  drive.mono = true;
+  drive.num_stations = 20;
+  drive.lidar_points = 120000;
+  drive.output_path = dir.File("kitti");
+  sim::SimulateDataset(drive);
+  const std::string dataset = dir.File("dataset");
+  const auto import = RunCommand(kCli + " import_kitti --kitti_path " + dir.File("kitti/drive") +
+                                 " --calib_path " + dir.File("kitti/calibration") +
+                                 " --output_path " + dataset + " --write_guess 1 --seed 1");
+  ASSERT_EQ(import.exit_code, 0) << import.output;
+  const std::string ws = dir.File("ws");
+  const auto run =
+      RunCommand(kCli + " pipeline --dataset_path " + dataset + " --workspace_path " + ws +
+                 " --Import.matcher sequential --LidarRegistrator.deskew_sweeps 1");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::cout << run.output.substr(run.output.find("== Pipeline summary")) << std::endl;
+  EXPECT_NE(run.output.find("evaluating cam_from_lidar only"), std::string::npos);
+  EXPECT_TRUE(fs::is_directory(ws + "/lidar/deskewed"));
+
+  const nlohmann::json report = ReadJson(ws + "/sparse/joint/report.json");
+  EXPECT_GE(report["held_at_initial"].size(), 1u);
+  const nlohmann::json metrics = ReadJson(ws + "/evaluation/metrics.json");
+  const double guess_error_mm =
+      1000 * (ReadStationDataset(dataset).rig.cam_from_lidar_guess->translation -
+              ReadPoseFile(dataset + "/ground_truth/cam_from_lidar.txt").translation)
+                 .norm();
+  std::cout << "drive: cam_from_lidar " << metrics["cam_from_lidar_rotation_error_deg"] << " deg, "
+            << metrics["cam_from_lidar_translation_error_mm"] << " mm (guess " << guess_error_mm
+            << " mm), forward " << metrics["cam_from_lidar_translation_error_z_mm"] << " mm"
+            << std::endl;
+  EXPECT_LE(metrics["cam_from_lidar_rotation_error_deg"].get<double>(), 0.3);
+  EXPECT_LE(std::abs(metrics["cam_from_lidar_translation_error_z_mm"].get<double>()), 5.0);
+  EXPECT_LE(metrics["cam_from_lidar_translation_error_mm"].get<double>(), guess_error_mm + 1.0);
+  EXPECT_FALSE(metrics.contains("pose_position_error_mean_mm"));
+}
+
 }  // namespace
 }  // namespace colmap_lidar
