@@ -146,6 +146,25 @@ cv::Mat SourcePreview(const std::vector<DepthSource>& source, int width, int hei
   return preview;
 }
 
+// The station's stereo depth map in the original camera's grid; without image depth (`depth_path`
+// empty: a monocular rig) all zeros, so that fold 2 alone fills every pixel it can from the LiDAR.
+cv::Mat ReadImageDepth(const std::string& depth_path,
+                       const std::string& station,
+                       const colmap::Camera& original_camera) {
+  const int width = static_cast<int>(original_camera.width);
+  const int height = static_cast<int>(original_camera.height);
+  if (depth_path.empty()) return cv::Mat::zeros(height, width, CV_32F);
+  const std::string stereo_path = StereoDepthMapPath(depth_path, station);
+  cv::Mat stereo = ReadColmapDepthMap(stereo_path);
+  if (stereo.cols != width || stereo.rows != height) {
+    throw std::runtime_error("station " + station + ": the depth map " + stereo_path + " is " +
+                             std::to_string(stereo.cols) + "x" + std::to_string(stereo.rows) +
+                             " but the camera is " + std::to_string(width) + "x" +
+                             std::to_string(height));
+  }
+  return stereo;
+}
+
 // Fold 1 and 2 for one station; writes its maps, image and preview into the workspace and adds its
 // LiDAR cloud to the LiDAR map.
 StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
@@ -165,20 +184,7 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   const colmap::Camera& camera = reconstruction.Camera(image.CameraId());
   const PinholeIntrinsics intrinsics = IntrinsicsOf(camera);
 
-  // Without image depth (a monocular rig), fold 2 alone: every pixel is a hole for the LiDAR to fill.
-  cv::Mat stereo = cv::Mat::zeros(
-      static_cast<int>(original_camera.height), static_cast<int>(original_camera.width), CV_32F);
-  if (!depth_path.empty()) {
-    const std::string stereo_path = StereoDepthMapPath(depth_path, station);
-    stereo = ReadColmapDepthMap(stereo_path);
-    if (stereo.cols != static_cast<int>(original_camera.width) ||
-        stereo.rows != static_cast<int>(original_camera.height)) {
-      throw std::runtime_error("station " + station + ": the depth map " + stereo_path + " is " +
-                               std::to_string(stereo.cols) + "x" + std::to_string(stereo.rows) +
-                               " but the camera is " + std::to_string(original_camera.width) + "x" +
-                               std::to_string(original_camera.height));
-    }
-  }
+  cv::Mat stereo = ReadImageDepth(depth_path, station, original_camera);
   if (undistorter) stereo = undistorter->UndistortDepthMap(stereo);
   const Eigen::Map<const DepthImage> stereo_depth(stereo.ptr<float>(), stereo.rows, stereo.cols);
 
