@@ -120,6 +120,7 @@ Eigen::Vector3d SolveTranslationAndScale(const std::vector<HandEyeMotion>& motio
                                          const Eigen::Matrix3d& rotation,
                                          const Eigen::Vector3d& axis,
                                          const Eigen::Vector3d& fallback,
+                                         bool per_motion_scale,
                                          HandEyeResult* result) {
   const bool planar = axis.squaredNorm() > 0;
   Eigen::Matrix3d basis = Eigen::Matrix3d::Identity();
@@ -130,18 +131,20 @@ Eigen::Vector3d SolveTranslationAndScale(const std::vector<HandEyeMotion>& motio
     num_free = 2;
   }
   const Eigen::Vector3d fixed_part = axis * axis.dot(fallback);
-  Eigen::MatrixXd lhs(3 * motions.size(), num_free + 1);
+  const int num_scales = per_motion_scale ? static_cast<int>(motions.size()) : 1;
+  Eigen::MatrixXd lhs = Eigen::MatrixXd::Zero(3 * motions.size(), num_free + num_scales);
   Eigen::VectorXd rhs(3 * motions.size());
   for (size_t k = 0; k < motions.size(); ++k) {
     const colmap::Rigid3d& a = motions[k].cam_i_from_cam_j;
     const Eigen::Matrix3d r_a_minus_i = a.rotation.toRotationMatrix() - Eigen::Matrix3d::Identity();
     lhs.block(3 * k, 0, 3, num_free) = r_a_minus_i * basis.leftCols(num_free);
-    lhs.block<3, 1>(3 * k, num_free) = a.translation;
+    lhs.block<3, 1>(3 * k, num_free + (per_motion_scale ? k : 0)) = a.translation;
     rhs.segment<3>(3 * k) =
         rotation * motions[k].lidar_i_from_lidar_j.translation - r_a_minus_i * fixed_part;
   }
   const Eigen::VectorXd solution = lhs.colPivHouseholderQr().solve(rhs);
-  result->scale = solution[num_free];
+  // The mean scale; -1 when a motion's scale is not positive (an inconsistent motion).
+  result->scale = solution.tail(num_scales).minCoeff() > 0 ? solution.tail(num_scales).mean() : -1;
   result->translation_rms_m = std::sqrt((lhs * solution - rhs).squaredNorm() / rhs.size());
   return basis.leftCols(num_free) * solution.head(num_free) + fixed_part;
 }
@@ -186,31 +189,21 @@ HandEyeResult SolveHandEye(const std::vector<HandEyeMotion>& motions,
   return result;
 }
 
-HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& all_motions,
-                                     const HandEyeOptions& options,
-                                     const Eigen::Vector3d& axis_translation_fallback) {
-  THROW_CHECK(options.Check());
+namespace {
+
+// The similarity hand-eye on consistent motions, as general motion or, with `planar`, as rotation about
+// one axis (mean of the rotation axes, plus the translation directions of the motions that hardly
+// rotate; the translation along the axis from the fallback).
+HandEyeResult SimilarityHandEye(const std::vector<HandEyeMotion>& motions,
+                                const HandEyeOptions& options,
+                                const Eigen::Vector3d& axis_translation_fallback,
+                                bool per_motion_scale,
+                                bool planar) {
   HandEyeResult result;
-  // A monocular model can be locally wrong (forward motion): motions whose camera and LiDAR rotation
-  // angles disagree are left out altogether.
-  std::vector<HandEyeMotion> motions;
-  for (const HandEyeMotion& motion : all_motions) {
-    if (std::abs(Eigen::AngleAxisd(motion.cam_i_from_cam_j.rotation).angle() -
-                 Eigen::AngleAxisd(motion.lidar_i_from_lidar_j.rotation).angle()) <=
-        options.max_axis_residual_deg * kDegToRad) {
-      motions.push_back(motion);
-    }
-  }
   RotationAxes axes = RotatingMotions(motions, options);
   result.num_motions = static_cast<int>(axes.motions.size());
   result.max_axis_angle_deg = MaxAngleBetweenLinesDeg(axes.in_cam);
-  const bool planar =
-      axes.motions.size() < 2 || result.max_axis_angle_deg < options.min_axis_angle_deg;
   if (planar) {
-    if (axes.motions.empty()) {
-      result.message = DegenerateMessage(0, 0);
-      return result;
-    }
     Eigen::Vector3d mean_axis = Eigen::Vector3d::Zero();
     for (size_t k = 0; k < axes.in_cam.size(); ++k) {
       const double sign = axes.in_cam[k].dot(axes.in_cam.front()) < 0 ? -1.0 : 1.0;
@@ -235,29 +228,79 @@ HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& all_motio
     result.rotation_rms_deg = AxisFitRmsDeg(axes, rotation);
     result.cam_from_lidar = colmap::Rigid3d(
         Eigen::Quaterniond(rotation),
-        SolveTranslationAndScale(motions, rotation, axis, axis_translation_fallback, &result));
+        SolveTranslationAndScale(
+            motions, rotation, axis, axis_translation_fallback, per_motion_scale, &result));
   }
-  result.rotation_unique = true;
+  // Planar with translation directions only: the forward translation is confounded with the motions'
+  // own scales (a car drives mostly straight), so no component of t_X is trusted: all from the fallback.
+  if (planar && per_motion_scale) result.cam_from_lidar.translation = axis_translation_fallback;
+  // A general fit must explain the axes; a planar one mixes axes and directions of small motions.
+  result.rotation_unique =
+      result.scale > 0 && (planar || result.rotation_rms_deg <= options.max_axis_residual_deg);
+  result.unique = result.rotation_unique && !planar;
+  return result;
+}
+
+std::string SimilarityMessage(const HandEyeResult& result,
+                              size_t num_used,
+                              size_t num_given,
+                              bool planar,
+                              bool per_motion_scale) {
   std::ostringstream message;
-  message << std::fixed << std::setprecision(1) << "similarity hand-eye from " << motions.size()
-          << " of " << all_motions.size() << " motion pairs (" << axes.motions.size()
-          << " rotating, axes span " << result.max_axis_angle_deg << " deg): scale "
-          << std::setprecision(4) << result.scale << ", axis fit " << std::setprecision(3)
-          << result.rotation_rms_deg << " deg rms, translation residual "
-          << 1000 * result.translation_rms_m << " mm rms";
-  if (!(result.scale > 0) || result.rotation_rms_deg > options.max_axis_residual_deg) {
-    result.rotation_unique = false;
-    result.message = message.str() + "; inconsistent motions (" +
-                     (result.scale > 0 ? "the axes do not fit one rotation" : "no positive scale") +
-                     ")";
+  message << std::fixed << std::setprecision(1) << "similarity hand-eye from " << num_used << " of "
+          << num_given << " motion pairs (" << result.num_motions << " rotating, axes span "
+          << result.max_axis_angle_deg << " deg): scale " << std::setprecision(4) << result.scale
+          << ", axis fit " << std::setprecision(3) << result.rotation_rms_deg
+          << " deg rms, translation residual " << 1000 * result.translation_rms_m << " mm rms";
+  if (!result.rotation_unique) {
+    message << "; inconsistent motions ("
+            << (result.scale > 0 ? "the axes do not fit one rotation" : "no positive scale") << ")";
+  } else if (planar) {
+    message << "; rotation about one axis only (camera " << std::setprecision(2)
+            << result.unobservable_axis_in_cam.transpose() << "): the translation "
+            << (per_motion_scale ? "is" : "along it is")
+            << " not observable from motion and comes from the guess (or 0)";
+  }
+  return message.str();
+}
+
+}  // namespace
+
+HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& all_motions,
+                                     const HandEyeOptions& options,
+                                     const Eigen::Vector3d& axis_translation_fallback,
+                                     bool per_motion_scale) {
+  THROW_CHECK(options.Check());
+  // A monocular model can be locally wrong (forward motion): motions whose camera and LiDAR rotation
+  // angles disagree are left out altogether.
+  std::vector<HandEyeMotion> motions;
+  for (const HandEyeMotion& motion : all_motions) {
+    if (std::abs(Eigen::AngleAxisd(motion.cam_i_from_cam_j.rotation).angle() -
+                 Eigen::AngleAxisd(motion.lidar_i_from_lidar_j.rotation).angle()) <=
+        options.max_axis_residual_deg * kDegToRad) {
+      motions.push_back(motion);
+    }
+  }
+  const RotationAxes axes = RotatingMotions(motions, options);
+  if (axes.motions.empty()) {
+    HandEyeResult result;
+    result.message = DegenerateMessage(0, 0);
     return result;
   }
-  result.unique = !planar;
-  if (planar) {
-    message << "; rotation about one axis only (camera " << std::setprecision(2) << axis.transpose()
-            << "): the translation along it is not observable from motion";
+  // Planar when the axes are parallel, or when they do not fit one general rotation (the noisy axes of
+  // a car's small turns).
+  bool planar =
+      axes.motions.size() < 2 || MaxAngleBetweenLinesDeg(axes.in_cam) < options.min_axis_angle_deg;
+  HandEyeResult result =
+      SimilarityHandEye(motions, options, axis_translation_fallback, per_motion_scale, planar);
+  if (!planar && !result.rotation_unique) {
+    planar = true;
+    result = SimilarityHandEye(motions, options, axis_translation_fallback, per_motion_scale, true);
   }
-  result.message = message.str();
+  if (result.message.empty()) {
+    result.message =
+        SimilarityMessage(result, motions.size(), all_motions.size(), planar, per_motion_scale);
+  }
   return result;
 }
 

@@ -57,9 +57,14 @@ HandEyeResult SolveHandEye(const std::vector<HandEyeMotion>& motions,
 // motions that hardly rotate (a_k / |a_k| = R_X t_B / |t_B|), and the component of t_X along the common
 // axis, which no motion observes, is taken from `axis_translation_fallback` (e.g. the guess) and named
 // in the result.
+// `per_motion_scale`: each camera translation has a scale of its own (unit directions from two-view
+// geometry): (R_A - I) t_X + s_k a_k = R_X t_B with one s_k per motion; `scale` is then their mean.
+// Planar motion with per-motion scales takes all of t_X from the fallback (the forward translation is
+// confounded with the scales when the platform drives mostly straight).
 HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& motions,
                                      const HandEyeOptions& options,
-                                     const Eigen::Vector3d& axis_translation_fallback);
+                                     const Eigen::Vector3d& axis_translation_fallback,
+                                     bool per_motion_scale = false);
 
 // Least-squares scale s of up-to-scale camera motions given cam_from_lidar: s a_k = R_X t_B - (R_A - I) t_X.
 // Throws if no motion translates.

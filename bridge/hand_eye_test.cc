@@ -78,6 +78,20 @@ TEST(SimilarityHandEye, RecoversScaleAndExtrinsicFromMotionsAboutTwoAxes) {
               1e-9);
 }
 
+// Two-view geometry gives each camera motion a direction only: one scale per motion.
+TEST(SimilarityHandEye, RecoversTheExtrinsicFromTranslationDirections) {
+  std::vector<HandEyeMotion> motions = Conjugate({Motion(40, {0, 1, 0.05}, {1.2, 0.1, 0.4}),
+                                                  Motion(-70, {0.02, 1, -0.03}, {-0.8, 0.05, 1.1}),
+                                                  Motion(25, {1, 0.2, 0}, {0.1, -0.6, 0.3}),
+                                                  Motion(15, {0.3, 1, 0.2}, {0.7, 0.2, -0.5})});
+  for (HandEyeMotion& motion : motions) motion.cam_i_from_cam_j.translation.normalize();
+  const HandEyeResult result =
+      SolveSimilarityHandEye(motions, HandEyeOptions(), Eigen::Vector3d::Zero(), true);
+  ASSERT_TRUE(result.unique) << result.message;
+  EXPECT_LT(result.cam_from_lidar.rotation.angularDistance(kCamFromLidar.rotation), 1e-9);
+  EXPECT_LT((result.cam_from_lidar.translation - kCamFromLidar.translation).norm(), 1e-9);
+}
+
 // A car on a plane: yaw about the camera's y axis only, and straight stretches. The rotation follows
 // from the yaw axis and the driving direction; the height (along y) is not observable and stays at the
 // fallback, and the result says so.

@@ -2,6 +2,8 @@
 
 #include "colmap_ext/logging.h"
 
+#include "colmap/estimators/two_view_geometry.h"
+
 #include <Eigen/Geometry>
 
 #include <random>
@@ -141,6 +143,45 @@ std::vector<ImagePairPose> EstimateImagePairPoses(const colmap::Database& databa
     pose.image_i = image_i;
     pose.image_j = image_j;
     if (FitRelativePose(points, options, &rng, &pose)) poses.push_back(pose);
+  }
+  return poses;
+}
+
+std::vector<ImagePairPose> EstimateImagePairDirections(const colmap::Database& database,
+                                                       int min_inliers) {
+  std::vector<colmap::image_pair_t> pair_ids;
+  std::vector<colmap::TwoViewGeometry> geometries;
+  database.ReadTwoViewGeometries(&pair_ids, &geometries);
+  std::vector<ImagePairPose> poses;
+  for (size_t k = 0; k < pair_ids.size(); ++k) {
+    colmap::TwoViewGeometry& geometry = geometries[k];
+    if (static_cast<int>(geometry.inlier_matches.size()) < min_inliers) continue;
+    const auto [image_id1, image_id2] = colmap::Database::PairIdToImagePair(pair_ids[k]);
+    const colmap::Image image1 = database.ReadImage(image_id1);
+    const colmap::Image image2 = database.ReadImage(image_id2);
+    const auto points = [&database](colmap::image_t image_id) {
+      std::vector<Eigen::Vector2d> xy;
+      for (const colmap::FeatureKeypoint& keypoint : database.ReadKeypoints(image_id)) {
+        xy.emplace_back(keypoint.x, keypoint.y);
+      }
+      return xy;
+    };
+    if (!colmap::EstimateTwoViewGeometryPose(database.ReadCamera(image1.CameraId()),
+                                             points(image_id1),
+                                             database.ReadCamera(image2.CameraId()),
+                                             points(image_id2),
+                                             &geometry) ||
+        !(geometry.cam2_from_cam1.translation.norm() > 0)) {
+      continue;
+    }
+    ImagePairPose pose;
+    // cam2_from_cam1 = cam_{image 2}_from_cam_{image 1}: image_i = image 2, image_j = image 1.
+    pose.image_i = image_id2;
+    pose.image_j = image_id1;
+    pose.cam_i_from_cam_j = geometry.cam2_from_cam1;
+    pose.cam_i_from_cam_j.translation.normalize();
+    pose.num_inliers = static_cast<int>(geometry.inlier_matches.size());
+    poses.push_back(pose);
   }
   return poses;
 }

@@ -41,4 +41,11 @@ std::vector<ImagePairPose> EstimateImagePairPoses(const colmap::Database& databa
                                                   const DepthPriorsByImage& depth_priors,
                                                   const ImagePairPoseOptions& options);
 
+// Monocular image edges: for each image pair COLMAP verified with at least `min_inliers` inlier
+// matches, the relative rotation and the translation *direction* (unit norm: one camera has no scale)
+// from COLMAP's own two-view pose estimation (EstimateTwoViewGeometryPose on the inlier matches).
+// Pairs whose pose COLMAP cannot estimate are left out.
+std::vector<ImagePairPose> EstimateImagePairDirections(const colmap::Database& database,
+                                                       int min_inliers);
+
 }  // namespace colmap_lidar

@@ -87,7 +87,6 @@ bool PoseInitializerOptions::Check() const {
   CHECK_OPTION(image_pairs.Check());
   CHECK_OPTION(hand_eye.Check());
   CHECK_OPTION(similarity_hand_eye.Check());
-  CHECK_OPTION(mapping.Check());
   CHECK_OPTION_GT(sigma_rotation_deg, 0);
   CHECK_OPTION_GT(sigma_translation_m, 0);
   return true;
@@ -227,10 +226,13 @@ std::vector<HandEyeMotion> ModelMotions(
 double ChooseSimilarityExtrinsic(const std::vector<HandEyeMotion>& motions,
                                  const StationDataset& dataset,
                                  const PoseInitializerOptions& options,
-                                 PoseInitialization* init) {
+                                 PoseInitialization* init,
+                                 bool per_motion_scale = false) {
   const std::optional<colmap::Rigid3d>& guess = dataset.rig.cam_from_lidar_guess;
-  init->hand_eye = SolveSimilarityHandEye(
-      motions, options.similarity_hand_eye, guess ? guess->translation : Eigen::Vector3d::Zero());
+  init->hand_eye = SolveSimilarityHandEye(motions,
+                                          options.similarity_hand_eye,
+                                          guess ? guess->translation : Eigen::Vector3d::Zero(),
+                                          per_motion_scale);
   if ((options.use_guess && guess) || (!init->hand_eye.rotation_unique && guess)) {
     init->cam_from_lidar = *guess;
     init->extrinsic_source = "rig.json guess, scale from the LiDAR motions";
@@ -251,6 +253,33 @@ double ChooseSimilarityExtrinsic(const std::vector<HandEyeMotion>& motions,
                                     : " (translation along the unobservable axis set to 0)";
   }
   return init->hand_eye.scale;
+}
+
+// COLMAP's two-view rotations and translation directions paired with the LiDAR motions of the same
+// station pairs (a monocular rig's hand-eye input).
+std::vector<HandEyeMotion> PairDirectionMotions(const std::string& database_path,
+                                                const std::string& registration_path) {
+  const colmap::Database database(database_path);
+  std::map<std::string, colmap::image_t> image_of_station;
+  for (const colmap::Image& image : database.ReadAllImages()) {
+    image_of_station[fs::path(image.Name()).stem().string()] = image.ImageId();
+  }
+  std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d> directions;
+  for (const ImagePairPose& pair : EstimateImagePairDirections(database, 15)) {
+    directions[{pair.image_i, pair.image_j}] = pair.cam_i_from_cam_j;
+    directions[{pair.image_j, pair.image_i}] = colmap::Inverse(pair.cam_i_from_cam_j);
+  }
+  std::vector<HandEyeMotion> motions;
+  for (const LidarPairRecord& pair :
+       ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
+    if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) continue;
+    const auto direction =
+        directions.find({image_of_station.at(pair.target), image_of_station.at(pair.source)});
+    if (direction != directions.end()) {
+      motions.push_back({direction->second, pair.target_from_source});
+    }
+  }
+  return motions;
 }
 
 }  // namespace
@@ -305,14 +334,8 @@ PoseInitialization InitializeMonocular(const std::string& database_path,
     init.cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
     init.extrinsic_source = "rig.json guess";
   } else {
-    colmap::Reconstruction model =
-        MapWithColmap(database_path, (fs::path(dataset.root) / "images").string(), options.mapping);
-    std::map<std::string, colmap::image_t> model_image_of_station;
-    for (const colmap::image_t image_id : model.RegImageIds()) {
-      model_image_of_station[fs::path(model.Image(image_id).Name()).stem().string()] = image_id;
-    }
     ChooseSimilarityExtrinsic(
-        ModelMotions(model, model_image_of_station, registration_path), dataset, options, &init);
+        PairDirectionMotions(database_path, registration_path), dataset, options, &init, true);
   }
   const colmap::Database database(database_path);
   for (const colmap::Image& image : database.ReadAllImages()) {

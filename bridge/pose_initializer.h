@@ -8,14 +8,13 @@
 //    no edge reaches are reported and left out.
 // The world frame is the first station's camera frame; units are metres.
 //
-// A monocular dataset has no depth priors, so no metric image edges: it starts from COLMAP's own
-// incremental mapper (colmap_ext/incremental_mapping.h) and InitializeFromModel, whose scale and
-// cam_from_lidar then come from the similarity hand-eye with the LiDAR motions (or rig.json's guess).
+// A monocular dataset has no depth priors, so no metric image edges: InitializeMonocular takes
+// cam_from_lidar from the guess or a hand-eye between COLMAP's two-view rotations and translation
+// directions and the LiDAR motions, and places the stations through their LiDAR poses.
 #pragma once
 
 #include "bridge/hand_eye.h"
 #include "bridge/image_pair_poses.h"
-#include "colmap_ext/incremental_mapping.h"
 #include "colmap_ext/station_dataset.h"
 
 #include "colmap/scene/reconstruction.h"
@@ -39,8 +38,6 @@ struct PoseInitializerOptions {
     options.max_axis_residual_deg = 0.5;
     return options;
   }();
-  // COLMAP's mapper, for a monocular dataset
-  IncrementalMappingOptions mapping;
   // false: hand-eye even when rig.json has a guess
   bool use_guess = true;
   // pose-graph edge weights
@@ -89,8 +86,9 @@ PoseInitialization InitializeFromModel(const std::string& database_path,
                                        double* scale);
 
 // The monocular initialisation: cam_from_lidar from rig.json's guess (if allowed and present), else
-// from the similarity hand-eye between COLMAP's own incremental model of the database (mapped here)
-// and the LiDAR motions; then every station of the largest LiDAR component is placed through its
+// from the similarity hand-eye (one scale per motion) between COLMAP's two-view geometry of the
+// verified image pairs (EstimateImagePairDirections: rotation and translation direction) and the
+// LiDAR motions of the same station pairs; then every station of the largest LiDAR component is placed through its
 // LiDAR pose, cam_from_world = cam_from_lidar * inverse(world_from_lidar): the LiDAR trajectory is
 // metric and, on forward motion, more reliable than a monocular model. Stations outside that
 // component are listed as unreachable.

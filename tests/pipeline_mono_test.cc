@@ -1,7 +1,8 @@
 // Mono mode: one camera and a LiDAR (rig.json without "right"). The pipeline runs without stereo
-// steps; the initialisation takes cam_from_lidar from the similarity hand-eye between COLMAP's own
-// monocular model and the LiDAR motions and places the stations through their LiDAR poses; the joint
-// adjustment adds the landmark-to-LiDAR-plane term; the densifier has no image depth.
+// steps; the initialisation takes cam_from_lidar from the similarity hand-eye between COLMAP's two-view
+// geometry (rotations, translation directions) and the LiDAR motions and places the stations through
+// their LiDAR poses; the joint adjustment adds the landmark-to-LiDAR-plane term; the densifier has no
+// image depth.
 #include "colmap_ext/station_dataset.h"
 #include "tests/testing/pipeline_fixture.h"
 #include "tests/testing/scoped_temp_dir.h"

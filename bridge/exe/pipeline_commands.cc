@@ -29,9 +29,6 @@ void AddPoseInitializerOptions(const std::string& prefix,
           &options->use_guess,
           "use rig.json's cam_from_lidar_guess if present (0: hand-eye)");
   add.Add("min_pair_inliers", &options->image_pairs.min_inliers);
-  add.Add("min_model_size",
-          &options->mapping.min_model_size,
-          "monocular: smallest model COLMAP's mapper keeps");
   add.Add("sigma_rotation_deg", &options->sigma_rotation_deg, "pose-graph edge weight");
   add.Add("sigma_translation_m", &options->sigma_translation_m, "pose-graph edge weight");
 }
