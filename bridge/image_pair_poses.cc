@@ -152,6 +152,17 @@ std::vector<ImagePairPose> EstimateImagePairDirections(const colmap::Database& d
   std::vector<colmap::image_pair_t> pair_ids;
   std::vector<colmap::TwoViewGeometry> geometries;
   database.ReadTwoViewGeometries(&pair_ids, &geometries);
+  // Each image's keypoints read once, however many pairs it is in.
+  std::unordered_map<colmap::image_t, std::vector<Eigen::Vector2d>> keypoints;
+  const auto keypoints_of = [&](colmap::image_t image_id) -> const std::vector<Eigen::Vector2d>& {
+    auto [it, inserted] = keypoints.try_emplace(image_id);
+    if (inserted) {
+      for (const colmap::FeatureKeypoint& keypoint : database.ReadKeypoints(image_id)) {
+        it->second.emplace_back(keypoint.x, keypoint.y);
+      }
+    }
+    return it->second;
+  };
   std::vector<ImagePairPose> poses;
   for (size_t k = 0; k < pair_ids.size(); ++k) {
     colmap::TwoViewGeometry& geometry = geometries[k];
@@ -159,17 +170,10 @@ std::vector<ImagePairPose> EstimateImagePairDirections(const colmap::Database& d
     const auto [image_id1, image_id2] = colmap::Database::PairIdToImagePair(pair_ids[k]);
     const colmap::Image image1 = database.ReadImage(image_id1);
     const colmap::Image image2 = database.ReadImage(image_id2);
-    const auto points = [&database](colmap::image_t image_id) {
-      std::vector<Eigen::Vector2d> xy;
-      for (const colmap::FeatureKeypoint& keypoint : database.ReadKeypoints(image_id)) {
-        xy.emplace_back(keypoint.x, keypoint.y);
-      }
-      return xy;
-    };
     if (!colmap::EstimateTwoViewGeometryPose(database.ReadCamera(image1.CameraId()),
-                                             points(image_id1),
+                                             keypoints_of(image_id1),
                                              database.ReadCamera(image2.CameraId()),
-                                             points(image_id2),
+                                             keypoints_of(image_id2),
                                              &geometry) ||
         !(geometry.cam2_from_cam1.translation.norm() > 0)) {
       continue;

@@ -235,10 +235,13 @@ double ChooseSimilarityExtrinsic(const std::vector<HandEyeMotion>& motions,
                                           per_motion_scale);
   if ((options.use_guess && guess) || (!init->hand_eye.rotation_unique && guess)) {
     init->cam_from_lidar = *guess;
-    init->extrinsic_source = "rig.json guess, scale from the LiDAR motions";
+    init->extrinsic_source = "rig.json guess";
     if (!init->hand_eye.rotation_unique) {
       init->extrinsic_source += " (hand-eye: " + init->hand_eye.message + ")";
     }
+    // Translation directions (one scale per motion) have no common scale to fit.
+    if (per_motion_scale) return 1.0;
+    init->extrinsic_source += ", scale from the LiDAR motions";
     return HandEyeScale(motions, *guess);
   }
   if (!init->hand_eye.rotation_unique) {

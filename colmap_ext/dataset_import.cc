@@ -51,7 +51,8 @@ bool SameIntrinsics(const colmap::Camera& a, const colmap::Camera& b) {
   return true;
 }
 
-// The left camera: the one our rig row names if the database has one (it must match rig.json), else a
+// The left camera: the one our rig row names if the database has one (it must match rig.json); for a
+// monocular rig (no rig row) an existing camera with rig.json's intrinsics (a second import); else a
 // new camera with rig.json's intrinsics.
 colmap::camera_t LeftCameraId(const StationDataset& dataset,
                               colmap::Database* database,
@@ -67,6 +68,11 @@ colmap::camera_t LeftCameraId(const StationDataset& dataset,
                                "/rig.json; import into a new database");
     }
     return rig->left_camera_id;
+  }
+  if (!dataset.rig.IsStereo()) {
+    for (const colmap::Camera& existing : database->ReadAllCameras()) {
+      if (SameIntrinsics(existing, dataset.rig.left)) return existing.camera_id;
+    }
   }
   colmap::Camera camera = dataset.rig.left;
   camera.has_prior_focal_length = true;

@@ -7,6 +7,8 @@
 #include "tests/testing/pipeline_fixture.h"
 #include "tests/testing/scoped_temp_dir.h"
 
+#include "colmap/scene/database.h"
+
 #include <gtest/gtest.h>
 
 namespace colmap_lidar {
@@ -55,6 +57,12 @@ TEST(PipelineMonoTest, StationsCalibrateWithoutAGuessOrAStereoPair) {
   EXPECT_EQ(densifier["image_depth"].get<std::string>().rfind("none", 0), 0u);
   const nlohmann::json dense = ReadJson(ws + "/evaluation/model/metrics.json");
   EXPECT_LT(dense["mean_m"].get<double>(), 0.0045);
+
+  // A second import of the monocular dataset reuses its camera (there is no rig row to name it).
+  const auto again = RunCommand(kCli + " import_dataset --dataset_path " + dataset +
+                                " --database_path " + ws + "/database.db");
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(colmap::Database(ws + "/database.db").NumCameras(), 1u);
 
   // stereo_only has nothing to work with.
   const auto stereo_only =

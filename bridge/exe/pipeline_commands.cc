@@ -257,6 +257,10 @@ int RunPipeline(int argc, char** argv) {
   THROW_CHECK(pipeline.joint.Check());
   THROW_CHECK(pipeline.densifier.Check());
   const StationDataset dataset = ReadStationDataset(pipeline.dataset_path);
+  if (!dataset.rig.IsStereo() && pipeline.mode == "stereo_only") {
+    throw std::invalid_argument("--mode stereo_only needs a stereo rig; " + dataset.root +
+                                "/rig.json has one camera");
+  }
   const fs::path ws(pipeline.workspace_path);
   fs::create_directories(ws / "steps");
   fs::create_directories(ws / "sparse");

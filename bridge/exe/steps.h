@@ -18,9 +18,9 @@
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/stereo_depth.h"
 #include "lidar/lidar_pose_graph.h"
-#include "lidar/sweep_deskew.h"
 #include "lidar/model_evaluation.h"
 #include "lidar/station_cloud.h"
+#include "lidar/sweep_deskew.h"
 
 #include "colmap/controllers/option_manager.h"
 
