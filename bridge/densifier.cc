@@ -46,19 +46,21 @@ PinholeIntrinsics IntrinsicsOf(const colmap::Camera& camera) {
 // The registered images that are stations of the dataset, in station order.
 std::vector<StationView> StationViews(const colmap::Reconstruction& reconstruction,
                                       const StationDataset& dataset) {
-  std::map<std::string, colmap::image_t> by_name;
+  // By the stem of the image name: "left/000.png" or a user's "000.jpg" (image_name_format).
+  std::map<std::string, colmap::image_t> by_station;
   for (const colmap::image_t image_id : reconstruction.RegImageIds()) {
-    by_name[reconstruction.Image(image_id).Name()] = image_id;
+    by_station[std::filesystem::path(reconstruction.Image(image_id).Name()).stem().string()] =
+        image_id;
   }
   std::vector<StationView> views;
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
-    const auto found = by_name.find(dataset.LeftImageName(i));
-    if (found == by_name.end()) {
+    const auto found = by_station.find(dataset.stations[i]);
+    if (found == by_station.end()) {
       std::cout << "densifier: station " << dataset.stations[i]
                 << " is not registered in the model; skipped" << std::endl;
       continue;
     }
-    views.push_back({i, found->second, found->first});
+    views.push_back({i, found->second, reconstruction.Image(found->second).Name()});
   }
   if (views.empty()) {
     throw std::runtime_error(

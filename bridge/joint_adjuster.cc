@@ -146,6 +146,9 @@ struct RunState {
   size_t num_reprojection_outliers = 0;
   size_t num_lidar_outliers = 0;
   size_t num_landmark_outliers = 0;
+  // This round's association gate (0 in the last round): E_m's outlier cap is never below it, so
+  // that a coarse initial cam_from_lidar (a height off by 25 cm) is pulled in before the cap applies.
+  double round_gate_m = 0;
 
   bool UsesExtrinsic() const { return use_lidar || use_landmark_lidar; }
 
@@ -482,9 +485,10 @@ size_t FlagLidarOutliers(RunState* state, std::vector<LidarObservation>* observa
 
 // E_m observations beyond the absolute or the sigma gate get zero weight; returns how many new.
 size_t FlagLandmarkOutliers(RunState* state, std::vector<LandmarkPlaneObservation>* observations) {
-  const double gate =
+  const double gate = std::max(
+      state->round_gate_m,
       std::min(state->options.max_landmark_plane_m,
-               state->options.max_landmark_plane_sigmas * state->options.sigma_landmark_lidar_m);
+               state->options.max_landmark_plane_sigmas * state->options.sigma_landmark_lidar_m));
   size_t flagged = 0;
   for (LandmarkPlaneObservation& observation : *observations) {
     if (observation.outlier) continue;
@@ -546,6 +550,7 @@ void Reassociate(int round, int num_rounds, RunState* state, Associations* assoc
   const double gate = std::max(options.association.max_distance,
                                options.initial_association_distance_m * std::pow(0.5, round));
   const auto start = std::chrono::steady_clock::now();
+  state->round_gate_m = round + 1 < num_rounds ? gate : 0.0;  // the last round: the final cap
   if (state->use_lidar) associations->lidar = Associate(*state, gate);
   if (state->use_landmark_lidar) {
     associations->landmarks = AssociateLandmarksWithLidar(*state->reconstruction,

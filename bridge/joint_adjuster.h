@@ -67,7 +67,8 @@ struct JointAdjusterOptions {
   // sigma_m of E_m: the landmark's triangulation and the LiDAR surface together.
   double sigma_landmark_lidar_m = 0.02;
   // E_m outliers: beyond this distance or beyond max_landmark_plane_sigmas * sigma_m (absolute and in
-  // sigma units), zero weight until none remain; re-associated each round with the LiDAR term's gate.
+  // sigma units), zero weight until none remain; re-associated each round with the LiDAR term's gate,
+  // which is also the cap of every round but the last (a coarse start is pulled in first).
   double max_landmark_plane_m = 0.1;
   double max_landmark_plane_sigmas = 3.0;
   // Robust loss on every term: none | huber | cauchy (none in the paper). With a loss, each LiDAR

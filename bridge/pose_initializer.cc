@@ -1,6 +1,7 @@
 #include "bridge/pose_initializer.h"
 
 #include "bridge/lidar_registration_files.h"
+#include "bridge/model_completion.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "lidar/pose_graph.h"
@@ -23,6 +24,30 @@ namespace colmap_lidar {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The database's image of each station (by the file stem of its name).
+struct StationImages {
+  std::map<std::string, colmap::image_t> image_of_station;
+  std::map<colmap::image_t, std::string> names;      // the station images
+  std::map<colmap::image_t, std::string> all_names;  // every image of the database
+};
+
+StationImages ReadStationImages(const std::string& database_path, const StationDataset& dataset) {
+  const colmap::Database database(database_path);
+  const std::set<std::string> stations(dataset.stations.begin(), dataset.stations.end());
+  StationImages images;
+  for (const colmap::Image& image : database.ReadAllImages()) {
+    images.all_names[image.ImageId()] = image.Name();
+    const std::string station = fs::path(image.Name()).stem().string();
+    if (!stations.count(station)) continue;
+    images.image_of_station[station] = image.ImageId();
+    images.names[image.ImageId()] = image.Name();
+  }
+  if (images.image_of_station.empty()) {
+    throw std::runtime_error(database_path + " holds no image of the stations of " + dataset.root);
+  }
+  return images;
+}
 
 // cam_from_lidar: rig.json's guess if allowed and present, else hand-eye, else the guess anyway (with
 // the hand-eye failure recorded), else an error saying why.
@@ -100,23 +125,16 @@ PoseInitialization InitializePoses(const std::string& database_path,
   THROW_CHECK(fs::is_regular_file(database_path))
       << "Database file does not exist: " << database_path;
   PoseInitialization init;
+  const StationImages images = ReadStationImages(database_path, dataset);
+  const std::map<std::string, colmap::image_t>& image_of_station = images.image_of_station;
   const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
   const colmap::Database database(database_path);
-  std::map<std::string, colmap::image_t> image_of_station;
-  std::map<colmap::image_t, std::string> names;
-  std::set<std::string> stations(dataset.stations.begin(), dataset.stations.end());
   DepthPriorsByImage priors;
-  for (const colmap::Image& image : database.ReadAllImages()) {
-    const std::string station = fs::path(image.Name()).stem().string();
-    if (!stations.count(station)) continue;
-    image_of_station[station] = image.ImageId();
-    names[image.ImageId()] = image.Name();
-    for (const DepthPrior& prior : extension.ReadDepthPriors(image.ImageId())) {
-      priors[image.ImageId()][prior.point2D_idx] = prior;
+  for (const auto& [image_id, name] : images.names) {
+    for (const DepthPrior& prior : extension.ReadDepthPriors(image_id)) {
+      priors[image_id][prior.point2D_idx] = prior;
     }
   }
-  THROW_CHECK(!image_of_station.empty())
-      << database_path << " holds no image of the stations of " << dataset.root;
 
   // A_c.
   const std::vector<ImagePairPose> image_pairs =
@@ -167,7 +185,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
          true});
   }
 
-  SolveCameraPoseGraph(image_of_station, names, options, &init);
+  SolveCameraPoseGraph(image_of_station, images.names, options, &init);
   return init;
 }
 
@@ -258,6 +276,65 @@ double ChooseSimilarityExtrinsic(const std::vector<HandEyeMotion>& motions,
   return init->hand_eye.scale;
 }
 
+// Each model image must be the database's image of the same id and name, with its keypoints.
+void CheckModelImages(const colmap::Reconstruction& model, const StationImages& images) {
+  for (const colmap::image_t image_id : model.RegImageIds()) {
+    const colmap::Image& image = model.Image(image_id);
+    const auto name = images.names.find(image_id);
+    if (name == images.names.end()) {
+      if (images.all_names.count(image_id) && images.all_names.at(image_id) == image.Name()) {
+        continue;  // not a station image (e.g. an extra photo): joins no station
+      }
+      throw std::runtime_error("the model's image " + image.Name() + " (image_id " +
+                               std::to_string(image_id) +
+                               ") is not in the database under that id: the model must come from "
+                               "the same database");
+    }
+    if (name->second != image.Name()) {
+      throw std::runtime_error("the model's image_id " + std::to_string(image_id) + " is " +
+                               image.Name() + " but the database's is " + name->second +
+                               ": the model must come from the same database");
+    }
+  }
+}
+
+// Every model to metres and cam_from_lidar. Stereo: each model by its own depth priors, cam_from_lidar
+// by hand-eye over every model's motions (or the guess). Monocular: the first model's similarity
+// hand-eye gives cam_from_lidar and its scale; the other models are scaled to the LiDAR motions through it.
+void ChooseModelScalesAndExtrinsic(const std::string& database_path,
+                                   const StationDataset& dataset,
+                                   const std::string& registration_path,
+                                   const PoseInitializerOptions& options,
+                                   std::vector<colmap::Reconstruction>* models,
+                                   std::vector<double>* scales,
+                                   PoseInitialization* init) {
+  const auto motions_of = [&](const colmap::Reconstruction& model) {
+    std::map<std::string, colmap::image_t> image_of_station;
+    for (const colmap::image_t image_id : model.RegImageIds()) {
+      image_of_station[fs::path(model.Image(image_id).Name()).stem().string()] = image_id;
+    }
+    return ModelMotions(model, image_of_station, registration_path);
+  };
+  scales->clear();
+  std::vector<HandEyeMotion> motions;
+  for (size_t k = 0; k < models->size(); ++k) {
+    colmap::Reconstruction& model = (*models)[k];
+    double scale = 1;
+    if (dataset.rig.IsStereo()) {
+      scale = DepthPriorScale(database_path, model);
+    } else if (k == 0) {
+      scale = ChooseSimilarityExtrinsic(motions_of(model), dataset, options, init);
+    } else {
+      scale = HandEyeScale(motions_of(model), init->cam_from_lidar);
+    }
+    model.Transform(colmap::Sim3d(scale, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()));
+    scales->push_back(scale);
+    const std::vector<HandEyeMotion> metric = motions_of(model);
+    motions.insert(motions.end(), metric.begin(), metric.end());
+  }
+  if (dataset.rig.IsStereo()) ChooseExtrinsic(motions, dataset, options, init);
+}
+
 // COLMAP's two-view rotations and translation directions paired with the LiDAR motions of the same
 // station pairs (a monocular rig's hand-eye input).
 std::vector<HandEyeMotion> PairDirectionMotions(const std::string& database_path,
@@ -287,38 +364,44 @@ std::vector<HandEyeMotion> PairDirectionMotions(const std::string& database_path
 
 }  // namespace
 
-PoseInitialization InitializeFromModel(const std::string& database_path,
-                                       const StationDataset& dataset,
-                                       const std::string& registration_path,
-                                       const PoseInitializerOptions& options,
-                                       colmap::Reconstruction* model,
-                                       double* scale) {
+PoseInitialization InitializeFromModels(const std::string& database_path,
+                                        const StationDataset& dataset,
+                                        const std::string& registration_path,
+                                        const PoseInitializerOptions& options,
+                                        std::vector<colmap::Reconstruction>* models,
+                                        std::vector<double>* scales) {
   THROW_CHECK(options.Check());
-  THROW_CHECK_NOTNULL(model);
-  THROW_CHECK_GE(model->NumRegImages(), 2) << "the model has fewer than 2 registered images";
-  std::map<std::string, colmap::image_t> image_of_station;
-  for (const colmap::image_t image_id : model->RegImageIds()) {
-    image_of_station[fs::path(model->Image(image_id).Name()).stem().string()] = image_id;
-  }
+  THROW_CHECK(models != nullptr && scales != nullptr);
+  THROW_CHECK(!models->empty()) << "no COLMAP model given";
+  const StationImages images = ReadStationImages(database_path, dataset);
+  for (const colmap::Reconstruction& model : *models) CheckModelImages(model, images);
   PoseInitialization init;
-  if (dataset.rig.IsStereo()) {
-    *scale = DepthPriorScale(database_path, *model);
-  } else {
-    *scale = ChooseSimilarityExtrinsic(
-        ModelMotions(*model, image_of_station, registration_path), dataset, options, &init);
+  ChooseModelScalesAndExtrinsic(
+      database_path, dataset, registration_path, options, models, scales, &init);
+  std::vector<const colmap::Reconstruction*> metric;
+  for (const colmap::Reconstruction& model : *models) metric.push_back(&model);
+  ModelCompletionOptions completion;
+  completion.sigma_rotation_deg = options.sigma_rotation_deg;
+  completion.sigma_translation_m = options.sigma_translation_m;
+  const CompletedPoses completed = CompleteThroughLidar(
+      metric,
+      images.image_of_station,
+      images.names,
+      registration_path.empty()
+          ? std::vector<LidarPairRecord>()
+          : ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string()),
+      init.cam_from_lidar,
+      completion);
+  init.cam_from_world = completed.cam_from_world;
+  init.num_lidar_edges = completed.num_lidar_edges;
+  init.num_image_edges = completed.num_model_edges;
+  for (const auto& [name, reason] : completed.unreachable) {
+    init.unreachable.push_back(name);
+    init.unreachable_reason[name] = reason;
   }
-  model->Transform(colmap::Sim3d(*scale, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()));
-  const std::vector<HandEyeMotion> motions =
-      ModelMotions(*model, image_of_station, registration_path);
-  init.num_lidar_edges = static_cast<int>(motions.size());
-  if (dataset.rig.IsStereo()) ChooseExtrinsic(motions, dataset, options, &init);
-  for (const colmap::image_t image_id : model->RegImageIds()) {
-    init.cam_from_world[image_id] = model->Image(image_id).CamFromWorld();
-  }
-  for (size_t i = 0; i < dataset.stations.size(); ++i) {
-    if (!image_of_station.count(dataset.stations[i])) {
-      init.unreachable.push_back(dataset.LeftImageName(i));
-    }
+  // The models' cameras (the mapper may have refined them); the first model's win.
+  for (auto model = models->rbegin(); model != models->rend(); ++model) {
+    for (const auto& [camera_id, camera] : model->Cameras()) init.cameras[camera_id] = camera;
   }
   return init;
 }
@@ -364,7 +447,8 @@ void TriangulateInitialModel(const std::string& database_path,
   {
     const colmap::Database database(database_path);
     for (const colmap::Camera& camera : database.ReadAllCameras()) {
-      reconstruction->AddCamera(camera);
+      const auto given = initialization.cameras.find(camera.camera_id);
+      reconstruction->AddCamera(given == initialization.cameras.end() ? camera : given->second);
     }
     // Images without any match would break COLMAP's observation manager: they join after triangulation.
     std::set<colmap::image_t> matched;

@@ -57,6 +57,9 @@ struct PoseGraphEdge {
 struct PoseInitialization {
   std::map<colmap::image_t, colmap::Rigid3d> cam_from_world;  // reachable stations
   std::vector<std::string> unreachable;                       // image names
+  std::map<std::string, std::string> unreachable_reason;      // image name -> why (if known)
+  // Cameras that replace the database's (an existing model's refined intrinsics); empty: none.
+  std::map<colmap::camera_t, colmap::Camera> cameras;
   colmap::Rigid3d cam_from_lidar;
   std::string extrinsic_source;  // "rig.json guess" or "hand-eye"
   HandEyeResult hand_eye;
@@ -71,19 +74,23 @@ PoseInitialization InitializePoses(const std::string& database_path,
                                    const std::string& registration_path,
                                    const PoseInitializerOptions& options);
 
-// The existing-COLMAP-workflow variant: `model` (e.g. from `colmap mapper` on the same database) is
-// rescaled to metres in place (`scale` returns the factor) and cam_from_lidar chosen:
-// - stereo rig: the scale is the median ratio of depth prior to model depth over its landmark
-//   observations; cam_from_lidar the guess or hand-eye with the model's relative poses as image motions;
-// - monocular rig: the similarity hand-eye gives both (or the guess, with the scale fitted to the LiDAR
-//   motions through it); planar motion names its unobservable axis in `hand_eye`.
-// Stations the model did not register are listed.
-PoseInitialization InitializeFromModel(const std::string& database_path,
-                                       const StationDataset& dataset,
-                                       const std::string& registration_path,
-                                       const PoseInitializerOptions& options,
-                                       colmap::Reconstruction* model,
-                                       double* scale);
+// The existing-COLMAP-workflow variant: `models` (colmap mapper's, of the same database; ReadModels in
+// bridge/model_completion.h, the largest first) are rescaled to metres in place (`scales` returns the
+// factors) and cam_from_lidar chosen:
+// - stereo rig: each model's scale is the median ratio of depth prior to model depth over its landmark
+//   observations; cam_from_lidar the guess or hand-eye with the models' relative poses as image motions;
+// - monocular rig: the first model's similarity hand-eye gives both (or the guess, with the scale fitted
+//   to the LiDAR motions through it); planar motion names its unobservable axis in `hand_eye`; the
+//   other models are scaled to the LiDAR motions.
+// Then the stations the models did not register, and the other models, are placed through the LiDAR
+// pose graph (CompleteThroughLidar) in the first model's frame; stations no edge reaches are listed
+// with the kind of edge missing. `cameras` holds the models' cameras.
+PoseInitialization InitializeFromModels(const std::string& database_path,
+                                        const StationDataset& dataset,
+                                        const std::string& registration_path,
+                                        const PoseInitializerOptions& options,
+                                        std::vector<colmap::Reconstruction>* models,
+                                        std::vector<double>* scales);
 
 // The monocular initialisation: cam_from_lidar from rig.json's guess (if allowed and present), else
 // from the similarity hand-eye (one scale per motion) between COLMAP's two-view geometry of the
@@ -98,7 +105,8 @@ PoseInitialization InitializeMonocular(const std::string& database_path,
                                        const PoseInitializerOptions& options);
 
 // Writes a COLMAP sparse model with the initial poses and landmarks triangulated by COLMAP's own
-// triangulator (IncrementalMapperController::TriangulateReconstruction with the poses held fixed).
+// triangulator (IncrementalMapperController::TriangulateReconstruction with the poses held fixed); the
+// cameras are the database's, or `initialization.cameras` where given.
 void TriangulateInitialModel(const std::string& database_path,
                              const std::string& image_path,
                              const PoseInitialization& initialization,

@@ -13,12 +13,16 @@
 
 #include <filesystem>
 #include <iostream>
+#include <optional>
+#include <set>
 #include <sstream>
 
 namespace colmap_lidar {
 namespace {
 
 namespace fs = std::filesystem;
+
+constexpr char kStationPlaceholder[] = "{station}";
 
 void CheckImage(const std::string& station,
                 const std::string& side,
@@ -79,6 +83,85 @@ colmap::camera_t LeftCameraId(const StationDataset& dataset,
   return database->WriteCamera(camera);
 }
 
+// A database of the user's own (image_name_format given): the camera of the station images already in
+// it, given rig.json's intrinsics if they differ (keypoints and matches are pixels and stay valid).
+// Refused when the station images have several cameras or the camera also serves other images;
+// std::nullopt when no station image is in the database yet.
+std::optional<colmap::camera_t> ExistingStationCamera(const StationDataset& dataset,
+                                                      const std::vector<std::string>& names,
+                                                      colmap::Database* database) {
+  std::set<colmap::camera_t> cameras;
+  for (const std::string& name : names) {
+    if (database->ExistsImageWithName(name)) {
+      cameras.insert(database->ReadImageWithName(name).CameraId());
+    }
+  }
+  if (cameras.empty()) return std::nullopt;
+  if (cameras.size() > 1) {
+    throw std::runtime_error("the stations' images in the database have " +
+                             std::to_string(cameras.size()) +
+                             " cameras, but a station dataset has one left camera (rig.json)");
+  }
+  const colmap::camera_t camera_id = *cameras.begin();
+  const colmap::Camera camera = database->ReadCamera(camera_id);
+  if (SameIntrinsics(camera, dataset.rig.left)) return camera_id;
+  const std::set<std::string> station_names(names.begin(), names.end());
+  for (const colmap::Image& image : database->ReadAllImages()) {
+    if (image.CameraId() == camera_id && !station_names.count(image.Name())) {
+      throw std::runtime_error("camera " + std::to_string(camera_id) +
+                               " of the stations' images (" + camera.ModelName() + " " +
+                               camera.ParamsToString() +
+                               ") differs from rig.json's left camera and also serves image " +
+                               image.Name() + "; import into a database of the stations only");
+    }
+  }
+  std::cout << "Camera " << camera_id << " of the stations' images (" << camera.ModelName() << " "
+            << camera.ParamsToString() << ") takes rig.json's calibration ("
+            << dataset.rig.left.ModelName() << " " << dataset.rig.left.ParamsToString() << ")"
+            << std::endl;
+  colmap::Camera calibrated = dataset.rig.left;
+  calibrated.camera_id = camera_id;
+  calibrated.has_prior_focal_length = true;
+  database->UpdateCamera(calibrated);
+  return camera_id;
+}
+
+// Every station image not yet in the database must be readable under `image_path`.
+void CheckNewImagesExist(const StationDataset& dataset,
+                         const std::vector<std::string>& names,
+                         const std::string& image_path,
+                         const DatasetImportOptions& options,
+                         const colmap::Database& database) {
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (database.ExistsImageWithName(names[i])) continue;
+    const fs::path path = fs::path(image_path) / names[i];
+    if (!fs::is_regular_file(path)) {
+      throw std::runtime_error(
+          "station " + dataset.stations[i] + " has no image " + names[i] + " (image name format '" +
+          (options.image_name_format.empty() ? "left/{station}.png" : options.image_name_format) +
+          "'): not in the database, nor at " + path.string());
+    }
+  }
+}
+
+// COLMAP's SIFT extraction of the images not yet extracted (COLMAP skips the others).
+void Extract(const std::vector<std::string>& names,
+             const std::string& image_path,
+             const DatasetImportSummary& summary,
+             const DatasetImportOptions& options,
+             const std::string& database_path) {
+  colmap::ImageReaderOptions reader_options;
+  reader_options.database_path = database_path;
+  reader_options.image_path = image_path;
+  reader_options.image_list = names;
+  reader_options.existing_camera_id = static_cast<int>(summary.camera_id);
+  std::cout << "COLMAP SIFT extraction (" << summary.num_new_images << " new images)" << std::endl;
+  auto extractor =
+      colmap::CreateFeatureExtractorController(reader_options, options.sift_extraction);
+  extractor->Start();
+  extractor->Wait();
+}
+
 // The image id of each station's left image after COLMAP's extraction; throws naming the station
 // when COLMAP did not import it, it has another camera, or it has no features.
 std::vector<colmap::image_t> ImportedImageIds(const StationDataset& dataset,
@@ -90,7 +173,7 @@ std::vector<colmap::image_t> ImportedImageIds(const StationDataset& dataset,
   for (size_t i = 0; i < names.size(); ++i) {
     if (!database.ExistsImageWithName(names[i])) {
       throw std::runtime_error("station " + dataset.stations[i] + ": COLMAP did not import " +
-                               dataset.LeftImagePath(i));
+                               names[i]);
     }
     const colmap::Image image = database.ReadImageWithName(names[i]);
     if (image.CameraId() != camera_id) {
@@ -100,7 +183,7 @@ std::vector<colmap::image_t> ImportedImageIds(const StationDataset& dataset,
     }
     if (!database.ExistsKeypoints(image.ImageId())) {
       throw std::runtime_error("station " + dataset.stations[i] +
-                               ": COLMAP extracted no features from " + dataset.LeftImagePath(i));
+                               ": COLMAP extracted no features from " + names[i]);
     }
     image_ids.push_back(image.ImageId());
   }
@@ -177,6 +260,15 @@ void WriteRigAndLidarFrames(const StationDataset& dataset,
 
 }  // namespace
 
+std::string DatasetImportOptions::ImageName(const StationDataset& dataset, size_t station) const {
+  if (image_name_format.empty()) return dataset.LeftImageName(station);
+  std::string name = image_name_format;
+  name.replace(name.find(kStationPlaceholder),
+               std::string(kStationPlaceholder).size(),
+               dataset.stations.at(station));
+  return name;
+}
+
 colmap::SpatialMatchingOptions LidarSpatialMatchingOptions() {
   colmap::SpatialMatchingOptions options;
   options.ignore_z = false;
@@ -185,6 +277,8 @@ colmap::SpatialMatchingOptions LidarSpatialMatchingOptions() {
 
 bool DatasetImportOptions::Check() const {
   CHECK_OPTION(matcher == "exhaustive" || matcher == "sequential" || matcher == "spatial");
+  CHECK_OPTION(image_name_format.empty() ||
+               fs::path(image_name_format).stem().string() == kStationPlaceholder);
   CHECK_OPTION(exhaustive_matching.Check());
   CHECK_OPTION(sequential_matching.Check());
   CHECK_OPTION(spatial_matching.Check());
@@ -232,29 +326,34 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
     DatasetImportSummary summary;
     std::vector<std::string> names;
     for (size_t i = 0; i < dataset.stations.size(); ++i) {
-      names.push_back(dataset.LeftImageName(i));
+      names.push_back(options.ImageName(dataset, i));
     }
+    const std::string image_path = options.image_path.empty()
+                                       ? (fs::path(dataset.root) / "images").string()
+                                       : options.image_path;
+    bool all_extracted = true;
     {
       colmap::Database database(partial);  // creates COLMAP's tables if new
       ExtensionDatabase extension(partial);
-      summary.camera_id = LeftCameraId(dataset, &database, &extension);
+      CheckNewImagesExist(dataset, names, image_path, options, database);
+      std::optional<colmap::camera_t> camera_id;
+      if (!options.image_name_format.empty()) {
+        camera_id = ExistingStationCamera(dataset, names, &database);
+      }
+      summary.camera_id = camera_id ? *camera_id : LeftCameraId(dataset, &database, &extension);
       for (const std::string& name : names) {
-        if (!database.ExistsImageWithName(name)) ++summary.num_new_images;
+        if (!database.ExistsImageWithName(name)) {
+          ++summary.num_new_images;
+          all_extracted = false;
+        } else if (!database.ExistsKeypoints(database.ReadImageWithName(name).ImageId())) {
+          all_extracted = false;
+        }
       }
     }
-
-    colmap::ImageReaderOptions reader_options;
-    reader_options.database_path = partial;
-    reader_options.image_path = (fs::path(dataset.root) / "images").string();
-    reader_options.image_list = names;
-    reader_options.existing_camera_id = static_cast<int>(summary.camera_id);
-    std::cout << "COLMAP SIFT extraction (" << summary.num_new_images << " new images)"
-              << std::endl;
-    auto extractor =
-        colmap::CreateFeatureExtractorController(reader_options, options.sift_extraction);
-    extractor->Start();
-    extractor->Wait();
-    extractor.reset();  // closes its database connection
+    if (!all_extracted)
+      Extract(names, image_path, summary, options, partial);
+    else
+      std::cout << "COLMAP SIFT extraction: every station image has its features" << std::endl;
 
     const std::vector<colmap::image_t> image_ids =
         ImportedImageIds(dataset, names, summary.camera_id, partial);

@@ -43,8 +43,19 @@ struct DatasetImportOptions {
   // "spatial": the position of each station's camera in one world frame, by station name (e.g. from
   // lidar_registrator's lidar_poses.txt). Stations without one get no pose prior and so no pair.
   std::map<std::string, Eigen::Vector3d> station_positions;
+  // The database name of each station's image, "{station}" standing for the station's name: e.g.
+  // "{station}.png" or "cam0/{station}.jpg" for a database made by the user's own `colmap
+  // feature_extractor`, whose images (keypoints, matches) are then reused, never added twice. The
+  // file name must be "{station}" plus an extension (the other steps find a station's image by the
+  // stem of its name). Empty: this tool's layout, "left/{station}.png".
+  std::string image_name_format;
+  // Where images named by image_name_format that are not yet in the database are read; empty:
+  // DATASET/images.
+  std::string image_path;
 
   bool Check() const;
+  // The database name of station `station`'s image.
+  std::string ImageName(const StationDataset& dataset, size_t station) const;
 };
 
 struct DatasetImportSummary {

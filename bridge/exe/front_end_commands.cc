@@ -30,6 +30,13 @@ void AddImportStepOptions(const std::string& prefix,
   add.Add("lidar_registration_path",
           &options->lidar_registration_path,
           "lidar_registrator's output folder, for --matcher spatial");
+  add.Add("image_name_format",
+          &options->import.image_name_format,
+          "database name of each station's image, e.g. {station}.png for a database made by "
+          "colmap feature_extractor (its images are reused); empty: left/{station}.png");
+  add.Add("image_path",
+          &options->import.image_path,
+          "folder of the images named by --image_name_format; empty: DATASET/images");
 }
 
 bool ImportStepOptions::Check() const {

@@ -2,6 +2,7 @@
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "bridge/lidar_registration_files.h"
+#include "bridge/model_completion.h"
 #include "bridge/pose_initializer.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
@@ -38,7 +39,7 @@ namespace {
 void WriteInitializationReport(const std::string& path,
                                const PoseInitialization& init,
                                const std::string& input_path,
-                               double scale) {
+                               const std::vector<double>& scales) {
   nlohmann::json report;
   report["extrinsic_source"] = init.extrinsic_source;
   report["hand_eye"] = {{"unique", init.hand_eye.unique},
@@ -50,7 +51,9 @@ void WriteInitializationReport(const std::string& path,
   report["stations"] = init.cam_from_world.size();
   report["unreachable"] = init.unreachable;
   report["input_model"] = input_path;
-  report["scale_to_metres"] = scale;
+  report["scale_to_metres"] = scales.front();
+  if (!input_path.empty()) report["model_scales_to_metres"] = scales;
+  report["unreachable_reasons"] = init.unreachable_reason;
   if (init.hand_eye.unobservable_axis_in_cam.squaredNorm() > 0) {
     const Eigen::Vector3d& axis = init.hand_eye.unobservable_axis_in_cam;
     report["hand_eye"]["unobservable_translation_axis_in_cam"] = {axis.x(), axis.y(), axis.z()};
@@ -67,11 +70,11 @@ void RunPoseInitializerStep(const StationDataset& dataset,
   const auto start = std::chrono::steady_clock::now();
   PartialOutputFolder partial(paths.output_path);
   PoseInitialization init;
-  double scale = 1;
+  std::vector<double> scales{1.0};
   if (paths.input_path.empty() && !dataset.rig.IsStereo()) {
     std::cout << "Monocular dataset: stations placed through their LiDAR poses" << std::endl;
     init = InitializeMonocular(paths.database_path, dataset, paths.registration_path, options);
-    scale = init.hand_eye.scale;
+    scales = {init.hand_eye.scale};
     TriangulateInitialModel(
         paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
   } else if (paths.input_path.empty()) {
@@ -82,27 +85,32 @@ void RunPoseInitializerStep(const StationDataset& dataset,
     TriangulateInitialModel(
         paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
   } else {
-    THROW_CHECK(fs::is_directory(paths.input_path))
-        << "no sparse model folder " << paths.input_path;
-    colmap::Reconstruction model;
-    model.Read(paths.input_path);
-    init = InitializeFromModel(
-        paths.database_path, dataset, paths.registration_path, options, &model, &scale);
-    std::cout << "Rescaled " << paths.input_path << " to metres by " << scale
-              << " (median of depth prior / model depth); " << model.NumRegImages()
-              << " registered images" << std::endl;
-    model.WriteBinary(partial.Path());
+    std::vector<colmap::Reconstruction> models = ReadModels(paths.input_path);
+    init = InitializeFromModels(
+        paths.database_path, dataset, paths.registration_path, options, &models, &scales);
+    for (size_t k = 0; k < models.size(); ++k) {
+      std::cout << "Model " << k << " (" << models[k].NumRegImages()
+                << " registered images) rescaled to metres by " << scales[k] << std::endl;
+    }
+    std::cout << "Completed through the LiDAR: " << init.cam_from_world.size() << " stations from "
+              << init.num_image_edges << " model edges and " << init.num_lidar_edges
+              << " LiDAR edges (A_l)" << std::endl;
+    TriangulateInitialModel(
+        paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
   }
   std::cout << "cam_from_lidar: " << init.extrinsic_source
             << "; hand-eye: " << init.hand_eye.message << std::endl;
   for (const std::string& name : init.unreachable) {
-    std::cout << "WARNING: station image " << name
-              << " is not in the model (no image or LiDAR edge reaches it)" << std::endl;
+    const auto reason = init.unreachable_reason.find(name);
+    std::cout << "WARNING: station image " << name << " is not in the model ("
+              << (reason == init.unreachable_reason.end() ? "no image or LiDAR edge reaches it"
+                                                          : reason->second)
+              << ")" << std::endl;
   }
   WritePoseFile(partial.File("cam_from_lidar.txt"),
                 "initial cam_from_lidar (" + init.extrinsic_source + "); qw qx qy qz tx ty tz",
                 init.cam_from_lidar);
-  WriteInitializationReport(partial.File("initialization.json"), init, paths.input_path, scale);
+  WriteInitializationReport(partial.File("initialization.json"), init, paths.input_path, scales);
   partial.Commit();
   std::cout << "Wrote the initial model to " << paths.output_path << " (" << std::fixed
             << std::setprecision(1) << SecondsSince(start) << " s)" << std::endl;
@@ -121,8 +129,9 @@ int RunPoseInitializer(int argc, char** argv) {
   options.AddRequiredOption("output_path", &paths.output_path);
   options.AddDefaultOption("input_path",
                            &paths.input_path,
-                           "an existing COLMAP model of the same database (e.g. colmap mapper's): "
-                           "rescaled to metres instead of initialising poses");
+                           "existing COLMAP model(s) of the same database: a model folder (.bin "
+                           "or .txt) or colmap mapper's parent folder (sparse/0, sparse/1, ...); "
+                           "rescaled to metres, joined and completed through the LiDAR edges");
   AddPoseInitializerOptions("", &options, &initializer);
   options.Parse(argc, argv);
   THROW_CHECK(initializer.Check());  // before any file is read
