@@ -561,10 +561,11 @@ void Reassociate(int round, int num_rounds, RunState* state, Associations* assoc
   }
   state->num_lidar_outliers = 0;
   state->num_landmark_outliers = 0;
-  std::cout << "Round " << round + 1 << "/" << num_rounds << ": " << associations->lidar.size()
-            << " LiDAR point-to-plane observations, " << associations->landmarks.size()
-            << " landmark-to-LiDAR-plane observations (gate " << gate << " m, "
-            << SecondsSince(start) << " s)" << std::endl;
+  std::cout << "Round " << round + 1 << "/"
+            << (round < num_rounds ? std::to_string(num_rounds) : "+ (T_e still moving)") << ": "
+            << associations->lidar.size() << " LiDAR point-to-plane observations, "
+            << associations->landmarks.size() << " landmark-to-LiDAR-plane observations (gate "
+            << gate << " m, " << SecondsSince(start) << " s)" << std::endl;
 }
 
 void PrintSolve(const SolveStats& stats, size_t changes) {
@@ -738,14 +739,27 @@ struct HeldDirections {
   std::vector<std::string> names;
 };
 
+// How far a round moved T_e: rotation (deg), translation (mm).
+std::array<double, 2> ExtrinsicChange(const colmap::Rigid3d& before, const colmap::Rigid3d& after) {
+  return {before.rotation.angularDistance(after.rotation) * 180 / M_PI,
+          1000 * (before.translation - after.translation).norm()};
+}
+
+// Whether the last round still moved T_e (so that another round at the final gate is due).
+bool RoundMovedExtrinsic(const JointAdjusterOptions& options,
+                         const JointAdjustmentSummary& summary) {
+  if (summary.extrinsic_change_per_round.empty()) return false;
+  const std::array<double, 2>& last = summary.extrinsic_change_per_round.back();
+  return last[0] > options.round_convergence_deg || last[1] > options.round_convergence_mm;
+}
+
 HeldDirections UnobservableDirections(const ExtrinsicUncertainty& uncertainty,
-                                      const ObservabilityOptions& options) {
+                                      const JointAdjusterOptions& options) {
   HeldDirections held;
   for (int block = 0; block < 2; ++block) {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(
         uncertainty.covariance.block<3, 3>(3 * block, 3 * block));
-    const double threshold =
-        block == 0 ? options.unobservable_rotation_deg : options.unobservable_translation_mm;
+    const double threshold = block == 0 ? options.hold_rotation_deg : options.hold_translation_mm;
     for (int k = 0; k < 3; ++k) {
       const double sigma = std::sqrt(std::max(0.0, solver.eigenvalues()[k]));
       if (!(sigma > threshold)) continue;
@@ -803,6 +817,11 @@ bool JointAdjusterOptions::Check() const {
   CHECK_OPTION_GE(initial_association_distance_m, association.max_distance);
   CHECK_OPTION_GT(max_num_iterations, 0);
   CHECK_OPTION_GE(extrinsic_prior_sigma_m, 0);
+  CHECK_OPTION_GT(hold_rotation_deg, 0);
+  CHECK_OPTION_GE(max_association_rounds, num_association_rounds);
+  CHECK_OPTION_GT(round_convergence_deg, 0);
+  CHECK_OPTION_GT(round_convergence_mm, 0);
+  CHECK_OPTION_GT(hold_translation_mm, 0);
   CHECK_OPTION(association.Check());
   CHECK_OPTION(observability.Check());
   return true;
@@ -828,9 +847,17 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
   JointAdjustmentSummary summary;
   Associations associations;
   const int num_rounds = state.UsesExtrinsic() ? options_.num_association_rounds : 1;
-  for (int round = 0; round < num_rounds; ++round) {
+  for (int round = 0; round < num_rounds || RoundMovedExtrinsic(options_, summary); ++round) {
+    if (round >= options_.max_association_rounds) break;
+    const colmap::Rigid3d before = *cam_from_lidar;
     if (state.UsesExtrinsic()) Reassociate(round, num_rounds, &state, &associations);
     SolveWithOutliers(round, &state, &associations, &summary);
+    summary.extrinsic_change_per_round.push_back(ExtrinsicChange(before, *cam_from_lidar));
+    if (state.UsesExtrinsic()) {
+      std::cout << "  round " << round + 1 << " moved cam_from_lidar by "
+                << summary.extrinsic_change_per_round.back()[0] << " deg, "
+                << summary.extrinsic_change_per_round.back()[1] << " mm" << std::endl;
+    }
   }
 
   // The uncertainty and the perturbation curves are evaluated on a problem rebuilt from the final
@@ -866,7 +893,7 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
   JointAdjustmentSummary summary = RunOnce(
       data, reconstruction, cam_from_lidar, Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero());
   if (!may_hold || !summary.uncertainty.computed) return summary;
-  const HeldDirections held = UnobservableDirections(summary.uncertainty, options_.observability);
+  const HeldDirections held = UnobservableDirections(summary.uncertainty, options_);
   if (held.names.empty()) return summary;
   std::cout << "cam_from_lidar: " << held.names.size()
             << " direction(s) unobservable; solving again from the start with them held at their "

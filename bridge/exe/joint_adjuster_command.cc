@@ -269,6 +269,11 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("normal_space_sampling", &adjuster.association.normal_space_sampling);
   add.Add("association_max_distance_m", &adjuster.association.max_distance);
   add.Add("initial_association_distance_m", &adjuster.initial_association_distance_m);
+  add.Add("max_association_rounds",
+          &adjuster.max_association_rounds,
+          "further rounds while cam_from_lidar still moves, up to this many in all");
+  add.Add("round_convergence_deg", &adjuster.round_convergence_deg);
+  add.Add("round_convergence_mm", &adjuster.round_convergence_mm);
   add.Add("hold_rotation", &adjuster.hold_rotation);
   add.Add(
       "hold_translation", &options->hold_translation, "comma-separated camera axes, e.g. y or x,z");
@@ -277,6 +282,9 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("hold_unobservable",
           &adjuster.hold_unobservable,
           "solve again with unobservable directions of cam_from_lidar held at their initial value");
+  add.Add(
+      "hold_rotation_deg", &adjuster.hold_rotation_deg, "sigma above which a direction is held");
+  add.Add("hold_translation_mm", &adjuster.hold_translation_mm);
   add.Add("min_image_pair_inliers", &options->data.min_image_pair_inliers);
   add.Add("max_lidar_neighbors", &options->data.max_lidar_neighbors);
   add.Add("stereo_scale_sigma", &adjuster.observability.stereo_scale_sigma);
