@@ -16,6 +16,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -49,11 +50,62 @@ StationImages ReadStationImages(const std::string& database_path, const StationD
   return images;
 }
 
+// COLMAP's two-view rotations and translation directions paired with the LiDAR motions of the same
+// station pairs (a monocular rig's hand-eye input).
+std::vector<HandEyeMotion> PairDirectionMotions(const std::string& database_path,
+                                                const std::string& registration_path) {
+  const colmap::Database database(database_path);
+  std::map<std::string, colmap::image_t> image_of_station;
+  for (const colmap::Image& image : database.ReadAllImages()) {
+    image_of_station[fs::path(image.Name()).stem().string()] = image.ImageId();
+  }
+  std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d> directions;
+  for (const ImagePairPose& pair : EstimateImagePairDirections(database, 15)) {
+    directions[{pair.image_i, pair.image_j}] = pair.cam_i_from_cam_j;
+    directions[{pair.image_j, pair.image_i}] = colmap::Inverse(pair.cam_i_from_cam_j);
+  }
+  std::vector<HandEyeMotion> motions;
+  for (const LidarPairRecord& pair :
+       ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
+    if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) continue;
+    const auto direction =
+        directions.find({image_of_station.at(pair.target), image_of_station.at(pair.source)});
+    if (direction != directions.end()) {
+      motions.push_back({direction->second, pair.target_from_source});
+    }
+  }
+  return motions;
+}
+
+// A driving platform (every rotation about one axis, turns of a few degrees): the planar variant of
+// the similarity hand-eye on the metric stereo motions, the translation along the axis set to 0 and
+// named. False if it cannot recover the rotation either.
+bool PlanarHandEye(const std::vector<HandEyeMotion>& motions,
+                   const PoseInitializerOptions& options,
+                   PoseInitialization* init) {
+  if (motions.empty()) return false;
+  // One scale per motion, as for a monocular rig: with a common scale the forward translation is
+  // fitted from turns of 1-3 deg and came out 2.2 m off on the simulated drive; all of t_X is then 0
+  // (within decimetres of a car's rig), and the joint adjustment finds it.
+  const HandEyeResult planar = SolveSimilarityHandEye(
+      motions, options.similarity_hand_eye, Eigen::Vector3d::Zero(), /*per_motion_scale=*/true);
+  if (!planar.rotation_unique) return false;
+  const std::string general = init->hand_eye.message;
+  init->hand_eye = planar;
+  init->hand_eye.message = "general hand-eye: " + general + "; " + planar.message;
+  init->cam_from_lidar = planar.cam_from_lidar;
+  init->extrinsic_source = "planar hand-eye (rotation; translation set to 0)";
+  return true;
+}
+
 // cam_from_lidar: rig.json's guess if allowed and present, else hand-eye, else the guess anyway (with
 // the hand-eye failure recorded), else an error saying why.
+// `planar_motions`: the motions for the planar fallback (COLMAP's two-view geometry), computed only
+// when needed.
 void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
                      const StationDataset& dataset,
                      const PoseInitializerOptions& options,
+                     const std::function<std::vector<HandEyeMotion>()>& planar_motions,
                      PoseInitialization* init) {
   init->hand_eye = SolveHandEye(motions, options.hand_eye);
   if (options.use_guess && dataset.rig.cam_from_lidar_guess) {
@@ -62,6 +114,8 @@ void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
   } else if (init->hand_eye.unique) {
     init->cam_from_lidar = init->hand_eye.cam_from_lidar;
     init->extrinsic_source = "hand-eye";
+  } else if (!dataset.rig.cam_from_lidar_guess && PlanarHandEye(planar_motions(), options, init)) {
+    return;
   } else if (dataset.rig.cam_from_lidar_guess) {
     init->cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
     init->extrinsic_source = "rig.json guess (hand-eye: " + init->hand_eye.message + ")";
@@ -175,7 +229,15 @@ PoseInitialization InitializePoses(const std::string& database_path,
       motions.push_back({colmap::Inverse(image_edge.at({j, i})), lidar_i_from_lidar_j});
     }
   }
-  ChooseExtrinsic(motions, dataset, options, &init);
+  ChooseExtrinsic(
+      motions,
+      dataset,
+      options,
+      [&] {
+        return registration_path.empty() ? std::vector<HandEyeMotion>()
+                                         : PairDirectionMotions(database_path, registration_path);
+      },
+      &init);
   for (const auto& [i, j, lidar_i_from_lidar_j, weight] : lidar_edges) {
     init.edges.push_back(
         {i,
@@ -332,34 +394,10 @@ void ChooseModelScalesAndExtrinsic(const std::string& database_path,
     const std::vector<HandEyeMotion> metric = motions_of(model);
     motions.insert(motions.end(), metric.begin(), metric.end());
   }
-  if (dataset.rig.IsStereo()) ChooseExtrinsic(motions, dataset, options, init);
-}
-
-// COLMAP's two-view rotations and translation directions paired with the LiDAR motions of the same
-// station pairs (a monocular rig's hand-eye input).
-std::vector<HandEyeMotion> PairDirectionMotions(const std::string& database_path,
-                                                const std::string& registration_path) {
-  const colmap::Database database(database_path);
-  std::map<std::string, colmap::image_t> image_of_station;
-  for (const colmap::Image& image : database.ReadAllImages()) {
-    image_of_station[fs::path(image.Name()).stem().string()] = image.ImageId();
+  if (dataset.rig.IsStereo()) {
+    ChooseExtrinsic(
+        motions, dataset, options, [&] { return motions; }, init);
   }
-  std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d> directions;
-  for (const ImagePairPose& pair : EstimateImagePairDirections(database, 15)) {
-    directions[{pair.image_i, pair.image_j}] = pair.cam_i_from_cam_j;
-    directions[{pair.image_j, pair.image_i}] = colmap::Inverse(pair.cam_i_from_cam_j);
-  }
-  std::vector<HandEyeMotion> motions;
-  for (const LidarPairRecord& pair :
-       ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
-    if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) continue;
-    const auto direction =
-        directions.find({image_of_station.at(pair.target), image_of_station.at(pair.source)});
-    if (direction != directions.end()) {
-      motions.push_back({direction->second, pair.target_from_source});
-    }
-  }
-  return motions;
 }
 
 }  // namespace

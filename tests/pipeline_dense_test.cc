@@ -50,6 +50,24 @@ class PipelineDenseTest : public ::testing::Test {
            fixture_.File(output) + " " + extra;
   }
 
+  // pose_initializer from `input_model` (a model folder or colmap mapper's parent folder), the joint
+  // adjuster and evaluate_calibration into ws/NAME/{initial, joint, evaluation}; returns
+  // initialization.json and the evaluation's metrics.json.
+  std::pair<nlohmann::json, nlohmann::json> FromModels(const std::string& input_model,
+                                                       const std::string& name) const {
+    const testing::PipelineFixture& f = fixture_;
+    const std::string out = f.File(name);
+    Run(kCli + " pose_initializer --database_path " + f.File("database.db") + " --dataset_path " +
+        f.dataset + " --registration_path " + f.File("lidar") + " --input_path " + input_model +
+        " --output_path " + out + "/initial");
+    Run(kCli + " joint_adjuster --database_path " + f.File("database.db") + " --input_path " + out +
+        "/initial --dataset_path " + f.dataset + " --output_path " + out + "/joint");
+    Run(kCli + " evaluate_calibration --dataset_path " + f.dataset + " --input_path " + out +
+        "/joint --output_path " + out + "/evaluation");
+    return {ReadJson(out + "/initial/initialization.json"),
+            ReadJson(out + "/evaluation/metrics.json")};
+  }
+
   const testing::PipelineFixture fixture_;
 };
 
@@ -211,7 +229,8 @@ TEST_F(PipelineDenseTest, DistortedCameraGivesTheSameModelAndAMissingDepthMapIsR
 }
 
 // The existing COLMAP workflow on the same database: `colmap mapper`'s model (arbitrary scale and
-// frame) rescaled to metres by the depth priors, cam_from_lidar by hand-eye, then the joint adjuster.
+// frame, part of the stations) rescaled to metres by the depth priors, cam_from_lidar by hand-eye, the
+// other stations placed through the LiDAR edges, then the joint adjuster on all of them.
 TEST_F(PipelineDenseTest, ColmapMapperModelIsRescaledAndCalibrated) {
   const testing::PipelineFixture& f = fixture_;
   fs::remove_all(f.File("mapper"));
@@ -219,18 +238,10 @@ TEST_F(PipelineDenseTest, ColmapMapperModelIsRescaledAndCalibrated) {
   Run(kColmap + " mapper --database_path " + f.File("database.db") + " --image_path " + f.dataset +
       "/images --output_path " + f.File("mapper") + " --Mapper.ba_refine_focal_length 0" +
       " --Mapper.ba_refine_extra_params 0 --Mapper.num_threads 2");
-  Run(kCli + " pose_initializer --database_path " + f.File("database.db") + " --dataset_path " +
-      f.dataset + " --registration_path " + f.File("lidar") + " --input_path " +
-      f.File("mapper/0") + " --output_path " + f.File("mapper_initial"));
-  Run(kCli + " joint_adjuster --database_path " + f.File("database.db") + " --input_path " +
-      f.File("mapper_initial") + " --dataset_path " + f.dataset + " --output_path " +
-      f.File("mapper_joint"));
-  Run(kCli + " evaluate_calibration --dataset_path " + f.dataset + " --input_path " +
-      f.File("mapper_joint") + " --output_path " + f.File("mapper_evaluation"));
-  const nlohmann::json mapper_init = ReadJson(f.File("mapper_initial/initialization.json"));
+  fs::remove_all(f.File("from_mapper"));
+  const auto [mapper_init, from_mapper] = FromModels(f.File("mapper/0"), "from_mapper");
   EXPECT_EQ(mapper_init["extrinsic_source"], "hand-eye");
   EXPECT_NE(mapper_init["scale_to_metres"].get<double>(), 1.0);
-  const nlohmann::json from_mapper = ReadJson(f.File("mapper_evaluation/metrics.json"));
   std::cout << "from colmap mapper's model (scale " << mapper_init["scale_to_metres"]
             << "): cam_from_lidar error " << from_mapper["cam_from_lidar_rotation_error_deg"]
             << " deg, " << from_mapper["cam_from_lidar_translation_error_mm"] << " mm; poses mean "
@@ -282,20 +293,11 @@ TEST_F(PipelineDenseTest, SeveralPartialModelsAreJoinedThroughTheLidar) {
   Run(kColmap + " model_converter --input_path " + f.File("split/binary1") + " --output_path " +
       f.File("split/sparse/1") + " --output_type TXT");
   ASSERT_TRUE(fs::is_regular_file(f.File("split/sparse/1/images.txt")));
-  Run(kCli + " pose_initializer --database_path " + f.File("database.db") + " --dataset_path " +
-      f.dataset + " --registration_path " + f.File("lidar") + " --input_path " +
-      f.File("split/sparse") + " --output_path " + f.File("split/initial"));
-  Run(kCli + " joint_adjuster --database_path " + f.File("database.db") + " --input_path " +
-      f.File("split/initial") + " --dataset_path " + f.dataset + " --output_path " +
-      f.File("split/joint"));
-  Run(kCli + " evaluate_calibration --dataset_path " + f.dataset + " --input_path " +
-      f.File("split/joint") + " --output_path " + f.File("split/evaluation"));
-  const nlohmann::json init = ReadJson(f.File("split/initial/initialization.json"));
+  const auto [init, joined] = FromModels(f.File("split/sparse"), "split/result");
   ASSERT_EQ(init["model_scales_to_metres"].size(), 2u);
   EXPECT_NEAR(init["model_scales_to_metres"][0].get<double>(), 1 / 0.37, 0.01 / 0.37);
   EXPECT_NEAR(init["model_scales_to_metres"][1].get<double>(), 1 / 2.4, 0.01 / 2.4);
   EXPECT_EQ(init["stations"].get<int>(), 8);
-  const nlohmann::json joined = ReadJson(f.File("split/evaluation/metrics.json"));
   std::cout << "two partial models joined: cam_from_lidar "
             << joined["cam_from_lidar_rotation_error_deg"] << " deg, "
             << joined["cam_from_lidar_translation_error_mm"] << " mm; poses mean "

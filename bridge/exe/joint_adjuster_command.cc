@@ -259,7 +259,8 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("max_point_to_plane_m", &adjuster.max_point_to_plane_m);
   add.Add("landmark_lidar_weight",
           &options->landmark_lidar_weight,
-          "w_m of the landmark-to-LiDAR-plane term; -1: 1 for a monocular rig, 0 for stereo");
+          "w_m of the landmark-to-LiDAR-plane term; -1: 1 for a monocular rig or motion about "
+          "one axis (initialization.json), else 0");
   add.Add("sigma_landmark_lidar_m", &adjuster.sigma_landmark_lidar_m);
   add.Add("max_landmark_plane_m", &adjuster.max_landmark_plane_m);
   add.Add("max_landmark_plane_sigmas", &adjuster.max_landmark_plane_sigmas);
@@ -294,6 +295,28 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("write_text", &options->write_text, "also write cameras.txt, images.txt, points3D.txt");
 }
 
+namespace {
+
+// --landmark_lidar_weight -1: E_m on (1) for a monocular rig, and for a stereo rig whose initialisation
+// found every rotation about one axis (initialization.json names the axis: a driving platform, whose
+// height above the road only the landmarks on it observe); off (0, the paper's cost) otherwise.
+double AutoLandmarkLidarWeight(const StationDataset& dataset, const std::string& input_path) {
+  if (!dataset.rig.IsStereo()) return 1.0;
+  const fs::path report = fs::path(input_path) / "initialization.json";
+  if (!fs::is_regular_file(report)) return 0.0;
+  std::ifstream file(report);
+  const nlohmann::json init = nlohmann::json::parse(file, nullptr, /*allow_exceptions=*/false);
+  if (init.is_discarded() || !init.contains("hand_eye") ||
+      !init["hand_eye"].contains("unobservable_translation_axis_in_cam")) {
+    return 0.0;
+  }
+  std::cout << "The initial motion rotates about one axis only (" << report.string()
+            << "): the landmark-to-LiDAR-plane term is on (--landmark_lidar_weight 1)" << std::endl;
+  return 1.0;
+}
+
+}  // namespace
+
 void RunJointAdjusterStep(const StationDataset& dataset,
                           const JointAdjusterPaths& paths,
                           JointAdjusterStepOptions options) {
@@ -303,7 +326,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                                 "/rig.json has one camera");
   }
   if (options.landmark_lidar_weight < 0) {
-    options.adjuster.landmark_lidar_weight = dataset.rig.IsStereo() ? 0.0 : 1.0;
+    options.adjuster.landmark_lidar_weight = AutoLandmarkLidarWeight(dataset, paths.input_path);
   }
   const auto start = std::chrono::steady_clock::now();
   THROW_CHECK(fs::is_directory(paths.input_path)) << "no sparse model folder " << paths.input_path;
