@@ -100,6 +100,7 @@ TEST(JointAdjusterExactTest, CappedOutlierLoopEvaluatesTheUncertaintyOnTheFinalS
   JointAdjusterOptions options;
   options.max_outlier_iterations = 1;
   options.num_association_rounds = 1;
+  options.max_association_rounds = 1;
   // One capped solve leaves directions of T_e above the unobservable thresholds; the second, held
   // pass is not what this test is about.
   options.hold_unobservable = false;

@@ -236,6 +236,10 @@ bool JointAdjusterStepOptions::Check() {
   adjuster.association.num_samples = static_cast<size_t>(num_samples_per_pair);
   CHECK_OPTION(landmark_lidar_weight == -1 || landmark_lidar_weight >= 0);
   if (landmark_lidar_weight >= 0) adjuster.landmark_lidar_weight = landmark_lidar_weight;
+  CHECK_OPTION(hold_rotation_deg == -1 || hold_rotation_deg > 0);
+  CHECK_OPTION(hold_translation_mm == -1 || hold_translation_mm > 0);
+  if (hold_rotation_deg > 0) adjuster.hold_rotation_deg = hold_rotation_deg;
+  if (hold_translation_mm > 0) adjuster.hold_translation_mm = hold_translation_mm;
   return adjuster.Check() && data.Check();
 }
 
@@ -297,22 +301,48 @@ void AddJointAdjusterOptions(const std::string& prefix,
 
 namespace {
 
-// --landmark_lidar_weight -1: E_m on (1) for a monocular rig, and for a stereo rig whose initialisation
-// found every rotation about one axis (initialization.json names the axis: a driving platform, whose
-// height above the road only the landmarks on it observe); off (0, the paper's cost) otherwise.
-double AutoLandmarkLidarWeight(const StationDataset& dataset, const std::string& input_path) {
-  if (!dataset.rig.IsStereo()) return 1.0;
-  const fs::path report = fs::path(input_path) / "initialization.json";
-  if (!fs::is_regular_file(report)) return 0.0;
-  std::ifstream file(report);
+// What pose_initializer wrote about its start (INPUT/initialization.json), if anything.
+struct InitialisationFacts {
+  bool one_axis = false;    // every rotation about one axis (a driving platform)
+  bool from_guess = false;  // cam_from_lidar from rig.json's guess
+};
+
+InitialisationFacts ReadInitialisationFacts(const std::string& input_path) {
+  InitialisationFacts facts;
+  std::ifstream file(fs::path(input_path) / "initialization.json");
+  if (!file) return facts;
   const nlohmann::json init = nlohmann::json::parse(file, nullptr, /*allow_exceptions=*/false);
-  if (init.is_discarded() || !init.contains("hand_eye") ||
-      !init["hand_eye"].contains("unobservable_translation_axis_in_cam")) {
-    return 0.0;
+  if (init.is_discarded()) return facts;
+  facts.one_axis = init.contains("hand_eye") &&
+                   init["hand_eye"].contains("unobservable_translation_axis_in_cam");
+  facts.from_guess = init.value("extrinsic_source", "").rfind("rig.json guess", 0) == 0;
+  return facts;
+}
+
+// The -1 (automatic) options. E_m: on for a monocular rig, and for a stereo rig whose initialisation
+// found every rotation about one axis (the height above the road only the landmarks on it observe);
+// off (the paper's cost) otherwise. Holding: a guess is information, so what the data know worse than
+// the reporting thresholds stays at the guess; a hand-eye start (0 along an axis) is held only above
+// the adjuster's own thresholds.
+void ResolveAutomaticOptions(const StationDataset& dataset,
+                             const std::string& input_path,
+                             JointAdjusterStepOptions* options) {
+  const InitialisationFacts facts = ReadInitialisationFacts(input_path);
+  if (options->landmark_lidar_weight < 0) {
+    options->adjuster.landmark_lidar_weight = !dataset.rig.IsStereo() || facts.one_axis ? 1.0 : 0.0;
+    if (dataset.rig.IsStereo() && facts.one_axis) {
+      std::cout << "The initial motion rotates about one axis only (initialization.json): the "
+                   "landmark-to-LiDAR-plane term is on (--landmark_lidar_weight 1)"
+                << std::endl;
+    }
   }
-  std::cout << "The initial motion rotates about one axis only (" << report.string()
-            << "): the landmark-to-LiDAR-plane term is on (--landmark_lidar_weight 1)" << std::endl;
-  return 1.0;
+  if (facts.from_guess && options->hold_rotation_deg < 0) {
+    options->adjuster.hold_rotation_deg = options->adjuster.observability.unobservable_rotation_deg;
+  }
+  if (facts.from_guess && options->hold_translation_mm < 0) {
+    options->adjuster.hold_translation_mm =
+        options->adjuster.observability.unobservable_translation_mm;
+  }
 }
 
 }  // namespace
@@ -325,9 +355,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
     throw std::invalid_argument("--mode stereo_only needs a stereo rig; " + dataset.root +
                                 "/rig.json has one camera");
   }
-  if (options.landmark_lidar_weight < 0) {
-    options.adjuster.landmark_lidar_weight = AutoLandmarkLidarWeight(dataset, paths.input_path);
-  }
+  ResolveAutomaticOptions(dataset, paths.input_path, &options);
   const auto start = std::chrono::steady_clock::now();
   THROW_CHECK(fs::is_directory(paths.input_path)) << "no sparse model folder " << paths.input_path;
   colmap::Reconstruction reconstruction;

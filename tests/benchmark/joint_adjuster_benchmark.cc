@@ -97,6 +97,7 @@ Timing JointSolve(colmap::Reconstruction reconstruction,
                   int iterations) {
   JointAdjusterOptions options;
   options.num_association_rounds = 1;
+  options.max_association_rounds = 1;
   options.max_outlier_iterations = 1;
   options.max_num_iterations = iterations;
   options.initial_association_distance_m = options.association.max_distance;
