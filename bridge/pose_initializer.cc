@@ -78,8 +78,9 @@ std::vector<HandEyeMotion> PairDirectionMotions(const std::string& database_path
 }
 
 // A driving platform (every rotation about one axis, turns of a few degrees): the planar variant of
-// the similarity hand-eye on the metric stereo motions, the translation along the axis set to 0 and
-// named. False if it cannot recover the rotation either.
+// the similarity hand-eye on `motions` (COLMAP's two-view geometry), the rotation from the yaw axis
+// and the driving direction, the translation 0 and the axis named. False if it cannot recover the
+// rotation either.
 bool PlanarHandEye(const std::vector<HandEyeMotion>& motions,
                    const PoseInitializerOptions& options,
                    PoseInitialization* init) {
@@ -98,8 +99,8 @@ bool PlanarHandEye(const std::vector<HandEyeMotion>& motions,
   return true;
 }
 
-// cam_from_lidar: rig.json's guess if allowed and present, else hand-eye, else the guess anyway (with
-// the hand-eye failure recorded), else an error saying why.
+// cam_from_lidar: rig.json's guess if allowed and present, else hand-eye, else (no guess) the planar
+// hand-eye, else the guess anyway (with the hand-eye failure recorded), else an error saying why.
 // `planar_motions`: the motions for the planar fallback (COLMAP's two-view geometry), computed only
 // when needed.
 void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,

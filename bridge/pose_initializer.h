@@ -2,7 +2,9 @@
 // 1. image edges A_c: metric relative poses from matches with depth priors (bridge/image_pair_poses.h);
 // 2. LiDAR edges A_l: lidar_registrator's pairs.txt;
 // 3. cam_from_lidar: rig.json's guess if present, else hand-eye over the pairs with both an image and a
-//    LiDAR edge (bridge/hand_eye.h); degenerate motion without a guess is an error saying why;
+//    LiDAR edge (bridge/hand_eye.h); rotation about one axis only (a car) without a guess: the planar
+//    hand-eye on COLMAP's two-view geometry (rotation; translation 0, the axis named); other degenerate
+//    motion without a guess is an error saying why;
 // 4. LiDAR edges become camera edges through cam_from_lidar; a maximum-weight spanning tree from the
 //    first station gives initial poses; a pose graph over all edges (Ceres) refines them. Stations that
 //    no edge reaches are reported and left out.
