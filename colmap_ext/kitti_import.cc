@@ -118,6 +118,7 @@ KittiImportSummary ImportKittiDrive(const KittiImportOptions& options) {
   StationRig rig;
   rig.left = left.camera;
   rig.lidar_model = "HDL-64";
+  rig.lidar_sweep = StationRig::LidarSweep();  // one revolution per frame, from behind, ccw
   if (stereo) {
     const KittiCamera right = ReadKittiCamera(options.calib_path, options.camera + 1);
     rig.right = right.camera;

@@ -91,6 +91,25 @@ colmap::Rigid3d ParseRigid(const json& value, const std::string& path, const std
   return colmap::Rigid3d(rotation.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
 }
 
+StationRig::LidarSweep ParseSweep(const json& value, const std::string& path) {
+  StationRig::LidarSweep sweep;
+  if (!value.is_object()) Fail(path, "'lidar.sweep' must be an object");
+  if (value.contains("start_azimuth_deg")) {
+    const json& azimuth = value["start_azimuth_deg"];
+    if (!azimuth.is_number() || !std::isfinite(azimuth.get<double>())) {
+      Fail(path, "'lidar.sweep.start_azimuth_deg' must be a finite number");
+    }
+    sweep.start_azimuth_deg = azimuth.get<double>();
+  }
+  if (value.contains("counter_clockwise")) {
+    if (!value["counter_clockwise"].is_boolean()) {
+      Fail(path, "'lidar.sweep.counter_clockwise' must be true or false");
+    }
+    sweep.counter_clockwise = value["counter_clockwise"].get<bool>();
+  }
+  return sweep;
+}
+
 json CameraToJson(const colmap::Camera& camera) {
   return {{"model", camera.ModelName()},
           {"width", camera.width},
@@ -162,6 +181,7 @@ StationRig ReadRigJson(const std::string& path) {
     if (lidar.contains("range_noise_m")) {
       rig.lidar_range_noise_m = lidar["range_noise_m"].get<double>();
     }
+    if (lidar.contains("sweep")) rig.lidar_sweep = ParseSweep(lidar["sweep"], path);
   }
   return rig;
 }
@@ -183,6 +203,10 @@ void WriteRigJson(const std::string& path, const StationRig& rig) {
   }
   if (!rig.lidar_model.empty()) {
     root["lidar"] = {{"model", rig.lidar_model}, {"range_noise_m", rig.lidar_range_noise_m}};
+  }
+  if (rig.lidar_sweep) {
+    root["lidar"]["sweep"] = {{"start_azimuth_deg", rig.lidar_sweep->start_azimuth_deg},
+                              {"counter_clockwise", rig.lidar_sweep->counter_clockwise}};
   }
   WriteFileAtomically(path, root.dump(2) + "\n");
 }

@@ -32,6 +32,13 @@ struct StationRig {
   std::optional<colmap::Rigid3d> cam_from_lidar_guess;
   std::string lidar_model;         // e.g. "VLP-16"; empty if not given
   double lidar_range_noise_m = 0;  // 0 if not given
+  // "lidar": {"sweep": {"start_azimuth_deg": a, "counter_clockwise": b}}: each cloud is one revolution
+  // of a rotating LiDAR on a moving platform (import_kitti writes it), which the pipeline de-skews.
+  struct LidarSweep {
+    double start_azimuth_deg = 180.0;  // behind the platform (KITTI's HDL-64)
+    bool counter_clockwise = true;
+  };
+  std::optional<LidarSweep> lidar_sweep;
 
   bool IsStereo() const { return right.has_value(); }
   // 0 for a monocular rig.

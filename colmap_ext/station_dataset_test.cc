@@ -75,10 +75,22 @@ TEST_F(StationDatasetTest, RigJsonRoundTrips) {
   const StationRig copy = ReadRigJson(dir_.File("copy.json"));
   EXPECT_EQ(copy.right->params, rig.right->params);
   EXPECT_EQ(copy.lidar_model, "VLP-16");
+  EXPECT_FALSE(copy.lidar_sweep);  // tripod stations: accumulated clouds, not sweeps
   EXPECT_NEAR(
       copy.cam_from_lidar_guess->rotation.angularDistance(rig.cam_from_lidar_guess->rotation),
       0,
       1e-12);
+}
+
+// Sweeps of a moving platform (lidar.sweep) round-trip with their timing.
+TEST_F(StationDatasetTest, LidarSweepRoundTrips) {
+  StationRig rig = ReadRigJson(dir_.File("rig.json"));
+  rig.lidar_sweep = StationRig::LidarSweep{90.0, false};
+  WriteRigJson(dir_.File("copy.json"), rig);
+  const StationRig copy = ReadRigJson(dir_.File("copy.json"));
+  ASSERT_TRUE(copy.lidar_sweep);
+  EXPECT_EQ(copy.lidar_sweep->start_azimuth_deg, 90.0);
+  EXPECT_FALSE(copy.lidar_sweep->counter_clockwise);
 }
 
 TEST_F(StationDatasetTest, BadRigJsonNamesTheFileAndTheKey) {
@@ -111,6 +123,11 @@ TEST_F(StationDatasetTest, BadRigJsonNamesTheFileAndTheKey) {
   rig["right_from_left"]["translation"] = {0, 0, 0};
   WriteRig(rig);
   ExpectError("rig.json", "baseline");
+
+  rig = ValidRig();
+  rig["lidar"]["sweep"] = {{"start_azimuth_deg", "behind"}};
+  WriteRig(rig);
+  ExpectError("rig.json", "'lidar.sweep.start_azimuth_deg' must be a finite number");
 
   std::ofstream(dir_.File("rig.json")) << "{ \"left\": ";
   ExpectError("rig.json", "not valid JSON");

@@ -67,6 +67,11 @@ TEST_F(KittiImportTest, GivesBackTheSimulatorsTruth) {
                 "0000000000", "0000000001", "0000000002", "0000000003", "0000000004"}));
   ASSERT_TRUE(dataset.rig.IsStereo());
   EXPECT_FALSE(dataset.rig.cam_from_lidar_guess);
+  // KITTI's HDL-64 sweeps, one revolution per frame from behind, counter-clockwise: the pipeline
+  // de-skews them without being asked.
+  ASSERT_TRUE(dataset.rig.lidar_sweep);
+  EXPECT_EQ(dataset.rig.lidar_sweep->start_azimuth_deg, 180.0);
+  EXPECT_TRUE(dataset.rig.lidar_sweep->counter_clockwise);
   const StationRig truth_rig = sim::MakeDriveRig(0.5);
   EXPECT_EQ(dataset.rig.left.width, truth_rig.left.width);
   EXPECT_EQ(dataset.rig.left.height, truth_rig.left.height);

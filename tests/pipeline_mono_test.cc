@@ -82,8 +82,8 @@ TEST(PipelineMonoTest, StationsCalibrateWithoutAGuessOrAStereoPair) {
 // (camera z) translation 1.1-5.7 mm, the held translation 47.6-48.2 mm off (the guess: 50 mm);
 // evaluation of the extrinsic only (a drive has no true poses).
 // `num_frames` of the simulated street drive in KITTI raw's layout (one camera), imported by
-// import_kitti (with its seeded guess if `guess`), then the pipeline with sequential matching and
-// de-skewed sweeps into DIR/ws. Returns the pipeline's output.
+// import_kitti (with its seeded guess if `guess`), then the pipeline with sequential matching (the
+// sweeps de-skewed because rig.json says they are sweeps) into DIR/ws. Returns the pipeline's output.
 std::string RunDrive(const testing::ScopedTempDir& dir, int num_frames, bool guess) {
   sim::SimulationOptions drive;
   drive.scene = "street";
@@ -99,10 +99,12 @@ std::string RunDrive(const testing::ScopedTempDir& dir, int num_frames, bool gue
                  dir.File("kitti/calibration") + " --output_path " + dir.File("dataset") +
                  (guess ? " --write_guess 1 --seed 1" : ""));
   EXPECT_EQ(import.exit_code, 0) << import.output;
-  const auto run = RunCommand(kCli + " pipeline --dataset_path " + dir.File("dataset") +
-                              " --workspace_path " + dir.File("ws") +
-                              " --Import.matcher sequential --LidarRegistrator.deskew_sweeps 1");
+  // No --LidarRegistrator.deskew_sweeps: import_kitti marks the clouds as sweeps in rig.json.
+  const auto run =
+      RunCommand(kCli + " pipeline --dataset_path " + dir.File("dataset") + " --workspace_path " +
+                 dir.File("ws") + " --Import.matcher sequential");
   EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("lidar_registrator de-skews them"), std::string::npos);
   const size_t summary = run.output.find("== Pipeline summary");
   if (summary != std::string::npos) std::cout << run.output.substr(summary) << std::endl;
   EXPECT_NE(run.output.find("evaluating cam_from_lidar only"), std::string::npos);

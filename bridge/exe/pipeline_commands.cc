@@ -270,6 +270,18 @@ int RunPipeline(int argc, char** argv) {
     throw std::invalid_argument("--mode stereo_only needs a stereo rig; " + dataset.root +
                                 "/rig.json has one camera");
   }
+  if (dataset.rig.lidar_sweep && !pipeline.registrator.deskew_sweeps) {
+    // rig.json says the clouds are sweeps of a moving platform (import_kitti writes it).
+    pipeline.registrator.deskew_sweeps = true;
+    pipeline.registrator.sweep_timing.start_azimuth_deg =
+        dataset.rig.lidar_sweep->start_azimuth_deg;
+    pipeline.registrator.sweep_timing.counter_clockwise =
+        dataset.rig.lidar_sweep->counter_clockwise;
+    std::cout << dataset.root
+              << "/rig.json: the clouds are sweeps of a moving platform (lidar.sweep): "
+                 "lidar_registrator de-skews them"
+              << std::endl;
+  }
   const fs::path ws(pipeline.workspace_path);
   fs::create_directories(ws / "steps");
   fs::create_directories(ws / "sparse");
