@@ -817,10 +817,10 @@ bool JointAdjusterOptions::Check() const {
   CHECK_OPTION_GE(initial_association_distance_m, association.max_distance);
   CHECK_OPTION_GT(max_num_iterations, 0);
   CHECK_OPTION_GE(extrinsic_prior_sigma_m, 0);
-  CHECK_OPTION_GT(hold_rotation_deg, 0);
   CHECK_OPTION_GE(max_association_rounds, num_association_rounds);
   CHECK_OPTION_GT(round_convergence_deg, 0);
   CHECK_OPTION_GT(round_convergence_mm, 0);
+  CHECK_OPTION_GT(hold_rotation_deg, 0);
   CHECK_OPTION_GT(hold_translation_mm, 0);
   CHECK_OPTION(association.Check());
   CHECK_OPTION(observability.Check());

@@ -53,12 +53,11 @@ StationImages ReadStationImages(const std::string& database_path, const StationD
 // COLMAP's two-view rotations and translation directions paired with the LiDAR motions of the same
 // station pairs (a monocular rig's hand-eye input).
 std::vector<HandEyeMotion> PairDirectionMotions(const std::string& database_path,
+                                                const StationDataset& dataset,
                                                 const std::string& registration_path) {
+  const std::map<std::string, colmap::image_t> image_of_station =
+      ReadStationImages(database_path, dataset).image_of_station;
   const colmap::Database database(database_path);
-  std::map<std::string, colmap::image_t> image_of_station;
-  for (const colmap::Image& image : database.ReadAllImages()) {
-    image_of_station[fs::path(image.Name()).stem().string()] = image.ImageId();
-  }
   std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d> directions;
   for (const ImagePairPose& pair : EstimateImagePairDirections(database, 15)) {
     directions[{pair.image_i, pair.image_j}] = pair.cam_i_from_cam_j;
@@ -235,8 +234,9 @@ PoseInitialization InitializePoses(const std::string& database_path,
       dataset,
       options,
       [&] {
-        return registration_path.empty() ? std::vector<HandEyeMotion>()
-                                         : PairDirectionMotions(database_path, registration_path);
+        return registration_path.empty()
+                   ? std::vector<HandEyeMotion>()
+                   : PairDirectionMotions(database_path, dataset, registration_path);
       },
       &init);
   for (const auto& [i, j, lidar_i_from_lidar_j, weight] : lidar_edges) {
@@ -282,15 +282,16 @@ double DepthPriorScale(const std::string& database_path, const colmap::Reconstru
   return ratios[ratios.size() / 2];
 }
 
-// The model's relative motions paired with the LiDAR's over lidar_registrator's pairs.
-std::vector<HandEyeMotion> ModelMotions(
-    const colmap::Reconstruction& model,
-    const std::map<std::string, colmap::image_t>& image_of_station,
-    const std::string& registration_path) {
+// The model's relative motions paired with the LiDAR's over lidar_registrator's pairs (by station:
+// the stem of the image name).
+std::vector<HandEyeMotion> ModelMotions(const colmap::Reconstruction& model,
+                                        const std::vector<LidarPairRecord>& lidar_pairs) {
+  std::map<std::string, colmap::image_t> image_of_station;
+  for (const colmap::image_t image_id : model.RegImageIds()) {
+    image_of_station[fs::path(model.Image(image_id).Name()).stem().string()] = image_id;
+  }
   std::vector<HandEyeMotion> motions;
-  if (registration_path.empty()) return motions;
-  for (const LidarPairRecord& pair :
-       ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
+  for (const LidarPairRecord& pair : lidar_pairs) {
     if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) continue;
     const colmap::image_t i = image_of_station.at(pair.target);
     const colmap::image_t j = image_of_station.at(pair.source);
@@ -339,7 +340,7 @@ double ChooseSimilarityExtrinsic(const std::vector<HandEyeMotion>& motions,
   return init->hand_eye.scale;
 }
 
-// Each model image must be the database's image of the same id and name, with its keypoints.
+// Each registered model image must be the database's image of the same id and name.
 void CheckModelImages(const colmap::Reconstruction& model, const StationImages& images) {
   for (const colmap::image_t image_id : model.RegImageIds()) {
     const colmap::Image& image = model.Image(image_id);
@@ -366,18 +367,11 @@ void CheckModelImages(const colmap::Reconstruction& model, const StationImages& 
 // hand-eye gives cam_from_lidar and its scale; the other models are scaled to the LiDAR motions through it.
 void ChooseModelScalesAndExtrinsic(const std::string& database_path,
                                    const StationDataset& dataset,
-                                   const std::string& registration_path,
+                                   const std::vector<LidarPairRecord>& lidar_pairs,
                                    const PoseInitializerOptions& options,
                                    std::vector<colmap::Reconstruction>* models,
                                    std::vector<double>* scales,
                                    PoseInitialization* init) {
-  const auto motions_of = [&](const colmap::Reconstruction& model) {
-    std::map<std::string, colmap::image_t> image_of_station;
-    for (const colmap::image_t image_id : model.RegImageIds()) {
-      image_of_station[fs::path(model.Image(image_id).Name()).stem().string()] = image_id;
-    }
-    return ModelMotions(model, image_of_station, registration_path);
-  };
   scales->clear();
   std::vector<HandEyeMotion> motions;
   for (size_t k = 0; k < models->size(); ++k) {
@@ -386,13 +380,13 @@ void ChooseModelScalesAndExtrinsic(const std::string& database_path,
     if (dataset.rig.IsStereo()) {
       scale = DepthPriorScale(database_path, model);
     } else if (k == 0) {
-      scale = ChooseSimilarityExtrinsic(motions_of(model), dataset, options, init);
+      scale = ChooseSimilarityExtrinsic(ModelMotions(model, lidar_pairs), dataset, options, init);
     } else {
-      scale = HandEyeScale(motions_of(model), init->cam_from_lidar);
+      scale = HandEyeScale(ModelMotions(model, lidar_pairs), init->cam_from_lidar);
     }
     model.Transform(colmap::Sim3d(scale, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()));
     scales->push_back(scale);
-    const std::vector<HandEyeMotion> metric = motions_of(model);
+    const std::vector<HandEyeMotion> metric = ModelMotions(model, lidar_pairs);
     motions.insert(motions.end(), metric.begin(), metric.end());
   }
   if (dataset.rig.IsStereo()) {
@@ -414,23 +408,20 @@ PoseInitialization InitializeFromModels(const std::string& database_path,
   THROW_CHECK(!models->empty()) << "no COLMAP model given";
   const StationImages images = ReadStationImages(database_path, dataset);
   for (const colmap::Reconstruction& model : *models) CheckModelImages(model, images);
+  const std::vector<LidarPairRecord> lidar_pairs =
+      registration_path.empty()
+          ? std::vector<LidarPairRecord>()
+          : ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string());
   PoseInitialization init;
   ChooseModelScalesAndExtrinsic(
-      database_path, dataset, registration_path, options, models, scales, &init);
+      database_path, dataset, lidar_pairs, options, models, scales, &init);
   std::vector<const colmap::Reconstruction*> metric;
   for (const colmap::Reconstruction& model : *models) metric.push_back(&model);
   ModelCompletionOptions completion;
   completion.sigma_rotation_deg = options.sigma_rotation_deg;
   completion.sigma_translation_m = options.sigma_translation_m;
   const CompletedPoses completed = CompleteThroughLidar(
-      metric,
-      images.image_of_station,
-      images.names,
-      registration_path.empty()
-          ? std::vector<LidarPairRecord>()
-          : ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string()),
-      init.cam_from_lidar,
-      completion);
+      metric, images.image_of_station, images.names, lidar_pairs, init.cam_from_lidar, completion);
   init.cam_from_world = completed.cam_from_world;
   init.num_lidar_edges = completed.num_lidar_edges;
   init.num_image_edges = completed.num_model_edges;
@@ -459,8 +450,11 @@ PoseInitialization InitializeMonocular(const std::string& database_path,
     init.cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
     init.extrinsic_source = "rig.json guess";
   } else {
-    ChooseSimilarityExtrinsic(
-        PairDirectionMotions(database_path, registration_path), dataset, options, &init, true);
+    ChooseSimilarityExtrinsic(PairDirectionMotions(database_path, dataset, registration_path),
+                              dataset,
+                              options,
+                              &init,
+                              true);
   }
   const colmap::Database database(database_path);
   for (const colmap::Image& image : database.ReadAllImages()) {

@@ -350,10 +350,11 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
         }
       }
     }
-    if (!all_extracted)
-      Extract(names, image_path, summary, options, partial);
-    else
+    if (all_extracted) {
       std::cout << "COLMAP SIFT extraction: every station image has its features" << std::endl;
+    } else {
+      Extract(names, image_path, summary, options, partial);
+    }
 
     const std::vector<colmap::image_t> image_ids =
         ImportedImageIds(dataset, names, summary.camera_id, partial);

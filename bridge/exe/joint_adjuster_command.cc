@@ -307,12 +307,16 @@ struct InitialisationFacts {
   bool from_guess = false;  // cam_from_lidar from rig.json's guess
 };
 
+// A model without one (e.g. the user's own) has no facts; an unreadable one is an error naming it.
 InitialisationFacts ReadInitialisationFacts(const std::string& input_path) {
   InitialisationFacts facts;
-  std::ifstream file(fs::path(input_path) / "initialization.json");
-  if (!file) return facts;
+  const fs::path path = fs::path(input_path) / "initialization.json";
+  if (!fs::exists(path)) return facts;
+  std::ifstream file(path);
   const nlohmann::json init = nlohmann::json::parse(file, nullptr, /*allow_exceptions=*/false);
-  if (init.is_discarded()) return facts;
+  if (!file || init.is_discarded() || !init.is_object()) {
+    throw std::runtime_error("cannot read " + path.string() + " (pose_initializer's report)");
+  }
   facts.one_axis = init.contains("hand_eye") &&
                    init["hand_eye"].contains("unobservable_translation_axis_in_cam");
   facts.from_guess = init.value("extrinsic_source", "").rfind("rig.json guess", 0) == 0;
