@@ -144,6 +144,34 @@ void CheckNewImagesExist(const StationDataset& dataset,
   }
 }
 
+// Before extraction: every new image exists, the stations' camera is chosen (and counted into
+// `summary`); true if every station image is in the database with its features already.
+bool PrepareCamera(const StationDataset& dataset,
+                   const std::vector<std::string>& names,
+                   const std::string& image_path,
+                   const DatasetImportOptions& options,
+                   const std::string& database_path,
+                   DatasetImportSummary* summary) {
+  colmap::Database database(database_path);  // creates COLMAP's tables if new
+  ExtensionDatabase extension(database_path);
+  CheckNewImagesExist(dataset, names, image_path, options, database);
+  std::optional<colmap::camera_t> camera_id;
+  if (!options.image_name_format.empty()) {
+    camera_id = ExistingStationCamera(dataset, names, &database);
+  }
+  summary->camera_id = camera_id ? *camera_id : LeftCameraId(dataset, &database, &extension);
+  bool all_extracted = true;
+  for (const std::string& name : names) {
+    if (!database.ExistsImageWithName(name)) {
+      ++summary->num_new_images;
+      all_extracted = false;
+    } else if (!database.ExistsKeypoints(database.ReadImageWithName(name).ImageId())) {
+      all_extracted = false;
+    }
+  }
+  return all_extracted;
+}
+
 // COLMAP's SIFT extraction of the images not yet extracted (COLMAP skips the others).
 void Extract(const std::vector<std::string>& names,
              const std::string& image_path,
@@ -331,25 +359,8 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
     const std::string image_path = options.image_path.empty()
                                        ? (fs::path(dataset.root) / "images").string()
                                        : options.image_path;
-    bool all_extracted = true;
-    {
-      colmap::Database database(partial);  // creates COLMAP's tables if new
-      ExtensionDatabase extension(partial);
-      CheckNewImagesExist(dataset, names, image_path, options, database);
-      std::optional<colmap::camera_t> camera_id;
-      if (!options.image_name_format.empty()) {
-        camera_id = ExistingStationCamera(dataset, names, &database);
-      }
-      summary.camera_id = camera_id ? *camera_id : LeftCameraId(dataset, &database, &extension);
-      for (const std::string& name : names) {
-        if (!database.ExistsImageWithName(name)) {
-          ++summary.num_new_images;
-          all_extracted = false;
-        } else if (!database.ExistsKeypoints(database.ReadImageWithName(name).ImageId())) {
-          all_extracted = false;
-        }
-      }
-    }
+    const bool all_extracted =
+        PrepareCamera(dataset, names, image_path, options, partial, &summary);
     if (all_extracted) {
       std::cout << "COLMAP SIFT extraction: every station image has its features" << std::endl;
     } else {
