@@ -1,6 +1,7 @@
 #include "lidar/cloud_io.h"
 
 #include "lidar/atomic_file.h"
+#include "lidar/pcd_header.h"
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
@@ -112,7 +113,25 @@ double ReadPcdValue(const pcl::PCLPointField& field, const uint8_t* data) {
   }
 }
 
+// Bytes of one value of a PCL field type (0: unknown).
+int PcdValueBytes(const pcl::PCLPointField& field) {
+  switch (field.datatype) {
+    case pcl::PCLPointField::INT8:
+    case pcl::PCLPointField::UINT8:
+      return 1;
+    case pcl::PCLPointField::INT16:
+    case pcl::PCLPointField::UINT16:
+      return 2;
+    case pcl::PCLPointField::FLOAT64:
+      return 8;
+    default:
+      return 4;
+  }
+}
+
 PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
+  // Our own check first: PCL's reader trusts the header (random bytes crash it).
+  const PcdHeader header = ReadPcdHeader(path);
   pcl::PCLPointCloud2 blob;
   pcl::PCDReader reader;
   if (reader.read(path, blob) < 0) {
@@ -136,9 +155,15 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
   const pcl::PCLPointField* fnz = find("normal_z");
   const pcl::PCLPointField* frgb = find("rgb");
   if (!frgb) frgb = find("rgba");
+  for (const pcl::PCLPointField* field : {fx, fy, fz, fi, fnx, fny, fnz, frgb}) {
+    if (field &&
+        field->offset + std::max(PcdValueBytes(*field), field == frgb ? 4 : 0) > blob.point_step) {
+      Fail(path, "field '" + field->name + "' lies outside the point record");
+    }
+  }
   const bool normals = fnx && fny && fnz;
   const size_t num_points = static_cast<size_t>(blob.width) * blob.height;
-  if (blob.data.size() < num_points * blob.point_step) {
+  if (num_points != header.num_points || blob.data.size() < num_points * blob.point_step) {
     Fail(path, "truncated data section");
   }
   CloudBuilder builder(normals, frgb != nullptr, fi != nullptr);

@@ -6,6 +6,7 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -130,7 +131,7 @@ TEST_F(CloudIoTest, RejectsBadFilesWithTheFileNamed) {
   for (const char* name : {"cut.ply", "cut.pcd"}) {
     WritePointCloud(Path(name), cloud);
     fs::resize_file(Path(name), fs::file_size(Path(name)) - 100);
-    ExpectReadError(Path(name), std::string(name) == "cut.ply" ? "truncated" : "PCD");
+    ExpectReadError(Path(name), "truncated");
   }
 
   std::ofstream(Path("cut.bin"), std::ios::binary) << "0123456789";
@@ -151,6 +152,52 @@ TEST_F(CloudIoTest, RejectsBadFilesWithTheFileNamed) {
 
   std::ofstream(Path("notes.las")) << "x";
   ExpectReadError(Path("notes.las"), "unknown extension");
+}
+
+// A user's 1,000 random bytes named .pcd once made PCL's reader dereference null (SIGSEGV); a header
+// claiming 10^12 points must be refused before anything is allocated.
+TEST_F(CloudIoTest, RefusesPcdHeadersPclWouldTrust) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::string bytes(1000, '\0');
+    for (char& c : bytes) c = static_cast<char>(rng());
+    std::ofstream(Path("random.pcd"), std::ios::binary) << bytes;
+    ExpectReadError(Path("random.pcd"), "PCD");
+  }
+  const std::string fields = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(Path(name), std::ios::binary) << text;
+    return Path(name);
+  };
+  const std::string huge = "WIDTH 1000000000000\nHEIGHT 1\nPOINTS 1000000000000\n";
+  ExpectReadError(write("huge.pcd", fields + huge + "DATA binary\n" + std::string(24, 'a')),
+                  "truncated");
+  ExpectReadError(write("huge_ascii.pcd", fields + huge + "DATA ascii\n1 2 3\n"), "truncated");
+  std::string sizes(8, '\0');
+  const uint32_t stored[2] = {4, 4000000};
+  std::memcpy(sizes.data(), stored, 8);
+  ExpectReadError(
+      write("huge_lzf.pcd",
+            fields + "WIDTH 1000000\nHEIGHT 1\nPOINTS 1000000\nDATA binary_compressed\n" + sizes +
+                "abcd"),
+      "stored sizes");
+  ExpectReadError(
+      write("lengths.pcd",
+            "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n"),
+      "3 FIELDS but 2 SIZE");
+  ExpectReadError(
+      write("points.pcd", fields + "WIDTH 2\nHEIGHT 1\nPOINTS 3\nDATA ascii\n1 2 3\n1 2 3\n"),
+      "POINTS 3");
+  ExpectReadError(
+      write("type.pcd",
+            "FIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n"),
+      "field 'z'");
+  ExpectReadError(write("nodata.pcd", fields + "WIDTH 1\n"), "no DATA line");
+  ExpectReadError(write("nopoints.pcd", fields + "WIDTH 1\nDATA ascii\n1 2 3\n"), "no POINTS");
+  // A good ascii header still reads through PCL.
+  const std::string good =
+      write("good.pcd", fields + "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3\n4 5 6\n");
+  EXPECT_EQ(ReadPointCloud(good).Size(), 2u);
 }
 
 }  // namespace
