@@ -1,5 +1,6 @@
 // pose_initializer and pipeline: from raw stations to a metric sparse model with cam_from_lidar.
 #include "bridge/exe/commands.h"
+#include "bridge/exe/step_resources.h"
 #include "bridge/exe/steps.h"
 #include "bridge/lidar_registration_files.h"
 #include "bridge/model_completion.h"
@@ -16,6 +17,7 @@
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <tuple>
 #include <vector>
 
@@ -247,6 +249,64 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
   return steps;
 }
 
+struct StepRecord {
+  std::string name;
+  std::string status;  // ran | skipped
+  double wall_s = 0, cpu_s = 0, peak_mib = 0;
+};
+
+// WS/pipeline_steps.csv, rewritten after every step: what each step cost (scripts/benchmark_pipeline.sh
+// reads it).
+void WriteStepTable(const fs::path& ws, const std::vector<StepRecord>& records) {
+  std::ostringstream csv;
+  csv << "# step, status, wall seconds, CPU seconds (all threads), peak resident MiB of the step\n"
+      << std::fixed << std::setprecision(1);
+  for (const StepRecord& r : records) {
+    csv << r.name << "," << r.status << "," << r.wall_s << "," << r.cpu_s << "," << r.peak_mib
+        << "\n";
+  }
+  WriteFileAtomically((ws / "pipeline_steps.csv").string(), csv.str());
+}
+
+// Runs the steps not marked done in WS/steps (all with `overwrite`), marks each when it ends and
+// prints what each cost.
+void RunSteps(const std::vector<PipelineStep>& steps, const fs::path& ws, bool overwrite) {
+  std::vector<StepRecord> records;
+  for (size_t k = 0; k < steps.size(); ++k) {
+    const PipelineStep& step = steps[k];
+    const fs::path marker = ws / "steps" / (step.name + ".done");
+    std::cout << "== [" << k + 1 << "/" << steps.size() << "] " << step.name;
+    if (fs::exists(marker) && !overwrite) {
+      std::cout << ": done before, skipped (--overwrite 1 reruns it)" << std::endl;
+      records.push_back({step.name, "skipped"});
+      continue;
+    }
+    std::cout << std::endl;
+    fs::remove(marker);
+    if (step.name == "import_dataset" && overwrite) fs::remove(ws / "database.db");
+    const StepResources resources;
+    try {
+      step.run();
+    } catch (const std::exception& error) {
+      throw std::runtime_error("step " + step.name + " failed: " + error.what());
+    }
+    WriteFileAtomically(marker.string(), step.name + " finished\n");
+    records.push_back({step.name,
+                       "ran",
+                       resources.WallSeconds(),
+                       resources.CpuSeconds(),
+                       resources.PeakResidentMiB()});
+    WriteStepTable(ws, records);
+  }
+  std::cout << "\n== Pipeline summary (" << ws.string() << "): wall s, CPU s, peak MiB\n";
+  for (const StepRecord& r : records) {
+    std::cout << "  " << std::left << std::setw(24) << r.name << std::setw(9) << r.status
+              << std::right << std::fixed << std::setprecision(1) << std::setw(8) << r.wall_s
+              << std::setw(9) << r.cpu_s << std::setw(9) << std::setprecision(0) << r.peak_mib
+              << "\n";
+  }
+}
+
 }  // namespace
 
 int RunPipeline(int argc, char** argv) {
@@ -285,34 +345,7 @@ int RunPipeline(int argc, char** argv) {
   const fs::path ws(pipeline.workspace_path);
   fs::create_directories(ws / "steps");
   fs::create_directories(ws / "sparse");
-  const std::vector<PipelineStep> steps = PipelineSteps(dataset, pipeline);
-  std::vector<std::tuple<std::string, std::string, double>> table;
-  for (size_t k = 0; k < steps.size(); ++k) {
-    const PipelineStep& step = steps[k];
-    const fs::path marker = ws / "steps" / (step.name + ".done");
-    std::cout << "== [" << k + 1 << "/" << steps.size() << "] " << step.name;
-    if (fs::exists(marker) && !pipeline.overwrite) {
-      std::cout << ": done before, skipped (--overwrite 1 reruns it)" << std::endl;
-      table.emplace_back(step.name, "skipped", 0.0);
-      continue;
-    }
-    std::cout << std::endl;
-    fs::remove(marker);
-    if (step.name == "import_dataset" && pipeline.overwrite) fs::remove(ws / "database.db");
-    const auto start = std::chrono::steady_clock::now();
-    try {
-      step.run();
-    } catch (const std::exception& error) {
-      throw std::runtime_error("step " + step.name + " failed: " + error.what());
-    }
-    WriteFileAtomically(marker.string(), step.name + " finished\n");
-    table.emplace_back(step.name, "ran", SecondsSince(start));
-  }
-  std::cout << "\n== Pipeline summary (" << pipeline.workspace_path << ")\n";
-  for (const auto& [name, status, seconds] : table) {
-    std::cout << "  " << std::left << std::setw(24) << name << std::setw(9) << status << std::right
-              << std::fixed << std::setprecision(1) << std::setw(8) << seconds << " s\n";
-  }
+  RunSteps(PipelineSteps(dataset, pipeline), ws, pipeline.overwrite);
   std::cout << "  model: " << (ws / "sparse" / "joint").string()
             << " (cam_from_lidar.txt, report.json)\n"
             << "  dense: " << (ws / "dense").string()

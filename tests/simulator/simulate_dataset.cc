@@ -53,7 +53,9 @@ void WriteImage(const std::string& path, const cv::Mat& image) {
 // The LiDAR's path during frame i's sweep: from halfway since the previous frame to halfway to the
 // next (extrapolated at the ends), through the frame's own pose at tau = 0.5.
 std::function<colmap::Rigid3d(double)> SweepPath(const std::vector<colmap::Rigid3d>& poses,
-                                                 size_t i) {
+                                                 size_t i,
+                                                 bool moving) {
+  if (!moving) return [pose = poses[i]](double) { return pose; };
   const colmap::Rigid3d previous = i > 0 ? poses[i - 1] : Interpolate(poses[i], poses[i + 1], -1.0);
   const colmap::Rigid3d next =
       i + 1 < poses.size() ? poses[i + 1] : Interpolate(poses[i - 1], poses[i], 2.0);
@@ -125,7 +127,8 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
   for (size_t i = 0; i < stations.size(); ++i) {
     const std::string name = StationName(static_cast<int>(i));
     // Driving: the other cars move between frames (not during a sweep).
-    const Scene frame_scene = drive ? scene.MovedTo(i * kDriveFramePeriod) : scene;
+    const Scene frame_scene =
+        drive && options.moving_cars ? scene.MovedTo(i * kDriveFramePeriod) : scene;
     cam_from_world[name] = stations[i];
     ImageOptions image_options;
     image_options.pixel_noise = options.pixel_noise;
@@ -150,9 +153,10 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
     lidar_options.range_noise_m = options.range_noise_m;
     lidar_options.mixed_edge_points = options.mixed_edge_points;
     lidar_options.seed = options.seed * 1000 + i;
-    const PointCloud cloud =
-        drive ? ScanSweep(frame_scene, SweepPath(world_from_lidar, i), lidar_options)
-              : ScanLidar(scene, world_from_lidar[i], lidar_options);
+    const PointCloud cloud = drive ? ScanSweep(frame_scene,
+                                               SweepPath(world_from_lidar, i, options.sweep_motion),
+                                               lidar_options)
+                                   : ScanLidar(scene, world_from_lidar[i], lidar_options);
     WritePointCloud((partial / "lidar" / (name + ".pcd")).string(), cloud);
     result.num_lidar_points += cloud.Size();
     std::cout << "simulate_dataset: station " << name << " (" << i + 1 << "/" << stations.size()

@@ -14,6 +14,11 @@ struct SimulationOptions {
   // two_axes | one_axis | fixed_rotation | drive (frames of a car: MakeDriveRig, one ScanSweep per
   // frame with the frame's pose at mid-sweep, cars moving between frames; scene "street")
   std::string motion = "two_axes";
+  // drive: the pod moves during each sweep (false: a frozen pod per sweep, as stop-and-go; isolates
+  // de-skewing in experiments)
+  bool sweep_motion = true;
+  // drive: the two cars driving in the street move between frames (false: they stand still)
+  bool moving_cars = true;
   // 1 = 1028x752 per camera, 4 = the 4112x3008 of Zhen et al. 2019
   double image_scale = 1.0;
   // One camera: rig.json without "right", no images/right/ (a monocular dataset).

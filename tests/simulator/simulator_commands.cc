@@ -21,6 +21,10 @@ int RunSimulateDataset(int argc, char** argv) {
   manager.AddDefaultOption(
       "motion", &options.motion, "two_axes | one_axis | fixed_rotation | drive");
   manager.AddDefaultOption(
+      "sweep_motion", &options.sweep_motion, "drive: the pod moves during each sweep");
+  manager.AddDefaultOption(
+      "moving_cars", &options.moving_cars, "drive: the street's two cars move between frames");
+  manager.AddDefaultOption(
       "image_scale", &options.image_scale, "1 = 1028x752 per camera, 4 = 4112x3008");
   manager.AddDefaultOption(
       "layout", &options.layout, "dataset | kitti (KITTI raw's folders and calibration files)");
