@@ -191,7 +191,7 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   const Eigen::Map<const DepthImage> stereo_depth(stereo.ptr<float>(), stereo.rows, stereo.cols);
 
   // The station's cloud: into the LiDAR map (world frame), and cropped to the camera's view.
-  const PointCloud cloud = ReadPointCloud(dataset.cloud_paths[view.station]);
+  const PointCloud cloud = ReadStationCloud(dataset.cloud_paths[view.station]);
   const colmap::Rigid3d world_from_lidar = colmap::Inverse(image.CamFromWorld()) * cam_from_lidar;
   std::vector<Eigen::Vector3d> in_view;
   for (const Eigen::Vector3d& point_in_lidar : cloud.points) {

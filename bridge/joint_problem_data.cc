@@ -115,7 +115,7 @@ void LoadClouds(const StationDataset& dataset,
   cloud_options.compute_features = false;
   for (const colmap::image_t image_id : image_ids) {
     const size_t station = station_of_image.at(image_id);
-    const PointCloud raw = ReadPointCloud(dataset.cloud_paths[station]);
+    const PointCloud raw = ReadStationCloud(dataset.cloud_paths[station]);
     loaded->clouds.push_back(PrepareStationCloud(raw, cloud_options));
     loaded->data.clouds[image_id] = loaded->clouds.back().get();
     std::cout << "  cloud " << dataset.stations[station] << ": " << raw.Size() << " points -> "

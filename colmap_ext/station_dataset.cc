@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -235,6 +236,31 @@ bool StationDataset::HasReferenceExtrinsic() const {
   return fs::is_regular_file(GroundTruthPath("cam_from_lidar.txt"));
 }
 
+namespace {
+
+// Every cloud of ROOT/lidar is a station with a left image, and no station has two clouds.
+void CheckEveryCloudHasOneImage(const std::string& root, const std::vector<std::string>& stations) {
+  const fs::path lidar_dir = fs::path(root) / "lidar";
+  std::map<std::string, std::string> cloud_of_station;
+  for (const auto& entry : fs::directory_iterator(lidar_dir)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext != ".pcd" && ext != ".ply" && ext != ".bin") continue;
+    const std::string station = entry.path().stem().string();
+    const auto [it, inserted] = cloud_of_station.emplace(station, entry.path().string());
+    if (!inserted) {
+      Fail(entry.path().string(),
+           "station " + station + " has a second cloud (" + it->second + "); keep one");
+    }
+    if (!std::binary_search(stations.begin(), stations.end(), station)) {
+      Fail(entry.path().string(),
+           "a cloud without a left image (" +
+               (fs::path(root) / "images" / "left" / (station + ".png")).string() + ")");
+    }
+  }
+}
+
+}  // namespace
+
 StationDataset ReadStationDataset(const std::string& root) {
   if (!fs::is_directory(root)) Fail(root, "dataset directory does not exist");
   StationDataset dataset;
@@ -276,6 +302,7 @@ StationDataset ReadStationDataset(const std::string& root) {
     }
     dataset.cloud_paths.push_back(cloud);
   }
+  CheckEveryCloudHasOneImage(root, dataset.stations);
   return dataset;
 }
 

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -545,6 +546,23 @@ PointCloud ReadPointCloud(const std::string& path, CloudReadStats* stats) {
   if (ext == ".bin") return ReadKittiBin(path, stats);
   if (ext == ".xyz" || ext == ".txt") return ReadXyzText(path, stats);
   Fail(path, "unknown extension '" + ext + "' (expected .pcd .ply .bin .xyz .txt)");
+}
+
+PointCloud ReadStationCloud(const std::string& path, CloudReadStats* stats) {
+  PointCloud cloud = ReadPointCloud(path, stats);
+  std::vector<double> ranges;
+  const size_t stride = std::max<size_t>(1, cloud.Size() / 10000);
+  for (size_t i = 0; i < cloud.Size(); i += stride) ranges.push_back(cloud.points[i].norm());
+  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
+  const double median = ranges[ranges.size() / 2];
+  if (median > kMaxMedianRangeM) {
+    std::ostringstream problem;
+    problem << "the median range from the sensor is " << std::fixed << std::setprecision(0)
+            << median << " m; a station cloud must be in the LiDAR's frame in metres (is it in "
+            << "millimetres, or in a world frame?)";
+    Fail(path, problem.str());
+  }
+  return cloud;
 }
 
 void WritePointCloud(const std::string& path, const PointCloud& cloud) {

@@ -22,6 +22,12 @@ struct CloudReadStats {
 
 PointCloud ReadPointCloud(const std::string& path, CloudReadStats* stats = nullptr);
 
+// A station's LiDAR cloud: ReadPointCloud, then a check that it is in the sensor's frame in metres.
+// The median range from the sensor of any terrestrial LiDAR is far below kMaxMedianRangeM; a cloud
+// above it is in another unit (millimetres) or in a world frame, and is refused with the figure.
+constexpr double kMaxMedianRangeM = 500;
+PointCloud ReadStationCloud(const std::string& path, CloudReadStats* stats = nullptr);
+
 void WritePointCloud(const std::string& path, const PointCloud& cloud);
 
 }  // namespace colmap_lidar

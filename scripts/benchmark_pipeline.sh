@@ -8,15 +8,17 @@
 #     B  100 stations around bridge_pier, 400 k rays, 1028x752: scale
 #     C  the demo's default (25 stations, 400 k rays, 1028x752)
 #   BENCH_DIR   where datasets and workspaces go (default: /tmp/colmap-lidar-benchmark)
+#   BUILD_DIR   build directory (default: build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
 readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
 readonly kBench="${BENCH_DIR:-/tmp/colmap-lidar-benchmark}"
 readonly kDoc=docs/benchmarks/pipeline.md
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$kColmapPrefix" >/dev/null
-cmake --build build -j "$(nproc)" --target colmap_lidar_cli >/dev/null
-readonly cli="$PWD/build/bin/colmap-lidar"
+readonly kBuildDir="${BUILD_DIR:-build}"
+cmake -S . -B "$kBuildDir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$kColmapPrefix" >/dev/null
+cmake --build "$kBuildDir" -j "$(nproc)" --target colmap_lidar_cli >/dev/null
+readonly cli="$PWD/$kBuildDir/bin/colmap-lidar"
 readonly colmap="$kColmapPrefix/bin/colmap"
 configs=("$@")
 [ ${#configs[@]} -gt 0 ] || configs=(C A B)

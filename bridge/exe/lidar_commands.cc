@@ -90,6 +90,13 @@ std::vector<fs::path> StationCloudFiles(const std::string& lidar_path) {
     if (ext == ".pcd" || ext == ".ply" || ext == ".bin") files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end());
+  for (size_t i = 1; i < files.size(); ++i) {
+    if (files[i].stem() == files[i - 1].stem()) {
+      throw std::runtime_error("station " + files[i].stem().string() + " has two clouds in " +
+                               lidar_path + ": " + files[i - 1].filename().string() + " and " +
+                               files[i].filename().string() + " (keep one)");
+    }
+  }
   THROW_CHECK_GE(files.size(), 2) << "Fewer than 2 clouds in " << lidar_path;
   return files;
 }
@@ -150,7 +157,7 @@ LidarGraph RegisterClouds(const std::vector<fs::path>& files,
   std::vector<std::unique_ptr<StationCloud>> stations;
   for (size_t i = 0; i < files.size(); ++i) {
     CloudReadStats stats;
-    PointCloud raw = ReadPointCloud(files[i].string(), &stats);
+    PointCloud raw = ReadStationCloud(files[i].string(), &stats);
     if (sweep_motions != nullptr) {
       raw = DeskewSweep(raw, (*sweep_motions)[i], options.sweep_timing);
       WritePointCloud((fs::path(deskewed_path) / (files[i].stem().string() + ".pcd")).string(),

@@ -1,0 +1,248 @@
+// The bad-input matrix (docs/reliability.md): each case breaks one input of a small simulated dataset
+// the way a user's capture breaks, runs the real CLI on it and checks what the user gets: a non-zero
+// exit without a signal, exactly one "ERROR:" line naming the file (and the key or line where it
+// applies), no output left behind, and every input file byte-for-byte unchanged.
+#include "lidar/cloud_io.h"
+#include "tests/simulator/simulate_dataset.h"
+#include "tests/testing/run_command.h"
+#include "tests/testing/scoped_temp_dir.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::RunCommand;
+const std::string kCli = COLMAP_LIDAR_CLI_EXE;
+
+struct BadInputCase {
+  std::string name;
+  // Breaks the copy of the dataset at `dataset`.
+  std::function<void(const fs::path& dataset)> mutate;
+  // The CLI's arguments; {dataset} and {out} are replaced.
+  std::string arguments;
+  // What the ERROR line must contain (the file, the key, the cause).
+  std::vector<std::string> needles;
+};
+
+// Test names instead of byte dumps in GoogleTest's messages.
+void PrintTo(const BadInputCase& c, std::ostream* os) { *os << c.name; }
+
+std::string ReadBytes(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << file.rdbuf();
+  return bytes.str();
+}
+
+void WriteBytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+// Every file under `root` with its bytes.
+std::map<std::string, std::string> Snapshot(const fs::path& root) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    if (entry.is_regular_file()) files[entry.path().string()] = ReadBytes(entry.path());
+  }
+  return files;
+}
+
+// rig.json changed by `edit`.
+std::function<void(const fs::path&)> EditRig(std::function<void(nlohmann::json*)> edit) {
+  return [=](const fs::path& dataset) {
+    nlohmann::json rig = nlohmann::json::parse(ReadBytes(dataset / "rig.json"));
+    edit(&rig);
+    WriteBytes(dataset / "rig.json", rig.dump(2));
+  };
+}
+
+std::vector<std::string> ErrorLines(const std::string& output) {
+  std::vector<std::string> lines;
+  std::istringstream stream(output);
+  std::string line;
+  while (std::getline(stream, line)) {
+    if (line.rfind("ERROR:", 0) == 0) lines.push_back(line);
+  }
+  return lines;
+}
+
+class BadInputTest : public ::testing::TestWithParam<BadInputCase> {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new testing::ScopedTempDir("colmap_lidar_bad_input");
+    sim::SimulationOptions options;
+    options.output_path = dir_->File("dataset");
+    options.num_stations = 3;
+    options.image_scale = 0.25;
+    options.lidar_points = 20000;
+    sim::SimulateDataset(options);
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static testing::ScopedTempDir* dir_;
+};
+testing::ScopedTempDir* BadInputTest::dir_ = nullptr;
+
+TEST_P(BadInputTest, OneClearErrorNoOutputInputsUnchanged) {
+  const BadInputCase& c = GetParam();
+  const fs::path root = dir_->Path() / c.name;
+  fs::remove_all(root);
+  fs::create_directories(root);
+  const fs::path dataset = root / "dataset";
+  fs::copy(dir_->Path() / "dataset", dataset, fs::copy_options::recursive);
+  c.mutate(dataset);
+  const std::map<std::string, std::string> before = Snapshot(dataset);
+  const fs::path out = root / "out";
+  std::string arguments = c.arguments;
+  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+           {"{dataset}", dataset.string()}, {"{out}", out.string()}}) {
+    for (size_t at; (at = arguments.find(key)) != std::string::npos;) {
+      arguments.replace(at, key.size(), value);
+    }
+  }
+  const testing::CommandResult result = RunCommand(kCli + " " + arguments);
+  EXPECT_NE(result.exit_code, -1) << "killed by a signal:\n" << result.output;
+  EXPECT_NE(result.exit_code, 0) << result.output;
+  const std::vector<std::string> errors = ErrorLines(result.output);
+  ASSERT_EQ(errors.size(), 1u) << result.output;
+  for (const std::string& needle : c.needles) {
+    EXPECT_NE(errors[0].find(needle), std::string::npos) << "'" << needle << "' in " << errors[0];
+  }
+  EXPECT_FALSE(fs::exists(out)) << "output left behind: " << out;
+  EXPECT_TRUE(Snapshot(dataset) == before) << "an input file changed";
+}
+
+void CutCloud(const fs::path& dataset, const std::string& file, size_t bytes) {
+  const fs::path path = dataset / "lidar" / file;
+  fs::resize_file(path, fs::file_size(path) - bytes);
+}
+
+// The simulator's clouds are lidar/000.pcd ...; the images images/{left,right}/000.png ...
+std::vector<BadInputCase> Cases() {
+  const std::string registrator =
+      "lidar_registrator --lidar_path {dataset}/lidar --output_path {out}";
+  const std::string import = "import_dataset --dataset_path {dataset} --database_path {out}";
+  return {
+      {"empty_pcd",
+       [](const fs::path& d) { WriteBytes(d / "lidar/001.pcd", ""); },
+       registrator,
+       {"001.pcd", "empty"}},
+      {"truncated_pcd",
+       [](const fs::path& d) { CutCloud(d, "001.pcd", 1000); },
+       registrator,
+       {"001.pcd", "truncated"}},
+      {"random_bytes_pcd",
+       [](const fs::path& d) {
+         std::string bytes(1000, '\0');
+         for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<char>((i * 7919) % 251);
+         WriteBytes(d / "lidar/001.pcd", bytes);
+       },
+       registrator,
+       {"001.pcd", "PCD"}},
+      {"nan_cloud",
+       [](const fs::path& d) {
+         PointCloud cloud;
+         cloud.points.assign(100, Eigen::Vector3d::Constant(std::nan("")));
+         WritePointCloud((d / "lidar/001.pcd").string(), cloud);
+       },
+       registrator,
+       {"001.pcd", "NaN"}},
+      {"truncated_ply",
+       [](const fs::path& d) {
+         const PointCloud cloud = ReadPointCloud((d / "lidar/001.pcd").string());
+         fs::remove(d / "lidar/001.pcd");
+         WritePointCloud((d / "lidar/001.ply").string(), cloud);
+         CutCloud(d, "001.ply", 1000);
+       },
+       registrator,
+       {"001.ply", "truncated"}},
+      {"truncated_kitti_bin",
+       [](const fs::path& d) {
+         fs::remove(d / "lidar/001.pcd");
+         WriteBytes(d / "lidar/001.bin", std::string(100, '\1'));
+       },
+       registrator,
+       {"001.bin", "multiple of 16"}},
+      {"cloud_in_millimetres",
+       [](const fs::path& d) {
+         PointCloud cloud = ReadPointCloud((d / "lidar/001.pcd").string());
+         for (Eigen::Vector3d& p : cloud.points) p *= 1000;
+         WritePointCloud((d / "lidar/001.pcd").string(), cloud);
+       },
+       registrator,
+       {"001.pcd", "millimetres"}},
+      {"duplicated_station",
+       [](const fs::path& d) {
+         WritePointCloud((d / "lidar/001.ply").string(),
+                         ReadPointCloud((d / "lidar/001.pcd").string()));
+       },
+       registrator,
+       {"001", "two clouds"}},
+      {"duplicated_station_in_dataset",
+       [](const fs::path& d) {
+         WritePointCloud((d / "lidar/001.ply").string(),
+                         ReadPointCloud((d / "lidar/001.pcd").string()));
+       },
+       import,
+       {"001", "second cloud"}},
+      {"rig_not_json",
+       [](const fs::path& d) {
+         fs::resize_file(d / "rig.json", fs::file_size(d / "rig.json") / 2);
+       },
+       import,
+       {"rig.json"}},
+      {"rig_wrong_type",
+       EditRig([](nlohmann::json* rig) { (*rig)["left"]["width"] = "wide"; }),
+       import,
+       {"rig.json", "width"}},
+      {"rig_non_unit_quaternion",
+       EditRig([](nlohmann::json* rig) {
+         (*rig)["right_from_left"]["rotation"] = {2.0, 0.0, 0.0, 0.0};
+       }),
+       import,
+       {"rig.json", "rotation"}},
+      {"rig_nan_focal_length",
+       EditRig([](nlohmann::json* rig) { (*rig)["left"]["params"][0] = "nan"; }),
+       import,
+       {"rig.json", "params"}},
+      {"cloud_without_image",
+       [](const fs::path& d) { fs::remove(d / "images/left/001.png"); },
+       import,
+       {"001.pcd", "without a left image"}},
+      {"image_without_cloud",
+       [](const fs::path& d) { fs::remove(d / "lidar/001.pcd"); },
+       import,
+       {"001"}},
+      {"image_of_another_size",
+       [](const fs::path& d) {
+         fs::copy_file(d / "images/left/000.png", d / "images/left/000b.png");
+       },
+       import,
+       {"000b"}},
+      {"missing_rig", [](const fs::path& d) { fs::remove(d / "rig.json"); }, import, {"rig.json"}},
+      {"missing_lidar_folder",
+       [](const fs::path& d) { fs::remove_all(d / "lidar"); },
+       registrator,
+       {"lidar"}},
+  };
+}
+
+INSTANTIATE_TEST_SUITE_P(Matrix,
+                         BadInputTest,
+                         ::testing::ValuesIn(Cases()),
+                         [](const ::testing::TestParamInfo<BadInputCase>& info) {
+                           return info.param.name;
+                         });
+
+}  // namespace
+}  // namespace colmap_lidar
