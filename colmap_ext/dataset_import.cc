@@ -286,6 +286,16 @@ void WriteRigAndLidarFrames(const StationDataset& dataset,
   }
 }
 
+// " (... only N KiB free ...)" when the disk of `path` is (nearly) full, else "": COLMAP reports a
+// full disk as "SQL logic error".
+std::string DiskFullHint(const std::string& path) {
+  std::error_code error;
+  const fs::space_info space = fs::space(fs::absolute(path).parent_path(), error);
+  if (error || space.available > (uint64_t(64) << 20)) return "";
+  return " (writing " + path + ": only " + std::to_string(space.available / 1024) +
+         " KiB free on its disk; is it full?)";
+}
+
 }  // namespace
 
 std::string DatasetImportOptions::ImageName(const StationDataset& dataset, size_t station) const {
@@ -384,9 +394,9 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
     CopySqliteDatabase(partial, database_path);
     remove_partial();
     return summary;
-  } catch (...) {
+  } catch (const std::exception& error) {
     remove_partial();
-    throw;
+    throw std::runtime_error(error.what() + DiskFullHint(database_path));
   }
 }
 

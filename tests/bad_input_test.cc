@@ -27,12 +27,14 @@ const std::string kCli = COLMAP_LIDAR_CLI_EXE;
 
 struct BadInputCase {
   std::string name;
-  // Breaks the copy of the dataset at `dataset`.
+  // Breaks the copy of the dataset at `dataset` (ROOT/dataset; other input files go into ROOT).
   std::function<void(const fs::path& dataset)> mutate;
-  // The CLI's arguments; {dataset} and {out} are replaced.
+  // The CLI's arguments; {dataset}, {root} and {out} (= ROOT/out) are replaced.
   std::string arguments;
   // What the ERROR line must contain (the file, the key, the cause).
   std::vector<std::string> needles;
+  // ROOT/full is a 64 KiB tmpfs (a full disk); skipped with a message where it cannot be mounted.
+  bool full_disk = false;
 };
 
 // Test names instead of byte dumps in GoogleTest's messages.
@@ -49,11 +51,14 @@ void WriteBytes(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
 }
 
-// Every file under `root` with its bytes.
-std::map<std::string, std::string> Snapshot(const fs::path& root) {
+// Every file under `root` but outside `out` with its bytes.
+std::map<std::string, std::string> Snapshot(const fs::path& root, const fs::path& out) {
   std::map<std::string, std::string> files;
   for (const auto& entry : fs::recursive_directory_iterator(root)) {
-    if (entry.is_regular_file()) files[entry.path().string()] = ReadBytes(entry.path());
+    const std::string path = entry.path().string();
+    if (entry.is_regular_file() && path.rfind(out.string(), 0) != 0) {
+      files[path] = ReadBytes(entry.path());
+    }
   }
   return files;
 }
@@ -93,24 +98,36 @@ class BadInputTest : public ::testing::TestWithParam<BadInputCase> {
 };
 testing::ScopedTempDir* BadInputTest::dir_ = nullptr;
 
+std::string Expand(std::string arguments, const fs::path& root) {
+  for (const auto& [key, value] :
+       std::vector<std::pair<std::string, std::string>>{{"{dataset}", (root / "dataset").string()},
+                                                        {"{root}", root.string()},
+                                                        {"{out}", (root / "out").string()}}) {
+    for (size_t at; (at = arguments.find(key)) != std::string::npos;) {
+      arguments.replace(at, key.size(), value);
+    }
+  }
+  return arguments;
+}
+
 TEST_P(BadInputTest, OneClearErrorNoOutputInputsUnchanged) {
   const BadInputCase& c = GetParam();
   const fs::path root = dir_->Path() / c.name;
   fs::remove_all(root);
   fs::create_directories(root);
-  const fs::path dataset = root / "dataset";
-  fs::copy(dir_->Path() / "dataset", dataset, fs::copy_options::recursive);
-  c.mutate(dataset);
-  const std::map<std::string, std::string> before = Snapshot(dataset);
-  const fs::path out = root / "out";
-  std::string arguments = c.arguments;
-  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
-           {"{dataset}", dataset.string()}, {"{out}", out.string()}}) {
-    for (size_t at; (at = arguments.find(key)) != std::string::npos;) {
-      arguments.replace(at, key.size(), value);
+  fs::copy(dir_->Path() / "dataset", root / "dataset", fs::copy_options::recursive);
+  c.mutate(root / "dataset");
+  if (c.full_disk) {
+    fs::create_directories(root / "full");
+    if (RunCommand("mount -t tmpfs -o size=64k tmpfs " + (root / "full").string()).exit_code != 0) {
+      GTEST_SKIP()
+          << "cannot mount a 64 KiB tmpfs here (needs root): the full-disk case is skipped";
     }
   }
-  const testing::CommandResult result = RunCommand(kCli + " " + arguments);
+  const fs::path out = root / "out";
+  const std::map<std::string, std::string> before = Snapshot(root, out);
+  const testing::CommandResult result = RunCommand(kCli + " " + Expand(c.arguments, root));
+  if (c.full_disk) RunCommand("umount " + (root / "full").string());
   EXPECT_NE(result.exit_code, -1) << "killed by a signal:\n" << result.output;
   EXPECT_NE(result.exit_code, 0) << result.output;
   const std::vector<std::string> errors = ErrorLines(result.output);
@@ -119,7 +136,7 @@ TEST_P(BadInputTest, OneClearErrorNoOutputInputsUnchanged) {
     EXPECT_NE(errors[0].find(needle), std::string::npos) << "'" << needle << "' in " << errors[0];
   }
   EXPECT_FALSE(fs::exists(out)) << "output left behind: " << out;
-  EXPECT_TRUE(Snapshot(dataset) == before) << "an input file changed";
+  EXPECT_TRUE(Snapshot(root, out) == before) << "an input file changed";
 }
 
 void CutCloud(const fs::path& dataset, const std::string& file, size_t bytes) {
@@ -230,6 +247,26 @@ std::vector<BadInputCase> Cases() {
        import,
        {"000b"}},
       {"missing_rig", [](const fs::path& d) { fs::remove(d / "rig.json"); }, import, {"rig.json"}},
+      {"database_from_another_program",
+       [](const fs::path& d) {
+         testing::RunStep("sqlite3 " + (d.parent_path() / "other.db").string() +
+                          " 'CREATE TABLE notes (text TEXT); INSERT INTO notes VALUES (1);'");
+       },
+       "import_dataset --dataset_path {dataset} --database_path {root}/other.db",
+       {"other.db", "Not a COLMAP database"}},
+      {"full_disk",
+       [](const fs::path&) {},
+       "import_dataset --dataset_path {dataset} --database_path {root}/full/db.db",
+       {"full/db.db", "free on its disk"},
+       true},
+      {"existing_output_without_overwrite",
+       [](const fs::path&) {},
+       "simulate_dataset --num_stations 2 --output_path {dataset}",
+       {"dataset", "--overwrite"}},
+      {"output_below_a_file",
+       [](const fs::path& d) { WriteBytes(d.parent_path() / "file", "x"); },
+       "lidar_registrator --lidar_path {dataset}/lidar --output_path {root}/file/out",
+       {"file/out"}},
       {"missing_lidar_folder",
        [](const fs::path& d) { fs::remove_all(d / "lidar"); },
        registrator,
