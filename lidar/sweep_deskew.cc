@@ -3,6 +3,7 @@
 #include "lidar/check_option.h"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace colmap_lidar {
 
@@ -17,6 +18,52 @@ double SweepFraction(const Eigen::Vector3d& point_in_lidar, const SweepTimingOpt
   if (!options.counter_clockwise) turned = -turned;
   const double fraction = std::fmod(turned, 2 * M_PI) / (2 * M_PI);
   return fraction < 0 ? fraction + 1 : fraction;
+}
+
+namespace {
+
+// The motion per frame from sweep i to sweep j, or false when they are not comparable.
+bool MotionPerFrame(const std::vector<Eigen::Isometry3d>& world_from_lidar,
+                    const std::vector<double>& frame,
+                    const std::vector<int>& component,
+                    size_t i,
+                    size_t j,
+                    Eigen::Isometry3d* motion) {
+  if (j >= world_from_lidar.size() || component[i] != component[j] || frame[i] == frame[j]) {
+    return false;
+  }
+  const Eigen::Isometry3d i_from_j = world_from_lidar[i].inverse() * world_from_lidar[j];
+  const double per_frame = 1.0 / std::abs(frame[j] - frame[i]);
+  const Eigen::AngleAxisd rotation(i_from_j.rotation());
+  motion->setIdentity();
+  motion->linear() =
+      Eigen::AngleAxisd(per_frame * rotation.angle(), rotation.axis()).toRotationMatrix();
+  motion->translation() = per_frame * i_from_j.translation();
+  return true;
+}
+
+}  // namespace
+
+std::vector<SweepMotion> SweepMotionsFromPoses(
+    const std::vector<Eigen::Isometry3d>& world_from_lidar,
+    const std::vector<double>& frame,
+    const std::vector<int>& component) {
+  if (frame.size() != world_from_lidar.size() || component.size() != world_from_lidar.size()) {
+    throw std::invalid_argument(
+        "SweepMotionsFromPoses: poses, frames and components differ in size");
+  }
+  std::vector<SweepMotion> motions(world_from_lidar.size());
+  for (size_t i = 0; i < motions.size(); ++i) {
+    Eigen::Isometry3d next, previous;
+    const bool has_next = MotionPerFrame(world_from_lidar, frame, component, i, i + 1, &next);
+    const bool has_previous =
+        i > 0 && MotionPerFrame(world_from_lidar, frame, component, i, i - 1, &previous);
+    if (has_next) motions[i].mid_from_next_mid = next;
+    if (has_previous) motions[i].mid_from_previous_mid = previous;
+    if (has_next && !has_previous) motions[i].mid_from_previous_mid = next.inverse();
+    if (has_previous && !has_next) motions[i].mid_from_next_mid = previous.inverse();
+  }
+  return motions;
 }
 
 PointCloud DeskewSweep(const PointCloud& sweep,

@@ -18,6 +18,8 @@
 
 #include <Eigen/Geometry>
 
+#include <vector>
+
 namespace colmap_lidar {
 
 struct SweepTimingOptions {
@@ -38,6 +40,15 @@ struct SweepMotion {
   Eigen::Isometry3d mid_from_previous_mid = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d mid_from_next_mid = Eigen::Isometry3d::Identity();
 };
+
+// Each sweep's motion from the poses of its neighbours in time. Sweep i was taken at frame `frame[i]`
+// (increasing) with pose world_from_lidar[i] at its middle in component `component[i]` (poses of
+// different components are not comparable); the motion to a neighbour k frames away is divided by k.
+// Without one neighbour the other is mirrored (constant velocity); without both, none (identity).
+std::vector<SweepMotion> SweepMotionsFromPoses(
+    const std::vector<Eigen::Isometry3d>& world_from_lidar,
+    const std::vector<double>& frame,
+    const std::vector<int>& component);
 
 // The sweep in the LiDAR frame at its middle; normals are not carried (they change with the points).
 PointCloud DeskewSweep(const PointCloud& sweep,

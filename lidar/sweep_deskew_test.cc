@@ -90,5 +90,37 @@ TEST(SweepDeskew, UndoesTheMotionOfEachHalfSweep) {
   EXPECT_EQ(still.points, sweep.points);
 }
 
+// Poses of four sweeps at frames 10, 11, 13 (one frame skipped) and 14, the last in another
+// component: motions per frame, the skipped frame halving the motion, mirrored at the ends.
+TEST(SweepDeskew, MotionsFromPosesArePerFrameAndMirroredAtTheEnds) {
+  const Eigen::Isometry3d step = Motion(2, Eigen::Vector3d(0.9, 0.04, 0.0));
+  std::vector<Eigen::Isometry3d> world_from_lidar = {
+      Eigen::Isometry3d::Identity(), step, step * step * step, Motion(40, {5, 5, 0})};
+  const std::vector<SweepMotion> motions =
+      SweepMotionsFromPoses(world_from_lidar, {10, 11, 13, 14}, {0, 0, 0, 1});
+  ASSERT_EQ(motions.size(), 4u);
+  auto near = [](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+    return (a.matrix() - b.matrix()).norm() < 1e-9;
+  };
+  EXPECT_TRUE(near(motions[0].mid_from_next_mid, step));
+  EXPECT_TRUE(near(motions[0].mid_from_previous_mid, step.inverse()));  // mirrored
+  EXPECT_TRUE(near(motions[1].mid_from_previous_mid, step.inverse()));
+  // Two frames of `step`, per frame: half the angle about the same axis, half the translation.
+  auto halved = [](const Eigen::Isometry3d& motion) {
+    const Eigen::AngleAxisd rotation(motion.rotation());
+    Eigen::Isometry3d half = Eigen::Isometry3d::Identity();
+    half.linear() = Eigen::AngleAxisd(0.5 * rotation.angle(), rotation.axis()).toRotationMatrix();
+    half.translation() = 0.5 * motion.translation();
+    return half;
+  };
+  EXPECT_TRUE(near(motions[1].mid_from_next_mid, halved(step * step)));
+  EXPECT_TRUE(near(motions[2].mid_from_previous_mid, halved((step * step).inverse())));
+  // The next sweep is not comparable: the previous motion mirrored.
+  EXPECT_TRUE(near(motions[2].mid_from_next_mid, halved((step * step).inverse()).inverse()));
+  EXPECT_TRUE(near(motions[3].mid_from_next_mid, Eigen::Isometry3d::Identity()));
+  EXPECT_THROW(SweepMotionsFromPoses(world_from_lidar, {1, 2}, {0, 0, 0, 0}),
+               std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace colmap_lidar

@@ -60,6 +60,9 @@ const std::vector<Command>& Commands() {
       {"lidar_registrator",
        &RunLidarRegistrator,
        "Register all station clouds and build the LiDAR pose graph"},
+      {"deskew_sweeps",
+       &RunDeskewSweeps,
+       "De-skew the sweeps of a moving platform with a model's trajectory and cam_from_lidar"},
       {"joint_adjuster",
        &RunJointAdjuster,
        "Joint bundle adjustment: poses, landmarks and cam_from_lidar with "

@@ -30,6 +30,7 @@ int RunDepthPriorExtractor(int argc, char** argv);
 // Registers all station clouds (BSC + RANSAC + ICP), builds the LiDAR pose graph A_l and writes
 // pairs.txt, lidar_poses.txt and summary.txt.
 int RunLidarRegistrator(int argc, char** argv);
+int RunDeskewSweeps(int argc, char** argv);
 
 // The joint problem (reprojection + depth priors + LiDAR point-to-plane + cam_from_lidar) inside COLMAP's
 // bundle adjuster on a sparse model; writes the refined model, cam_from_lidar.txt, report.json, plots.

@@ -1,6 +1,7 @@
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "bridge/lidar_registration_files.h"
+#include "colmap_ext/atomic_file.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "colmap_ext/station_dataset.h"
@@ -8,6 +9,7 @@
 #include "lidar/lidar_pose_graph.h"
 
 #include "colmap/controllers/option_manager.h"
+#include "colmap/scene/reconstruction.h"
 
 #include <algorithm>
 #include <chrono>
@@ -183,52 +185,33 @@ LidarGraph RegisterClouds(const std::vector<fs::path>& files,
   });
 }
 
-// Frames apart: the difference of two numeric names (KITTI's %010d, possibly imported with a step),
-// else 1.
-double FramesApart(const std::string& a, const std::string& b) {
-  try {
-    size_t used_a = 0, used_b = 0;
-    const long long index_a = std::stoll(a, &used_a), index_b = std::stoll(b, &used_b);
-    if (used_a == a.size() && used_b == b.size() && index_a != index_b) {
-      return static_cast<double>(index_b - index_a);
+// The frame index of each station: its name when every name is a number (KITTI's %010d, possibly
+// imported with a step), else its position in name order.
+std::vector<double> FrameIndices(const std::vector<std::string>& names) {
+  std::vector<double> frames;
+  for (const std::string& name : names) {
+    size_t used = 0;
+    try {
+      frames.push_back(static_cast<double>(std::stoll(name, &used)));
+    } catch (const std::exception&) {
+      used = 0;
     }
-  } catch (const std::exception&) {
+    if (used != name.size() || used == 0) {
+      frames.clear();
+      for (size_t i = 0; i < names.size(); ++i) frames.push_back(static_cast<double>(i));
+      return frames;
+    }
   }
-  return 1.0;
+  return frames;
 }
 
-// The motion per frame from station i to station j (their registered poses, divided by the frames
-// between them), or nullopt when they are not in one component.
-std::optional<Eigen::Isometry3d> MotionPerFrame(const std::vector<std::string>& names,
-                                                const LidarGraph& graph,
-                                                size_t i,
-                                                size_t j) {
-  if (j >= names.size() || graph.component[i] != graph.component[j]) return std::nullopt;
-  const Eigen::Isometry3d i_from_j =
-      graph.world_from_lidar[i].inverse() * graph.world_from_lidar[j];
-  const double per_frame = 1.0 / std::abs(FramesApart(names[i], names[j]));
-  const Eigen::AngleAxisd rotation(i_from_j.rotation());
-  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-  motion.linear() =
-      Eigen::AngleAxisd(per_frame * rotation.angle(), rotation.axis()).toRotationMatrix();
-  motion.translation() = per_frame * i_from_j.translation();
-  return motion;
-}
-
-// Each station's sweep motion from its neighbours in name order (one missing: the other mirrored;
-// both: none).
+// Each station's sweep motion from its neighbours in name order (frames from numeric names).
 std::vector<SweepMotion> SweepMotions(const std::vector<std::string>& names,
                                       const LidarGraph& graph) {
-  std::vector<SweepMotion> motions(names.size());
-  for (size_t i = 0; i < names.size(); ++i) {
-    const auto next = MotionPerFrame(names, graph, i, i + 1);
-    const auto previous = i > 0 ? MotionPerFrame(names, graph, i, i - 1) : std::nullopt;
-    if (next) motions[i].mid_from_next_mid = *next;
-    if (previous) motions[i].mid_from_previous_mid = *previous;
-    if (next && !previous) motions[i].mid_from_previous_mid = next->inverse();
-    if (previous && !next) motions[i].mid_from_next_mid = previous->inverse();
-  }
-  return motions;
+  std::vector<Eigen::Isometry3d> world_from_lidar(graph.world_from_lidar.begin(),
+                                                  graph.world_from_lidar.end());
+  std::vector<int> component(graph.component.begin(), graph.component.end());
+  return SweepMotionsFromPoses(world_from_lidar, FrameIndices(names), component);
 }
 
 }  // namespace
@@ -262,6 +245,58 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
     std::cout << "lidar_registrator: WARNING: the stations form " << graph.num_components
               << " disconnected components (see summary.txt)" << std::endl;
   }
+}
+
+void RunDeskewSweepsStep(const StationDataset& dataset,
+                         const std::string& model_path,
+                         const std::string& output_path) {
+  if (!dataset.rig.lidar_sweep) {
+    throw std::runtime_error(dataset.root +
+                             "/rig.json has no lidar.sweep: its clouds are not sweeps of a moving "
+                             "platform, and there is nothing to de-skew");
+  }
+  SweepTimingOptions timing;
+  timing.start_azimuth_deg = dataset.rig.lidar_sweep->start_azimuth_deg;
+  timing.counter_clockwise = dataset.rig.lidar_sweep->counter_clockwise;
+  colmap::Reconstruction model;
+  model.Read(model_path);
+  const Eigen::Isometry3d cam_from_lidar =
+      ToIsometry(ReadPoseFile((fs::path(model_path) / "cam_from_lidar.txt").string()));
+  // Stations outside the model get a component of their own: their neighbours' motion is mirrored.
+  std::vector<Eigen::Isometry3d> world_from_lidar(dataset.stations.size(),
+                                                  Eigen::Isometry3d::Identity());
+  std::vector<int> component(dataset.stations.size());
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    const colmap::Image* image = model.FindImageWithName(dataset.LeftImageName(i));
+    component[i] = image ? 0 : static_cast<int>(i) + 1;
+    if (image)
+      world_from_lidar[i] = ToIsometry(colmap::Inverse(image->CamFromWorld())) * cam_from_lidar;
+  }
+  const std::vector<SweepMotion> motions =
+      SweepMotionsFromPoses(world_from_lidar, FrameIndices(dataset.stations), component);
+  PartialOutputFolder partial(output_path);
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    const PointCloud raw = ReadStationCloud(dataset.cloud_paths[i]);
+    WritePointCloud(partial.File(dataset.stations[i] + ".pcd"),
+                    DeskewSweep(raw, motions[i], timing));
+  }
+  partial.Commit();
+  std::cout << "deskew_sweeps: " << dataset.stations.size()
+            << " sweeps de-skewed with the motion of " << model_path << " into " << output_path
+            << std::endl;
+}
+
+int RunDeskewSweeps(int argc, char** argv) {
+  std::string dataset_path, input_path, output_path;
+  colmap::OptionManager manager;
+  manager.AddRequiredOption(
+      "dataset_path", &dataset_path, "raw sweeps in DATASET/lidar; rig.json with lidar.sweep");
+  manager.AddRequiredOption(
+      "input_path", &input_path, "a model with cam_from_lidar.txt (joint_adjuster's output)");
+  manager.AddRequiredOption("output_path", &output_path, "folder for <station>.pcd");
+  manager.Parse(argc, argv);
+  RunDeskewSweepsStep(ReadStationDataset(dataset_path), input_path, output_path);
+  return EXIT_SUCCESS;
 }
 
 int RunLidarRegistrator(int argc, char** argv) {
