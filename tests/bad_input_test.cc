@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -242,10 +243,11 @@ std::vector<BadInputCase> Cases() {
        {"001"}},
       {"image_of_another_size",
        [](const fs::path& d) {
-         fs::copy_file(d / "images/left/000.png", d / "images/left/000b.png");
+         cv::imwrite((d / "images/left/001.png").string(),
+                     cv::Mat(30, 40, CV_8UC1, cv::Scalar(128)));
        },
        import,
-       {"000b"}},
+       {"001.png", "40"}},
       {"missing_rig", [](const fs::path& d) { fs::remove(d / "rig.json"); }, import, {"rig.json"}},
       {"database_from_another_program",
        [](const fs::path& d) {
