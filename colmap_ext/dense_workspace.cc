@@ -17,6 +17,32 @@ namespace fs = std::filesystem;
 
 void EnsureParent(const std::string& path) { fs::create_directories(fs::path(path).parent_path()); }
 
+// COLMAP's depth and normal map files are "width&height&depth&" and width x height x depth float32.
+// COLMAP's reader trusts the header (a claimed 10^6 x 10^6 map is allocated); ours is checked first
+// against the file's size.
+void CheckColmapMatrixFile(const std::string& path, size_t channels) {
+  std::ifstream file(path, std::ios::binary);
+  size_t dims[3] = {0, 0, 0};
+  for (size_t& dim : dims) {
+    std::string digits;
+    char c = 0;
+    while (file.get(c) && c != '&' && digits.size() < 10) digits.push_back(c);
+    if (c != '&' || digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) {
+      throw std::runtime_error(
+          "Not a COLMAP depth or normal map (no width&height&depth& header): " + path);
+    }
+    dim = std::stoul(digits);
+  }
+  const uint64_t expected = uint64_t(dims[0]) * dims[1] * dims[2] * sizeof(float);
+  const uint64_t present = fs::file_size(path) - static_cast<uint64_t>(file.tellg());
+  if (dims[2] != channels || dims[0] == 0 || dims[1] == 0 || expected != present) {
+    throw std::runtime_error("Not a COLMAP map of " + std::to_string(channels) +
+                             " channel(s): " + path + " claims " + std::to_string(dims[0]) + "x" +
+                             std::to_string(dims[1]) + "x" + std::to_string(dims[2]) +
+                             " floats in " + std::to_string(present) + " bytes");
+  }
+}
+
 }  // namespace
 
 bool IsPinholeCamera(const colmap::Camera& camera) {
@@ -28,6 +54,7 @@ cv::Mat ReadColmapDepthMap(const std::string& path) {
   if (!fs::is_regular_file(path)) {
     throw std::runtime_error("No depth map at " + path);
   }
+  CheckColmapMatrixFile(path, 1);
   colmap::mvs::DepthMap map;
   try {
     map.Read(path);
@@ -146,6 +173,7 @@ cv::Mat DenseWorkspace::ReadNormalMap(const std::string& image_name) const {
   if (!fs::is_regular_file(path)) {
     throw std::runtime_error("No normal map at " + path);
   }
+  CheckColmapMatrixFile(path, 3);
   colmap::mvs::NormalMap map;
   map.Read(path);
   if (map.GetDepth() != 3) {

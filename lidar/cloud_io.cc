@@ -135,10 +135,15 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
   const PcdHeader header = ReadPcdHeader(path);
   pcl::PCLPointCloud2 blob;
   pcl::PCDReader reader;
-  if (reader.read(path, blob) < 0) {
-    Fail(path,
-         "PCL's PCD reader rejected it (truncated or malformed; see "
-         "the message above)");
+  int status = -1;
+  try {
+    status = reader.read(path, blob);
+  } catch (
+      const std::exception& error) {  // PCL throws on some headers ours accepts (std::out_of_range)
+    Fail(path, std::string("PCL's PCD reader failed: ") + error.what());
+  }
+  if (status < 0) {
+    Fail(path, "PCL's PCD reader rejected it (truncated or malformed; see the message above)");
   }
   auto find = [&](const std::string& name) -> const pcl::PCLPointField* {
     for (const auto& f : blob.fields) {

@@ -1,0 +1,37 @@
+// libFuzzer target: our parsers of the text files a user writes or edits by hand (FUZZ_FILE): rig.json
+// (colmap_ext ReadRigJson), cam_from_world.txt / lidar_poses.txt (ReadNamedPoses), cam_from_lidar.txt
+// (ReadPoseFile) and pairs.txt (bridge ReadLidarPairs). Errors are std::exception with the file named;
+// anything else is a finding.
+#include "bridge/lidar_registration_files.h"
+#include "colmap_ext/station_dataset.h"
+
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <string>
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static const std::string path =
+      "/tmp/colmap_lidar_fuzz_" + std::to_string(getpid()) + "_" + FUZZ_FILE;
+  FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) return 0;
+  std::fwrite(data, 1, size, file);
+  std::fclose(file);
+  const std::string kind = FUZZ_FILE;
+  try {
+    if (kind == "rig.json") {
+      colmap_lidar::ReadRigJson(path);
+    } else if (kind == "cam_from_world.txt") {
+      colmap_lidar::ReadNamedPoses(path);
+    } else if (kind == "cam_from_lidar.txt") {
+      colmap_lidar::ReadPoseFile(path);
+    } else {
+      colmap_lidar::ReadLidarPairs(path);
+    }
+  } catch (const std::exception&) {
+  }
+  std::remove(path.c_str());
+  return 0;
+}
