@@ -199,20 +199,26 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
   const std::string evaluation = (ws / "evaluation").string();
   // A monocular rig has no stereo steps and no stereo depth for the densifier.
   const bool stereo_rig = dataset.rig.IsStereo();
-  std::vector<PipelineStep> steps = {
-      {"import_dataset", [=, &dataset] { RunImportStep(dataset, database, options.import); }}};
+  const PipelineStep registrator = {
+      "lidar_registrator", [=, &dataset] {
+        RunLidarRegistratorStep(
+            (fs::path(dataset.root) / "lidar").string(), lidar, options.registrator);
+      }};
+  // The spatial matcher matches only images of stations near in the LiDAR registration: the LiDAR
+  // registration runs first (no N^2 image pairs on large surveys).
+  const bool lidar_first = options.import.import.matcher == "spatial";
+  std::vector<PipelineStep> steps;
+  if (lidar_first) steps.push_back(registrator);
+  steps.push_back(
+      {"import_dataset", [=, &dataset] { RunImportStep(dataset, database, options.import); }});
   if (stereo_rig) {
     steps.push_back(
         {"stereo_depth", [=, &dataset] { RunStereoDepthStep(dataset, stereo, options.stereo); }});
     steps.push_back({"depth_prior_extractor",
                      [=] { RunDepthPriorStep(database, stereo, options.depth_prior); }});
   }
+  if (!lidar_first) steps.push_back(registrator);
   std::vector<PipelineStep> back_end = {
-      {"lidar_registrator",
-       [=, &dataset] {
-         RunLidarRegistratorStep(
-             (fs::path(dataset.root) / "lidar").string(), lidar, options.registrator);
-       }},
       {"pose_initializer",
        [=, &dataset] {
          RunPoseInitializerStep(dataset, {database, lidar, "", initial}, options.initializer);
@@ -316,6 +322,12 @@ int RunPipeline(int argc, char** argv) {
   manager.Parse(argc, argv);
   TakeColmapImportOptions(manager, &pipeline.import);
   pipeline.joint.mode = pipeline.mode;
+  if (pipeline.import.import.matcher == "spatial" &&
+      pipeline.import.lidar_registration_path.empty()) {
+    // The pipeline's own LiDAR registration, run before the import (PipelineSteps).
+    pipeline.import.lidar_registration_path =
+        (fs::path(pipeline.workspace_path) / "lidar").string();
+  }
   if (pipeline.mode == "stereo_only") pipeline.densifier.refine_with_lidar = false;
   // Every step's options are checked before the first step runs.
   THROW_CHECK(pipeline.import.Check());
