@@ -172,6 +172,47 @@ void CheckDataSize(const std::string& path, std::ifstream& file, const PcdHeader
   }
 }
 
+// PCL's header parser does not stop at DATA: it goes on reading lines that are empty, comments or start
+// with a header keyword (a prefix match: "DATA1", "COLUMNSx"), and acts on them (a stray "COLUMNS" line
+// made it crash). A data section that PCL would take for header lines is refused.
+void CheckDataDoesNotLookLikeHeader(const std::string& path,
+                                    const std::string& prefix,
+                                    size_t begin,
+                                    int line) {
+  static const char* kKeywords[] = {"VERSION",
+                                    "FIELDS",
+                                    "COLUMNS",
+                                    "SIZE",
+                                    "TYPE",
+                                    "COUNT",
+                                    "WIDTH",
+                                    "HEIGHT",
+                                    "VIEWPOINT",
+                                    "POINTS",
+                                    "DATA"};
+  while (begin < prefix.size()) {
+    size_t end = prefix.find('\n', begin);
+    if (end == std::string::npos) end = prefix.size();
+    const std::string text = prefix.substr(begin, end - begin);
+    begin = end + 1;
+    ++line;
+    const size_t first = text.find_first_not_of("\t\r ");
+    if (text.empty()) continue;
+    const std::string token =
+        first == 0 ? text.substr(0, text.find_first_of("\t\r ")) : std::string();
+    if (token.rfind('#', 0) == 0) continue;
+    for (const char* keyword : kKeywords) {
+      if (token.rfind(keyword, 0) == 0) {
+        FailAt(path,
+               line,
+               "the data after DATA starts with '" + std::string(keyword) +
+                   "', which PCL would read as a header line");
+      }
+    }
+    return;
+  }
+}
+
 }  // namespace
 
 PcdHeader ReadPcdHeader(const std::string& path) {
@@ -186,6 +227,7 @@ PcdHeader ReadPcdHeader(const std::string& path) {
   FieldLines lines;
   bool data_seen = false;
   size_t begin = 0;
+  int data_line = 0;
   for (int number = 1; !data_seen && begin < prefix.size(); ++number) {
     size_t end = prefix.find('\n', begin);
     if (end == std::string::npos) end = prefix.size();
@@ -196,8 +238,10 @@ PcdHeader ReadPcdHeader(const std::string& path) {
     }
     if (!text.empty() && text.back() == '\r') text.pop_back();
     data_seen = ParseLine(path, number, text, &lines, &header);
+    data_line = number;
   }
   if (!data_seen) Fail(path, "no DATA line in the PCD header (not a PCD file, or truncated)");
+  CheckDataDoesNotLookLikeHeader(path, prefix, begin, data_line);
   header.data_offset = std::min<uint64_t>(begin, std::filesystem::file_size(path));
   BuildFields(path, lines, &header);
   if (header.width == 0 || header.height == 0) Fail(path, "PCD header has WIDTH or HEIGHT 0");
