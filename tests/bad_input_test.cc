@@ -11,12 +11,15 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace colmap_lidar {
@@ -278,6 +281,39 @@ std::vector<BadInputCase> Cases() {
        registrator,
        {"lidar"}},
   };
+}
+
+// Two pipelines on one workspace: the second is refused with the holder's pid and touches nothing;
+// once the first has ended (its lock released by the kernel), the workspace is free again.
+TEST(WorkspaceLockTest, ASecondPipelineOnTheWorkspaceIsRefused) {
+  testing::ScopedTempDir dir("colmap_lidar_lock");
+  sim::SimulationOptions options;
+  options.output_path = dir.File("dataset");
+  options.num_stations = 3;
+  options.image_scale = 0.25;
+  options.lidar_points = 20000;
+  sim::SimulateDataset(options);
+  const std::string pipeline = kCli + " pipeline --dataset_path " + dir.File("dataset") +
+                               " --workspace_path " + dir.File("ws");
+  ASSERT_EQ(std::system((pipeline + " > " + dir.File("first.log") + " 2>&1 &").c_str()), 0);
+  const fs::path lock = dir.Path() / "ws" / "pipeline.lock";
+  for (int i = 0; i < 300 && (!fs::exists(lock) || fs::file_size(lock) == 0); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_TRUE(fs::exists(lock));
+  const testing::CommandResult second = RunCommand(pipeline);
+  EXPECT_EQ(second.exit_code, 1) << second.output;
+  const std::vector<std::string> errors = ErrorLines(second.output);
+  ASSERT_EQ(errors.size(), 1u) << second.output;
+  EXPECT_NE(errors[0].find("in use by another pipeline (pid "), std::string::npos) << errors[0];
+  // After the first ends, a rerun gets the workspace (finished steps are skipped).
+  testing::CommandResult rerun;
+  for (int i = 0; i < 300; ++i) {
+    rerun = RunCommand(pipeline);
+    if (rerun.output.find("in use by another pipeline") == std::string::npos) break;
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+  EXPECT_EQ(rerun.output.find("in use by another pipeline"), std::string::npos) << rerun.output;
 }
 
 INSTANTIATE_TEST_SUITE_P(Matrix,

@@ -2,6 +2,7 @@
 #include "bridge/exe/commands.h"
 #include "bridge/exe/step_resources.h"
 #include "bridge/exe/steps.h"
+#include "bridge/exe/workspace_lock.h"
 #include "bridge/lidar_registration_files.h"
 #include "bridge/model_completion.h"
 #include "bridge/pose_initializer.h"
@@ -355,6 +356,7 @@ int RunPipeline(int argc, char** argv) {
               << std::endl;
   }
   const fs::path ws(pipeline.workspace_path);
+  const WorkspaceLock lock(pipeline.workspace_path);
   fs::create_directories(ws / "steps");
   fs::create_directories(ws / "sparse");
   RunSteps(PipelineSteps(dataset, pipeline), ws, pipeline.overwrite);
