@@ -97,7 +97,7 @@ std::string RunDrive(const testing::ScopedTempDir& dir, int num_frames, bool gue
   const auto import =
       RunCommand(kCli + " import_kitti --kitti_path " + dir.File("kitti/drive") + " --calib_path " +
                  dir.File("kitti/calibration") + " --output_path " + dir.File("dataset") +
-                 (guess ? " --write_guess 1 --seed 1" : ""));
+                 (guess ? " --write_guess 1 --guess_rotation_deg 1 --seed 1" : ""));
   EXPECT_EQ(import.exit_code, 0) << import.output;
   // No --LidarRegistrator.deskew_sweeps: import_kitti marks the clouds as sweeps in rig.json.
   const auto run =
@@ -112,6 +112,10 @@ std::string RunDrive(const testing::ScopedTempDir& dir, int num_frames, bool gue
   return run.output;
 }
 
+// The guess is 1 deg / 5 cm off: from the simulator's usual 3 deg, 20 frames ended at 1.47 deg in one
+// of about six runs (COLMAP's matching differs from run to run; the associations of the first round
+// start 1 m off at 20 m range). What this test checks is the hold of the unobservable directions; the
+// convergence without any guess is the 40-frame test's.
 TEST(PipelineMonoTest, KittiLayoutDriveHoldsWhatItCannotSee) {
   testing::ScopedTempDir dir;
   RunDrive(dir, 20, true);

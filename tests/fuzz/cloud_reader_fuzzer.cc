@@ -4,8 +4,7 @@
 // line); anything else (a crash, a sanitizer report, a hang, an allocation above libFuzzer's
 // -malloc_limit_mb) is a finding.
 #include "lidar/cloud_io.h"
-
-#include <unistd.h>
+#include "tests/fuzz/fuzz_input_file.h"
 
 #include <cstdint>
 #include <cstdio>
@@ -13,12 +12,8 @@
 #include <string>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const std::string path =
-      "/tmp/colmap_lidar_fuzz_" + std::to_string(getpid()) + FUZZ_EXTENSION;
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) return 0;
-  std::fwrite(data, 1, size, file);
-  std::fclose(file);
+  const std::string path = colmap_lidar::WriteFuzzInput(data, size, FUZZ_EXTENSION);
+  if (path.empty()) return 0;
   try {
     colmap_lidar::ReadStationCloud(path);
   } catch (const std::exception&) {

@@ -1,8 +1,7 @@
 // libFuzzer target: COLMAP depth maps as our densifier reads them (colmap_ext ReadColmapDepthMap: our
 // header check, then COLMAP's reader). Errors are std::exception; anything else is a finding.
 #include "colmap_ext/dense_workspace.h"
-
-#include <unistd.h>
+#include "tests/fuzz/fuzz_input_file.h"
 
 #include <cstdint>
 #include <cstdio>
@@ -10,12 +9,8 @@
 #include <string>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const std::string path =
-      "/tmp/colmap_lidar_fuzz_" + std::to_string(getpid()) + ".geometric.bin";
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) return 0;
-  std::fwrite(data, 1, size, file);
-  std::fclose(file);
+  const std::string path = colmap_lidar::WriteFuzzInput(data, size, ".geometric.bin");
+  if (path.empty()) return 0;
   try {
     colmap_lidar::ReadColmapDepthMap(path);
   } catch (const std::exception&) {

@@ -4,8 +4,7 @@
 // anything else is a finding.
 #include "bridge/lidar_registration_files.h"
 #include "colmap_ext/station_dataset.h"
-
-#include <unistd.h>
+#include "tests/fuzz/fuzz_input_file.h"
 
 #include <cstdint>
 #include <cstdio>
@@ -13,12 +12,8 @@
 #include <string>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const std::string path =
-      "/tmp/colmap_lidar_fuzz_" + std::to_string(getpid()) + "_" + FUZZ_FILE;
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) return 0;
-  std::fwrite(data, 1, size, file);
-  std::fclose(file);
+  const std::string path = colmap_lidar::WriteFuzzInput(data, size, std::string("_") + FUZZ_FILE);
+  if (path.empty()) return 0;
   const std::string kind = FUZZ_FILE;
   try {
     if (kind == "rig.json") {
