@@ -90,12 +90,7 @@ class BadInputTest : public ::testing::TestWithParam<BadInputCase> {
  protected:
   static void SetUpTestSuite() {
     dir_ = new testing::ScopedTempDir("colmap_lidar_bad_input");
-    sim::SimulationOptions options;
-    options.output_path = dir_->File("dataset");
-    options.num_stations = 3;
-    options.image_scale = 0.25;
-    options.lidar_points = 20000;
-    sim::SimulateDataset(options);
+    sim::SimulateSmallDataset(dir_->File("dataset"), 3, 0.25, 20000);
   }
   static void TearDownTestSuite() { delete dir_; }
   static testing::ScopedTempDir* dir_;
@@ -287,12 +282,7 @@ std::vector<BadInputCase> Cases() {
 // once the first has ended (its lock released by the kernel), the workspace is free again.
 TEST(WorkspaceLockTest, ASecondPipelineOnTheWorkspaceIsRefused) {
   testing::ScopedTempDir dir("colmap_lidar_lock");
-  sim::SimulationOptions options;
-  options.output_path = dir.File("dataset");
-  options.num_stations = 3;
-  options.image_scale = 0.25;
-  options.lidar_points = 20000;
-  sim::SimulateDataset(options);
+  sim::SimulateSmallDataset(dir.File("dataset"), 3, 0.25, 20000);
   const std::string pipeline = kCli + " pipeline --dataset_path " + dir.File("dataset") +
                                " --workspace_path " + dir.File("ws");
   ASSERT_EQ(std::system((pipeline + " > " + dir.File("first.log") + " 2>&1 &").c_str()), 0);

@@ -27,13 +27,8 @@ nlohmann::json ReadJson(const std::string& path) {
 class EvaluatorCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    sim::SimulationOptions options;
-    options.output_path = dir_.File("dataset");
-    options.num_stations = 4;
-    options.image_scale = 0.25;
-    options.lidar_points = 5000;
-    sim::SimulateDataset(options);
-    dataset_ = ReadStationDataset(options.output_path);
+    sim::SimulateSmallDataset(dir_.File("dataset"), 4, 0.25, 5000);
+    dataset_ = ReadStationDataset(dir_.File("dataset"));
   }
   testing::ScopedTempDir dir_;
   StationDataset dataset_;

@@ -73,12 +73,7 @@ void ExpectConsistentWorkspace(const fs::path& ws, const std::string& when) {
 
 TEST(KillRerunTest, KilledAtTenMomentsTheRerunGivesTheSameCalibration) {
   testing::ScopedTempDir dir("colmap_lidar_kill");
-  sim::SimulationOptions options;
-  options.output_path = dir.File("dataset");
-  options.num_stations = 6;
-  options.image_scale = 0.5;
-  options.lidar_points = 60000;
-  sim::SimulateDataset(options);
+  sim::SimulateSmallDataset(dir.File("dataset"), 6, 0.5, 60000);
 
   const auto start = std::chrono::steady_clock::now();
   const pid_t reference =

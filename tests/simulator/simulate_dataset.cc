@@ -186,5 +186,17 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
   return result;
 }
 
+SimulationResult SimulateSmallDataset(const std::string& output_path,
+                                      int num_stations,
+                                      double image_scale,
+                                      size_t lidar_points) {
+  SimulationOptions options;
+  options.output_path = output_path;
+  options.num_stations = num_stations;
+  options.image_scale = image_scale;
+  options.lidar_points = lidar_points;
+  return SimulateDataset(options);
+}
+
 }  // namespace sim
 }  // namespace colmap_lidar

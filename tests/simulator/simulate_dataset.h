@@ -56,5 +56,12 @@ struct SimulationResult {
 // run never leaves a dataset that looks complete. Prints a progress line per station.
 SimulationResult SimulateDataset(const SimulationOptions& options);
 
+// A small dataset of the default scene for tests: `num_stations` stations, images scaled by
+// `image_scale`, `lidar_points` rays per station, every other option at its default.
+SimulationResult SimulateSmallDataset(const std::string& output_path,
+                                      int num_stations,
+                                      double image_scale,
+                                      size_t lidar_points);
+
 }  // namespace sim
 }  // namespace colmap_lidar
