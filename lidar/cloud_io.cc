@@ -114,7 +114,7 @@ double ReadPcdValue(const pcl::PCLPointField& field, const uint8_t* data) {
   }
 }
 
-// Bytes of one value of a PCL field type (0: unknown).
+// Bytes of one value of a PCL field type (4: FLOAT32, INT32, UINT32).
 int PcdValueBytes(const pcl::PCLPointField& field) {
   switch (field.datatype) {
     case pcl::PCLPointField::INT8:
@@ -136,10 +136,10 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
   pcl::PCLPointCloud2 blob;
   pcl::PCDReader reader;
   int status = -1;
+  // PCL throws on some headers ours accepted (std::out_of_range); the fuzzers found one.
   try {
     status = reader.read(path, blob);
-  } catch (
-      const std::exception& error) {  // PCL throws on some headers ours accepts (std::out_of_range)
+  } catch (const std::exception& error) {
     Fail(path, std::string("PCL's PCD reader failed: ") + error.what());
   }
   if (status < 0) {

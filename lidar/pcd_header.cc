@@ -35,6 +35,15 @@ uint64_t ParseCount(const std::string& path, int line, const std::string& token)
   return std::stoull(token);
 }
 
+// The line of `text` that starts at *begin (without its '\n'); *begin moves past it.
+std::string NextLine(const std::string& text, size_t* begin) {
+  size_t end = text.find('\n', *begin);
+  if (end == std::string::npos) end = text.size();
+  std::string line = text.substr(*begin, end - *begin);
+  *begin = end + 1;
+  return line;
+}
+
 std::vector<std::string> Tokens(std::istringstream& line) {
   std::vector<std::string> tokens;
   std::string token;
@@ -191,10 +200,7 @@ void CheckDataDoesNotLookLikeHeader(const std::string& path,
                                     "POINTS",
                                     "DATA"};
   while (begin < prefix.size()) {
-    size_t end = prefix.find('\n', begin);
-    if (end == std::string::npos) end = prefix.size();
-    const std::string text = prefix.substr(begin, end - begin);
-    begin = end + 1;
+    const std::string text = NextLine(prefix, &begin);
     ++line;
     const size_t first = text.find_first_not_of("\t\r ");
     if (text.empty()) continue;
@@ -229,10 +235,7 @@ PcdHeader ReadPcdHeader(const std::string& path) {
   size_t begin = 0;
   int data_line = 0;
   for (int number = 1; !data_seen && begin < prefix.size(); ++number) {
-    size_t end = prefix.find('\n', begin);
-    if (end == std::string::npos) end = prefix.size();
-    std::string text = prefix.substr(begin, end - begin);
-    begin = end + 1;
+    std::string text = NextLine(prefix, &begin);
     if (text.find('\0') != std::string::npos) {
       FailAt(path, number, "binary bytes (not a PCD header)");
     }

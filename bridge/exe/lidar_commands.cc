@@ -208,10 +208,7 @@ std::vector<double> FrameIndices(const std::vector<std::string>& names) {
 // Each station's sweep motion from its neighbours in name order (frames from numeric names).
 std::vector<SweepMotion> SweepMotions(const std::vector<std::string>& names,
                                       const LidarGraph& graph) {
-  std::vector<Eigen::Isometry3d> world_from_lidar(graph.world_from_lidar.begin(),
-                                                  graph.world_from_lidar.end());
-  std::vector<int> component(graph.component.begin(), graph.component.end());
-  return SweepMotionsFromPoses(world_from_lidar, FrameIndices(names), component);
+  return SweepMotionsFromPoses(graph.world_from_lidar, FrameIndices(names), graph.component);
 }
 
 }  // namespace
@@ -266,11 +263,19 @@ void RunDeskewSweepsStep(const StationDataset& dataset,
   std::vector<Eigen::Isometry3d> world_from_lidar(dataset.stations.size(),
                                                   Eigen::Isometry3d::Identity());
   std::vector<int> component(dataset.stations.size());
+  size_t num_in_model = 0;
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
     const colmap::Image* image = model.FindImageWithName(dataset.LeftImageName(i));
     component[i] = image ? 0 : static_cast<int>(i) + 1;
-    if (image)
+    if (image) {
       world_from_lidar[i] = ToIsometry(colmap::Inverse(image->CamFromWorld())) * cam_from_lidar;
+      ++num_in_model;
+    }
+  }
+  if (num_in_model < 2) {
+    throw std::runtime_error(model_path + " holds " + std::to_string(num_in_model) +
+                             " of the station images of " + dataset.root + " (named like " +
+                             dataset.LeftImageName(0) + "): no trajectory to de-skew with");
   }
   const std::vector<SweepMotion> motions =
       SweepMotionsFromPoses(world_from_lidar, FrameIndices(dataset.stations), component);

@@ -16,20 +16,18 @@ double ProcessCpuSeconds() {
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
-// "5" resets the peak resident set size (VmHWM) of the process (Linux >= 4.0).
-bool ResetPeakResident() {
+// "5" resets the peak resident set size (VmHWM) of the process (Linux >= 4.0; ignored before).
+void ResetPeakResident() {
   std::ofstream clear_refs("/proc/self/clear_refs");
   clear_refs << "5";
-  clear_refs.flush();
-  return static_cast<bool>(clear_refs);
 }
 
 }  // namespace
 
 StepResources::StepResources()
-    : wall_start_(std::chrono::steady_clock::now()),
-      cpu_start_(ProcessCpuSeconds()),
-      peak_is_per_step_(ResetPeakResident()) {}
+    : wall_start_(std::chrono::steady_clock::now()), cpu_start_(ProcessCpuSeconds()) {
+  ResetPeakResident();
+}
 
 double StepResources::WallSeconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();

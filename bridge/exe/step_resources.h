@@ -1,7 +1,7 @@
 // What one pipeline step costs: wall time, CPU time (every thread of the process) and peak resident
 // memory. Linux only: getrusage(RUSAGE_SELF) and VmHWM of /proc/self/status, whose high-water mark is
-// reset through /proc/self/clear_refs at the start so that each step has its own peak (where the
-// kernel refuses the reset, the peak is the process's so far and `peak_is_per_step` says so).
+// reset through /proc/self/clear_refs at the start so that each step has its own peak (on a kernel
+// older than Linux 4.0, which has no reset, the peak is the process's so far).
 #pragma once
 
 #include <chrono>
@@ -16,12 +16,10 @@ class StepResources {
   double WallSeconds() const;
   double CpuSeconds() const;
   double PeakResidentMiB() const;
-  bool PeakIsPerStep() const { return peak_is_per_step_; }
 
  private:
   std::chrono::steady_clock::time_point wall_start_;
   double cpu_start_ = 0;
-  bool peak_is_per_step_ = false;
 };
 
 }  // namespace colmap_lidar
