@@ -6,6 +6,7 @@
 #include "colmap_ext/logging.h"
 #include "colmap_ext/stereo_depth_files.h"
 #include "lidar/cloud_io.h"
+#include "lidar/parallel_for_each.h"
 #include "lidar/pinhole_depth_image.h"
 #include "lidar/voxel_accumulator.h"
 
@@ -20,6 +21,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <mutex>
 
 namespace colmap_lidar {
 namespace {
@@ -167,8 +169,8 @@ cv::Mat ReadImageDepth(const std::string& depth_path,
   return stereo;
 }
 
-// Fold 1 and 2 for one station; writes its maps, image and preview into the workspace and adds its
-// LiDAR cloud to the LiDAR map.
+// Fold 1 and 2 for one station; writes its maps, image and preview into the workspace and returns
+// its LiDAR cloud in the world frame (for the LiDAR map) in `points_in_world`.
 StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
                                    const StationView& view,
                                    const colmap::Rigid3d& cam_from_lidar,
@@ -178,7 +180,7 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
                                    const DensifierOptions& options,
                                    const colmap::Camera& original_camera,
                                    const CameraUndistorter* undistorter,
-                                   VoxelAccumulator* lidar_map) {
+                                   std::vector<Eigen::Vector3d>* points_in_world) {
   const std::string& station = dataset.stations[view.station];
   StationDensification result;
   result.station = station;
@@ -194,9 +196,10 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   const PointCloud cloud = ReadStationCloud(dataset.cloud_paths[view.station]);
   const colmap::Rigid3d world_from_lidar = colmap::Inverse(image.CamFromWorld()) * cam_from_lidar;
   std::vector<Eigen::Vector3d> in_view;
+  points_in_world->clear();
+  points_in_world->reserve(cloud.Size());
   for (const Eigen::Vector3d& point_in_lidar : cloud.points) {
-    lidar_map->Add(
-        world_from_lidar * point_in_lidar, Eigen::Vector3f::Zero(), Color3ub(128, 128, 128));
+    points_in_world->push_back(world_from_lidar * point_in_lidar);
     const Eigen::Vector3d point_in_cam = cam_from_lidar * point_in_lidar;
     Eigen::Vector2d xy;
     if (point_in_cam.z() < options.min_depth_m || point_in_cam.z() > options.max_depth_m ||
@@ -464,11 +467,16 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
                 : options.refine_with_lidar ? "LiDAR-refined"
                                             : "stereo only")
             << std::endl;
-  for (size_t k = 0; k < views.size(); ++k) {
+  // Stations in parallel (each station's own loops then run on its thread alone).
+  summary.stations.resize(views.size());
+  std::mutex mutex;
+  size_t num_done = 0;
+  ParallelForEach(static_cast<int>(views.size()), [&](int k) {
     const auto station_start = std::chrono::steady_clock::now();
     const colmap::camera_t camera_id = input_model.Image(views[k].image_id).CameraId();
     const auto undistorter = undistorters.find(camera_id);
-    summary.stations.push_back(
+    std::vector<Eigen::Vector3d> points_in_world;
+    StationDensification station =
         RefineStation(reconstruction,
                       views[k],
                       cam_from_lidar,
@@ -478,10 +486,22 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
                       options,
                       input_model.Camera(camera_id),
                       undistorter == undistorters.end() ? nullptr : undistorter->second.get(),
-                      &lidar_map));
-    summary.stations.back().seconds = SecondsSince(station_start);
-    PrintStation(k, views.size(), summary.stations.back());
-  }
+                      &points_in_world);
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const Eigen::Vector3d& point : points_in_world) {
+      lidar_map.Add(point, Eigen::Vector3f::Zero(), Color3ub(128, 128, 128));
+    }
+    station.seconds = SecondsSince(station_start);
+    PrintStation(num_done++, views.size(), station);
+    summary.stations[k] = std::move(station);
+  });
+
+  PointCloud lidar_cloud = lidar_map.Extract();
+  lidar_map.Clear();
+  lidar_cloud.normals.clear();
+  summary.lidar_map_points = lidar_cloud.Size();
+  WritePointCloud(partial.File("lidar_map.ply"), lidar_cloud);
+  lidar_cloud = PointCloud();
 
   VoxelAccumulator fused(options.fused_voxel_size_m);
   for (size_t k = 0; k < views.size(); ++k) {
@@ -489,16 +509,13 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
     FuseStation(reconstruction, views, k, workspace, options, &summary.stations[k], &fused);
     summary.stations[k].seconds += SecondsSince(station_start);
   }
+  const size_t num_fused_points = fused.NumPointsAdded();
   const PointCloud fused_cloud = fused.Extract();
+  fused.Clear();
   summary.fused_points = fused_cloud.Size();
-  std::cout << "densifier: fused " << fused.NumPointsAdded() << " points into "
-            << fused_cloud.Size() << " voxels of " << options.fused_voxel_size_m * 1000 << " mm"
-            << std::endl;
+  std::cout << "densifier: fused " << num_fused_points << " points into " << fused_cloud.Size()
+            << " voxels of " << options.fused_voxel_size_m * 1000 << " mm" << std::endl;
   WritePointCloud(partial.File("fused.ply"), fused_cloud);
-  PointCloud lidar_cloud = lidar_map.Extract();
-  lidar_cloud.normals.clear();
-  summary.lidar_map_points = lidar_cloud.Size();
-  WritePointCloud(partial.File("lidar_map.ply"), lidar_cloud);
 
   workspace.WriteSparse(reconstruction);
   std::vector<std::string> names;

@@ -88,7 +88,8 @@ cv::Mat ComputeVerticallySymmetric(cv::StereoSGBM& matcher,
 
 // Left-right consistency: left disparities whose right match disagrees by more than max_diff_px, or
 // that lie outside the original image (mask 0), are set to 0. Returns |d_left - d_right| per kept
-// pixel, -1 elsewhere.
+// pixel, -1 elsewhere. Without a right disparity map (empty: SGBM checked already) only the mask
+// applies and kept pixels get 0.
 cv::Mat LeftRightCheck(const cv::Mat& right_disparity,
                        const cv::Mat& mask,
                        double max_diff_px,
@@ -98,9 +99,12 @@ cv::Mat LeftRightCheck(const cv::Mat& right_disparity,
     for (int col = 0; col < left_disparity->cols; ++col) {
       float& d = left_disparity->at<float>(row, col);
       if (d <= 0.f) continue;
-      const int right_col = static_cast<int>(std::lround(col - d));
-      const float d_right = right_col >= 0 ? right_disparity.at<float>(row, right_col) : 0.f;
-      const float diff = std::abs(d - d_right);
+      float diff = 0.f, d_right = d;
+      if (!right_disparity.empty()) {
+        const int right_col = static_cast<int>(std::lround(col - d));
+        d_right = right_col >= 0 ? right_disparity.at<float>(row, right_col) : 0.f;
+        diff = std::abs(d - d_right);
+      }
       if (mask.at<uchar>(row, col) == 0 || d_right <= 0.f || diff > max_diff_px) {
         d = 0.f;
       } else {
@@ -180,21 +184,23 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
   int min_disparity = 0, num_disparities = 0;
   DisparityRange(rectifier, options, &min_disparity, &num_disparities);
   const int area = options.block_size * options.block_size;
-  cv::Ptr<cv::StereoSGBM> matcher =
-      cv::StereoSGBM::create(min_disparity,
-                             num_disparities,
-                             options.block_size,
-                             options.p1_factor * area,
-                             options.p2_factor * area,
-                             /*disp12MaxDiff=*/-1,
-                             options.pre_filter_cap,
-                             options.uniqueness_ratio,
-                             options.speckle_window_size,
-                             static_cast<int>(std::ceil(options.speckle_range_px)),
-                             SgbmMode(options.mode));
+  cv::Ptr<cv::StereoSGBM> matcher = cv::StereoSGBM::create(
+      min_disparity,
+      num_disparities,
+      options.block_size,
+      options.p1_factor * area,
+      options.p2_factor * area,
+      /*disp12MaxDiff=*/options.mirrored_left_right_check
+          ? -1
+          : std::max(1, static_cast<int>(std::lround(options.max_left_right_diff_px))),
+      options.pre_filter_cap,
+      options.uniqueness_ratio,
+      options.speckle_window_size,
+      static_cast<int>(std::ceil(options.speckle_range_px)),
+      SgbmMode(options.mode));
 
-  // Left disparity, and the right image's disparity by matching the mirrored pair (the right image
-  // becomes the reference): d_right(x) = d such that right x matches left x + d.
+  // Left disparity (and, for the mirrored check, the right image's disparity by matching the mirrored
+  // pair, the right image as the reference: d_right(x) = d such that right x matches left x + d).
   // SGBM leaves the first min + num disparity columns invalid; padding the pair on the side of the
   // reference image's border keeps every pixel whose match lies inside the other image.
   const int pad = min_disparity + num_disparities;
@@ -210,14 +216,15 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
     }
     return fixed(cv::Rect(pad, 0, reference.cols, reference.rows)).clone();
   };
-  const cv::Mat left_fixed = match(left_rectified, right_rectified);
-  cv::Mat left_mirrored, right_mirrored, right_fixed;
-  cv::flip(left_rectified, left_mirrored, 1);
-  cv::flip(right_rectified, right_mirrored, 1);
-  cv::flip(match(right_mirrored, left_mirrored), right_fixed, 1);
-  cv::Mat left_disparity = ToPixels(left_fixed, min_disparity);
-  const cv::Mat right_disparity = ToPixels(right_fixed, min_disparity);
-
+  cv::Mat left_disparity = ToPixels(match(left_rectified, right_rectified), min_disparity);
+  cv::Mat right_disparity;
+  if (options.mirrored_left_right_check) {
+    cv::Mat left_mirrored, right_mirrored, right_fixed;
+    cv::flip(left_rectified, left_mirrored, 1);
+    cv::flip(right_rectified, right_mirrored, 1);
+    cv::flip(match(right_mirrored, left_mirrored), right_fixed, 1);
+    right_disparity = ToPixels(right_fixed, min_disparity);
+  }
   const cv::Mat lr_diff = LeftRightCheck(right_disparity,
                                          rectifier.LeftRectifiedMask(),
                                          options.max_left_right_diff_px,

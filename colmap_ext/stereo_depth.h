@@ -37,6 +37,11 @@ struct StereoDepthOptions {
   double speckle_range_px = 2.0;
   // Left-right check: |d_left(x) - d_right(x - d_left(x))| must not exceed this (pixels).
   double max_left_right_diff_px = 1.0;
+  // false: the right disparities come from the left pass's own aggregated costs (SGBM's disp12MaxDiff,
+  // as in Hirschmueller's SGM: the check costs nothing; whole pixels; the confidence map is then 255
+  // wherever there is depth). true: the mirrored pair is matched again with the right image as the
+  // reference (twice the time; sub-pixel check, and the confidence map grades the agreement).
+  bool mirrored_left_right_check = false;
   // stations in parallel; -1 = all cores
   int num_threads = -1;
 

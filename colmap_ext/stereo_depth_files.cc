@@ -130,7 +130,8 @@ void WriteStereoDepthInfo(const std::string& output_path,
                      {"uniqueness_ratio", options.uniqueness_ratio},
                      {"speckle_window_size", options.speckle_window_size},
                      {"speckle_range_px", options.speckle_range_px},
-                     {"max_left_right_diff_px", options.max_left_right_diff_px}};
+                     {"max_left_right_diff_px", options.max_left_right_diff_px},
+                     {"mirrored_left_right_check", options.mirrored_left_right_check}};
   for (const auto& [station, fraction] : info.valid_fraction) {
     json["valid_fraction"][station] = fraction;
   }

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -36,6 +37,9 @@ class CloudBuilder {
  public:
   CloudBuilder(bool normals, bool colors, bool intensities)
       : normals_(normals), colors_(colors), intensities_(intensities) {}
+
+  // Callers pass a count the file's bytes can hold, never a header's bare claim.
+  void Reserve(size_t num_points) { cloud_.Reserve(num_points, normals_, colors_, intensities_); }
 
   void Add(const Eigen::Vector3d& point,
            const Eigen::Vector3d& normal,
@@ -198,57 +202,95 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
 
 // ---------------------------------------------------------------- PLY
 
+enum class PlyType {
+  kUnknown,
+  kInt8,
+  kUint8,
+  kInt16,
+  kUint16,
+  kInt32,
+  kUint32,
+  kFloat32,
+  kFloat64
+};
+
 struct PlyProperty {
   std::string name;
   std::string type;
+  PlyType kind = PlyType::kUnknown;
   int size = 0;
 };
 
-int PlyTypeSize(const std::string& type) {
-  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
-      type == "float32")
-    return 4;
-  if (type == "double" || type == "float64") return 8;
-  return 0;
+// Both spellings of the PLY specification (char, int8, ...).
+PlyType ParsePlyType(const std::string& type) {
+  static const std::map<std::string, PlyType> kTypes = {{"char", PlyType::kInt8},
+                                                        {"int8", PlyType::kInt8},
+                                                        {"uchar", PlyType::kUint8},
+                                                        {"uint8", PlyType::kUint8},
+                                                        {"short", PlyType::kInt16},
+                                                        {"int16", PlyType::kInt16},
+                                                        {"ushort", PlyType::kUint16},
+                                                        {"uint16", PlyType::kUint16},
+                                                        {"int", PlyType::kInt32},
+                                                        {"int32", PlyType::kInt32},
+                                                        {"uint", PlyType::kUint32},
+                                                        {"uint32", PlyType::kUint32},
+                                                        {"float", PlyType::kFloat32},
+                                                        {"float32", PlyType::kFloat32},
+                                                        {"double", PlyType::kFloat64},
+                                                        {"float64", PlyType::kFloat64}};
+  const auto found = kTypes.find(type);
+  return found == kTypes.end() ? PlyType::kUnknown : found->second;
 }
 
-double DecodePly(const std::string& type, const char* data, bool swap) {
+int PlyTypeSize(PlyType kind) {
+  switch (kind) {
+    case PlyType::kInt8:
+    case PlyType::kUint8:
+      return 1;
+    case PlyType::kInt16:
+    case PlyType::kUint16:
+      return 2;
+    case PlyType::kInt32:
+    case PlyType::kUint32:
+    case PlyType::kFloat32:
+      return 4;
+    case PlyType::kFloat64:
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+template <typename T>
+double DecodeAs(const char* bytes) {
+  T value;
+  std::memcpy(&value, bytes, sizeof(T));
+  return static_cast<double>(value);
+}
+
+double DecodePly(const PlyProperty& property, const char* data, bool swap) {
   char buffer[8];
-  const int size = PlyTypeSize(type);
-  std::memcpy(buffer, data, size);
-  if (swap) std::reverse(buffer, buffer + size);
-  if (type == "float" || type == "float32") {
-    float v;
-    std::memcpy(&v, buffer, 4);
-    return v;
+  std::memcpy(buffer, data, property.size);
+  if (swap) std::reverse(buffer, buffer + property.size);
+  switch (property.kind) {
+    case PlyType::kInt8:
+      return DecodeAs<int8_t>(buffer);
+    case PlyType::kUint8:
+      return DecodeAs<uint8_t>(buffer);
+    case PlyType::kInt16:
+      return DecodeAs<int16_t>(buffer);
+    case PlyType::kUint16:
+      return DecodeAs<uint16_t>(buffer);
+    case PlyType::kInt32:
+      return DecodeAs<int32_t>(buffer);
+    case PlyType::kUint32:
+      return DecodeAs<uint32_t>(buffer);
+    case PlyType::kFloat32:
+      return DecodeAs<float>(buffer);
+    default:
+      return DecodeAs<double>(buffer);
   }
-  if (type == "double" || type == "float64") {
-    double v;
-    std::memcpy(&v, buffer, 8);
-    return v;
-  }
-  if (type == "uchar" || type == "uint8") return static_cast<uint8_t>(buffer[0]);
-  if (type == "char" || type == "int8") return static_cast<int8_t>(buffer[0]);
-  if (type == "ushort" || type == "uint16") {
-    uint16_t v;
-    std::memcpy(&v, buffer, 2);
-    return v;
-  }
-  if (type == "short" || type == "int16") {
-    int16_t v;
-    std::memcpy(&v, buffer, 2);
-    return v;
-  }
-  if (type == "uint" || type == "uint32") {
-    uint32_t v;
-    std::memcpy(&v, buffer, 4);
-    return v;
-  }
-  int32_t v;
-  std::memcpy(&v, buffer, 4);
-  return v;
 }
 
 struct PlyHeader {
@@ -283,7 +325,8 @@ void ParsePlyHeaderLine(const std::string& path,
     tokens >> property.type;
     if (property.type == "list") Fail(path, "list property in vertex element");
     tokens >> property.name;
-    property.size = PlyTypeSize(property.type);
+    property.kind = ParsePlyType(property.type);
+    property.size = PlyTypeSize(property.kind);
     if (property.size == 0) Fail(path, "unknown property type '" + property.type + "'");
     header->properties.push_back(property);
   }
@@ -372,7 +415,7 @@ void ReadPlyBinaryVertex(const std::string& path,
   const bool swap = header.format == "binary_big_endian";
   size_t offset = 0;
   for (size_t i = 0; i < header.properties.size(); ++i) {
-    (*values)[i] = DecodePly(header.properties[i].type, record->data() + offset, swap);
+    (*values)[i] = DecodePly(header.properties[i], record->data() + offset, swap);
     offset += header.properties[i].size;
   }
 }
@@ -390,6 +433,13 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
   size_t record_size = 0;
   for (const auto& p : header.properties) record_size += p.size;
   std::vector<char> record(record_size);
+  if (header.format != "ascii" && record_size > 0) {
+    const auto data_start = file.tellg();
+    file.seekg(0, std::ios::end);
+    const size_t num_bytes = static_cast<size_t>(file.tellg() - data_start);
+    file.seekg(data_start);
+    builder.Reserve(std::min(header.num_vertices, num_bytes / record_size));
+  }
   auto vector_of = [&](const std::array<int, 3>& f) {
     return Eigen::Vector3d(values[f[0]], values[f[1]], values[f[2]]);
   };

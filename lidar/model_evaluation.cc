@@ -3,12 +3,15 @@
 #include "lidar/check_option.h"
 #include "lidar/kd_tree.h"
 #include "lidar/point_to_plane_icp.h"
+#include "lidar/voxel_accumulator.h"
 
 #include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+#include <unordered_set>
 
 namespace colmap_lidar {
 
@@ -54,21 +57,56 @@ double TruthSpacing(const PointCloud& truth, const KdTree3& truth_tree) {
   return std::max(1e-6, Percentile(spacings, 0.5));
 }
 
+// The voxels (side: crop distance + truth spacing) holding a truth sample, dilated by one voxel. A
+// point outside them is farther than the crop distance from every sample and from the sampled surface
+// (DistanceToSampledSurface >= nearest distance - spacing), so it needs no k-d tree search: most of a
+// street's or a site's dense points are far from the structure.
+class NearTruthVoxels {
+ public:
+  NearTruthVoxels(const PointCloud& truth, double crop_distance, double spacing)
+      : voxel_size_(crop_distance + spacing) {
+    std::unordered_set<uint64_t> occupied;
+    for (const Eigen::Vector3d& point : truth.points) occupied.insert(VoxelKey(point, voxel_size_));
+    for (const uint64_t key : occupied) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dz = -1; dz <= 1; ++dz) {
+            keys_.insert(NeighbourVoxelKey(key, Eigen::Vector3i(dx, dy, dz)));
+          }
+        }
+      }
+    }
+  }
+
+  bool MayBeNear(const Eigen::Vector3d& point) const {
+    return keys_.count(VoxelKey(point, voxel_size_)) > 0;
+  }
+
+ private:
+  double voxel_size_;
+  std::unordered_set<uint64_t> keys_;
+};
+
 // Rigid point-to-plane ICP of the model points near the structure (within the crop distance).
 void AlignByIcp(const PointCloud& model,
                 const PointCloud& truth,
                 const KdTree3& truth_tree,
                 double spacing,
+                const NearTruthVoxels& near_truth,
                 const ModelEvaluationOptions& options,
                 ModelEvaluation* result) {
-  PointCloud cropped;
-  for (size_t i = 0; i < model.Size(); ++i) {
+  std::vector<char> near(model.Size());
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < static_cast<int64_t>(model.Size()); ++i) {
+    if (!near_truth.MayBeNear(model.points[i])) continue;
     size_t index;
     double squared;
     truth_tree.Nearest(model.points[i], &index, &squared);
-    if (squared <= options.crop_distance_m * options.crop_distance_m) {
-      cropped.points.push_back(model.points[i]);
-    }
+    near[i] = squared <= options.crop_distance_m * options.crop_distance_m;
+  }
+  PointCloud cropped;
+  for (size_t i = 0; i < model.Size(); ++i) {
+    if (near[i]) cropped.points.push_back(model.points[i]);
   }
   if (cropped.Size() < 6) return;
   IcpOptions icp;
@@ -108,7 +146,7 @@ void ScoreThresholds(const PointCloud& truth,
   const KdTree3 model_tree(evaluated_points);
   std::vector<double> truth_to_model(truth.Size());
 #pragma omp parallel for schedule(static)
-  for (size_t i = 0; i < truth.Size(); ++i) {
+  for (int64_t i = 0; i < static_cast<int64_t>(truth.Size()); ++i) {
     size_t index;
     double squared;
     model_tree.Nearest(truth.points[i], &index, &squared);
@@ -151,16 +189,25 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
   result.num_truth_points = truth.Size();
   const KdTree3 truth_tree(truth.points);
   const double spacing = TruthSpacing(truth, truth_tree);
-  if (options.align_icp) AlignByIcp(model, truth, truth_tree, spacing, options, &result);
+  const NearTruthVoxels near_truth(truth, options.crop_distance_m, spacing);
+  if (options.align_icp) {
+    AlignByIcp(model, truth, truth_tree, spacing, near_truth, options, &result);
+  }
   // After alignment, evaluate all model points within the crop distance.
+  std::vector<double> distances(model.Size());
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < static_cast<int64_t>(model.Size()); ++i) {
+    const Eigen::Vector3d point = result.truth_from_model * model.points[i];
+    distances[i] = near_truth.MayBeNear(point)
+                       ? DistanceToSampledSurface(truth, truth_tree, spacing, point)
+                       : std::numeric_limits<double>::infinity();
+  }
   std::vector<Eigen::Vector3d> evaluated_points;
   for (size_t i = 0; i < model.Size(); ++i) {
-    const Eigen::Vector3d p = result.truth_from_model * model.points[i];
-    const double d = DistanceToSampledSurface(truth, truth_tree, spacing, p);
-    if (d <= options.crop_distance_m) {
-      result.distances.push_back(d);
+    if (distances[i] <= options.crop_distance_m) {
+      result.distances.push_back(distances[i]);
       result.evaluated_indices.push_back(i);
-      evaluated_points.push_back(p);
+      evaluated_points.push_back(result.truth_from_model * model.points[i]);
     }
   }
   result.num_evaluated = result.distances.size();

@@ -6,40 +6,100 @@
 
 namespace colmap_lidar {
 
-VoxelAccumulator::VoxelAccumulator(double voxel_size) : voxel_size_(voxel_size) {
+VoxelAccumulator::VoxelAccumulator(double voxel_size, size_t min_buffered_points)
+    : voxel_size_(voxel_size), min_buffered_points_(std::max<size_t>(1, min_buffered_points)) {
   if (!(voxel_size > 0)) {
     throw std::invalid_argument("VoxelAccumulator: voxel_size must be > 0");
   }
 }
 
-uint64_t VoxelAccumulator::Key(const Eigen::Vector3d& point) const {
-  // 21 bits per axis around the origin: +-1 million voxels, 1 km at 1 mm.
-  constexpr int64_t kOffset = int64_t(1) << 20;
-  constexpr int64_t kMask = (int64_t(1) << 21) - 1;
+namespace {
+constexpr int kBitsPerAxis = 21;
+constexpr int64_t kAxisMask = (int64_t(1) << kBitsPerAxis) - 1;
+}  // namespace
+
+uint64_t VoxelKey(const Eigen::Vector3d& point, double voxel_size) {
+  constexpr int64_t kOffset = int64_t(1) << (kBitsPerAxis - 1);
   uint64_t key = 0;
   for (int axis = 0; axis < 3; ++axis) {
-    const int64_t cell = static_cast<int64_t>(std::floor(point[axis] / voxel_size_)) + kOffset;
-    key = (key << 21) | static_cast<uint64_t>(cell & kMask);
+    const int64_t cell = static_cast<int64_t>(std::floor(point[axis] / voxel_size)) + kOffset;
+    key = (key << kBitsPerAxis) | static_cast<uint64_t>(cell & kAxisMask);
   }
   return key;
 }
+
+uint64_t NeighbourVoxelKey(uint64_t key, const Eigen::Vector3i& offset) {
+  uint64_t neighbour = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const int shift = kBitsPerAxis * (2 - axis);
+    const int64_t cell = static_cast<int64_t>((key >> shift) & kAxisMask) + offset[axis];
+    neighbour |= static_cast<uint64_t>(cell & kAxisMask) << shift;
+  }
+  return neighbour;
+}
+
+namespace {
+
+template <typename VoxelT>
+void Accumulate(const VoxelT& from, VoxelT* into) {
+  into->sum_point += from.sum_point;
+  into->sum_normal += from.sum_normal;
+  into->sum_color += from.sum_color;
+  into->count += from.count;
+}
+
+}  // namespace
 
 void VoxelAccumulator::Add(const Eigen::Vector3d& point,
                            const Eigen::Vector3f& normal,
                            const Color3ub& color) {
   if (!point.allFinite()) return;
-  Voxel& voxel = voxels_[Key(point)];
-  voxel.sum_point += point;
-  voxel.sum_normal += normal;
-  voxel.sum_color += color.cast<float>();
-  ++voxel.count;
+  pending_.push_back({VoxelKey(point, voxel_size_), point, normal, color.cast<float>(), 1});
   ++num_added_;
+  if (pending_.size() >= std::max(min_buffered_points_, voxels_.size() / 4)) Compact();
+}
+
+void VoxelAccumulator::Compact() const {
+  if (pending_.empty()) return;
+  std::sort(pending_.begin(), pending_.end(), [](const Voxel& a, const Voxel& b) {
+    return a.key < b.key;
+  });
+  // Runs of one key into one voxel each, in place; those whose key is already a voxel go there.
+  size_t num_runs = 0;
+  size_t v = 0;
+  for (size_t p = 0; p < pending_.size();) {
+    Voxel run = pending_[p++];
+    while (p < pending_.size() && pending_[p].key == run.key) Accumulate(pending_[p++], &run);
+    while (v < voxels_.size() && voxels_[v].key < run.key) ++v;
+    if (v < voxels_.size() && voxels_[v].key == run.key) {
+      Accumulate(run, &voxels_[v]);
+    } else {
+      pending_[num_runs++] = run;
+    }
+  }
+  // The new voxels merged in from the back: no second copy of the voxels.
+  size_t old_end = voxels_.size();
+  voxels_.resize(old_end + num_runs);
+  for (size_t out = voxels_.size(); num_runs > 0;) {
+    if (old_end > 0 && voxels_[old_end - 1].key > pending_[num_runs - 1].key) {
+      voxels_[--out] = voxels_[--old_end];
+    } else {
+      voxels_[--out] = pending_[--num_runs];
+    }
+  }
+  pending_.clear();
+}
+
+size_t VoxelAccumulator::NumVoxels() const {
+  Compact();
+  return voxels_.size();
 }
 
 PointCloud VoxelAccumulator::Extract(int min_points) const {
+  Compact();
   PointCloud cloud;
   cloud.Reserve(voxels_.size(), true, true, false);
-  for (const auto& [key, voxel] : voxels_) {
+  for (const Voxel& voxel : voxels_) {
     if (voxel.count < static_cast<uint32_t>(std::max(1, min_points))) continue;
     cloud.points.push_back(voxel.sum_point / voxel.count);
     const Eigen::Vector3f normal = voxel.sum_normal;
@@ -49,6 +109,12 @@ PointCloud VoxelAccumulator::Extract(int min_points) const {
     cloud.colors.push_back((color.array() + 0.5f).min(255.f).cast<uint8_t>().matrix());
   }
   return cloud;
+}
+
+void VoxelAccumulator::Clear() {
+  std::vector<Voxel>().swap(voxels_);
+  std::vector<Voxel>().swap(pending_);
+  num_added_ = 0;
 }
 
 }  // namespace colmap_lidar

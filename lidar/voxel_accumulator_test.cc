@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <random>
+
 namespace colmap_lidar {
 namespace {
 
@@ -40,6 +43,43 @@ TEST(VoxelAccumulator, NegativeCoordinatesDoNotShareVoxelsWithPositiveOnes) {
   accumulator.Add(Eigen::Vector3d(0.001, 0, 0), Eigen::Vector3f::Zero(), {});
   EXPECT_EQ(accumulator.NumVoxels(), 2u);
   EXPECT_THROW(VoxelAccumulator(0), std::invalid_argument);
+}
+
+TEST(VoxelAccumulator, MergesThroughManyBufferFlushesLikeAMap) {
+  // A buffer of 100 points: the 20,000 points below are merged in about 200 steps, into voxels
+  // first seen early and late; the result must equal a plain map from voxel to sums.
+  VoxelAccumulator accumulator(0.1, 100);
+  std::map<uint64_t, std::pair<Eigen::Vector3d, int>> expected;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coordinate(-2, 2);
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Vector3d point(coordinate(rng), coordinate(rng), 0.05 + 0.1 * (i % 3));
+    accumulator.Add(point, Eigen::Vector3f(0, 0, 1), Color3ub(i % 256, 0, 0));
+    auto& [sum, count] =
+        expected.try_emplace(VoxelKey(point, 0.1), Eigen::Vector3d::Zero(), 0).first->second;
+    sum += point;
+    ++count;
+  }
+  ASSERT_EQ(accumulator.NumVoxels(), expected.size());
+  const PointCloud merged = accumulator.Extract();
+  ASSERT_EQ(merged.Size(), expected.size());
+  size_t k = 0;
+  for (const auto& [key, sum_and_count] : expected) {  // Extract's order is the keys'
+    EXPECT_EQ(VoxelKey(merged.points[k], 0.1), key);
+    EXPECT_LT((merged.points[k] - sum_and_count.first / sum_and_count.second).norm(), 1e-12);
+    ++k;
+  }
+}
+
+TEST(VoxelAccumulator, NeighbourKeysStepOneVoxelAlongEachAxis) {
+  const Eigen::Vector3d point(-0.35, 0.12, 7.01);
+  for (const Eigen::Vector3i offset : {Eigen::Vector3i(1, 0, 0),
+                                       Eigen::Vector3i(0, -1, 0),
+                                       Eigen::Vector3i(-1, 1, 1),
+                                       Eigen::Vector3i(0, 0, -1)}) {
+    EXPECT_EQ(NeighbourVoxelKey(VoxelKey(point, 0.1), offset),
+              VoxelKey(point + 0.1 * offset.cast<double>(), 0.1));
+  }
 }
 
 }  // namespace

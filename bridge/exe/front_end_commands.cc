@@ -102,6 +102,7 @@ void AddStereoDepthOptions(const std::string& prefix,
   add.Add("speckle_window_size", &options->speckle_window_size);
   add.Add("speckle_range_px", &options->speckle_range_px);
   add.Add("max_left_right_diff_px", &options->max_left_right_diff_px);
+  add.Add("mirrored_left_right_check", &options->mirrored_left_right_check);
   add.Add("num_threads", &options->num_threads);
 }
 
