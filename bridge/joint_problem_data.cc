@@ -2,6 +2,7 @@
 
 #include "colmap_ext/logging.h"
 #include "lidar/cloud_io.h"
+#include "lidar/kd_tree.h"
 
 #include "colmap/scene/database.h"
 
@@ -132,20 +133,35 @@ ImagePairSet OverlappingLidarPairs(const colmap::Reconstruction& reconstruction,
                                    const colmap::Rigid3d& cam_from_lidar,
                                    const std::map<colmap::image_t, const StationCloud*>& clouds,
                                    const JointDataOptions& options) {
-  std::vector<std::vector<std::pair<double, size_t>>> partners(image_ids.size());
+  // Candidates: each station's nearest stations by position (four times the neighbours kept), so
+  // that the overlap tests grow as N, not N^2, on large surveys.
+  std::vector<colmap::Rigid3d> world_from_lidar;
+  std::vector<Eigen::Vector3d> positions;
+  for (const colmap::image_t image_id : image_ids) {
+    world_from_lidar.push_back(colmap::Inverse(reconstruction.Image(image_id).CamFromWorld()) *
+                               cam_from_lidar);
+    positions.push_back(world_from_lidar.back().translation);
+  }
+  const KdTree3 position_tree(positions);
+  const size_t num_candidates = 4 * static_cast<size_t>(options.max_lidar_neighbors) + 1;
+  std::set<std::pair<size_t, size_t>> candidates;
   for (size_t a = 0; a < image_ids.size(); ++a) {
-    for (size_t b = a + 1; b < image_ids.size(); ++b) {
-      const colmap::Rigid3d lidar_a_from_lidar_b =
-          colmap::Inverse(cam_from_lidar) * reconstruction.Image(image_ids[a]).CamFromWorld() *
-          colmap::Inverse(reconstruction.Image(image_ids[b]).CamFromWorld()) * cam_from_lidar;
-      const double overlap = Overlap(*clouds.at(image_ids[a]),
-                                     *clouds.at(image_ids[b]),
-                                     lidar_a_from_lidar_b,
-                                     options.lidar_overlap_distance_m);
-      if (overlap >= options.min_lidar_overlap) {
-        partners[a].emplace_back(overlap, b);
-        partners[b].emplace_back(overlap, a);
-      }
+    std::vector<size_t> nearest;
+    std::vector<double> squared;
+    position_tree.KNearest(positions[a], num_candidates, &nearest, &squared);
+    for (const size_t b : nearest) {
+      if (b != a) candidates.insert({std::min(a, b), std::max(a, b)});
+    }
+  }
+  std::vector<std::vector<std::pair<double, size_t>>> partners(image_ids.size());
+  for (const auto& [a, b] : candidates) {
+    const double overlap = Overlap(*clouds.at(image_ids[a]),
+                                   *clouds.at(image_ids[b]),
+                                   colmap::Inverse(world_from_lidar[a]) * world_from_lidar[b],
+                                   options.lidar_overlap_distance_m);
+    if (overlap >= options.min_lidar_overlap) {
+      partners[a].emplace_back(overlap, b);
+      partners[b].emplace_back(overlap, a);
     }
   }
   ImagePairSet lidar_pairs;

@@ -42,6 +42,11 @@ struct PoseInitializerOptions {
   }();
   // false: hand-eye even when rig.json has a guess
   bool use_guess = true;
+  // A LiDAR edge and an image edge of the same station pair measure one motion of the pod, so their
+  // rotation angles agree whatever cam_from_lidar is (A = X B X^-1); a LiDAR edge whose angle differs
+  // by more than this (degrees) is a wrong registration (sparse clouds: ICP slid along the ground) and
+  // is left out of the hand-eye and the pose graph.
+  double max_lidar_image_angle_deg = 2.0;
   // pose-graph edge weights
   double sigma_rotation_deg = 0.1;
   double sigma_translation_m = 0.005;
@@ -68,6 +73,9 @@ struct PoseInitialization {
   std::vector<PoseGraphEdge> edges;
   int num_image_edges = 0;
   int num_lidar_edges = 0;
+  // LiDAR edges left out because an image edge of the same pair contradicts them: "target source:
+  // LiDAR x deg, images y deg".
+  std::vector<std::string> contradicted_lidar_edges;
 };
 
 // `registration_path`: lidar_registrator's output folder (pairs.txt); may be empty (no LiDAR edges).
