@@ -1,5 +1,6 @@
 #include "bridge/pose_initializer.h"
 
+#include "bridge/edge_consistency.h"
 #include "bridge/lidar_registration_files.h"
 #include "bridge/model_completion.h"
 #include "colmap_ext/logging.h"
@@ -161,90 +162,6 @@ void SolveCameraPoseGraph(const std::map<std::string, colmap::image_t>& image_of
   }
 }
 
-double RotationAngleDeg(const colmap::Rigid3d& motion) {
-  return Eigen::AngleAxisd(motion.rotation).angle() * 180 / M_PI;
-}
-
-struct ChainedRotation {
-  int component = 0;
-  int depth = 0;  // image edges from the component's first station
-  Eigen::Quaterniond world_from_cam;
-};
-
-// world_from_cam rotations of the stations that image edges connect, one frame per connected
-// component of A_c (breadth first from its first station): the camera motion between any two
-// stations of a component, without cam_from_lidar.
-std::map<colmap::image_t, ChainedRotation> ImageComponentRotations(
-    const std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d>& image_edge) {
-  std::multimap<colmap::image_t, std::pair<colmap::image_t, Eigen::Quaterniond>> neighbours;
-  for (const auto& [pair, cam_i_from_cam_j] : image_edge) {
-    neighbours.insert({pair.first, {pair.second, cam_i_from_cam_j.rotation}});
-    neighbours.insert({pair.second, {pair.first, cam_i_from_cam_j.rotation.inverse()}});
-  }
-  std::map<colmap::image_t, ChainedRotation> world_from_cam;
-  int component = 0;
-  for (const auto& [root, unused] : neighbours) {
-    if (world_from_cam.count(root)) continue;
-    world_from_cam[root] = {component, 0, Eigen::Quaterniond::Identity()};
-    std::vector<colmap::image_t> queue = {root};
-    for (size_t q = 0; q < queue.size(); ++q) {
-      const auto range = neighbours.equal_range(queue[q]);
-      for (auto it = range.first; it != range.second; ++it) {
-        const auto& [other, from_other] = it->second;
-        if (world_from_cam.count(other)) continue;
-        const ChainedRotation& from = world_from_cam.at(queue[q]);
-        world_from_cam[other] = {component, from.depth + 1, from.world_from_cam * from_other};
-        queue.push_back(other);
-      }
-    }
-    ++component;
-  }
-  return world_from_cam;
-}
-
-// See PoseInitializerOptions::max_lidar_image_angle_deg. The image motion between the two stations is
-// the edge's own or, when image edges connect them otherwise, the chain of image edges' (the bound
-// then grows by 0.1 deg per chained edge).
-void DropContradictedLidarEdges(
-    const std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d>& image_edge,
-    const std::map<colmap::image_t, std::string>& names,
-    const PoseInitializerOptions& options,
-    std::vector<std::tuple<colmap::image_t, colmap::image_t, colmap::Rigid3d, double>>* lidar_edges,
-    PoseInitialization* init) {
-  const auto world_from_cam = ImageComponentRotations(image_edge);
-  std::vector<std::tuple<colmap::image_t, colmap::image_t, colmap::Rigid3d, double>> kept;
-  for (const auto& edge : *lidar_edges) {
-    const auto& [i, j, lidar_i_from_lidar_j, weight] = edge;
-    const auto cam_i = world_from_cam.find(i), cam_j = world_from_cam.find(j);
-    if (cam_i == world_from_cam.end() || cam_j == world_from_cam.end() ||
-        cam_i->second.component != cam_j->second.component) {
-      kept.push_back(edge);  // nothing to compare: the LiDAR bridges the images
-      continue;
-    }
-    auto direct = image_edge.find({i, j});
-    if (direct == image_edge.end()) direct = image_edge.find({j, i});
-    const bool chained = direct == image_edge.end();
-    const double image_angle =
-        chained ? cam_i->second.world_from_cam.angularDistance(cam_j->second.world_from_cam) * 180 /
-                      M_PI
-                : RotationAngleDeg(direct->second);
-    const double bound = options.max_lidar_image_angle_deg +
-                         (chained ? 0.1 * (cam_i->second.depth + cam_j->second.depth) : 0.0);
-    const double lidar_angle = RotationAngleDeg(lidar_i_from_lidar_j);
-    if (std::abs(image_angle - lidar_angle) > bound) {
-      std::ostringstream reason;
-      reason << names.at(i) << " " << names.at(j) << ": LiDAR " << std::fixed
-             << std::setprecision(1) << lidar_angle << " deg, images " << image_angle << " deg";
-      init->contradicted_lidar_edges.push_back(reason.str());
-      std::cout << "pose_initializer: LiDAR edge " << reason.str()
-                << " of rotation: a wrong registration, left out" << std::endl;
-      continue;
-    }
-    kept.push_back(edge);
-  }
-  lidar_edges->swap(kept);
-}
-
 }  // namespace
 
 bool PoseInitializerOptions::Check() const {
@@ -279,7 +196,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
   // A_c.
   const std::vector<ImagePairPose> image_pairs =
       EstimateImagePairPoses(database, priors, options.image_pairs);
-  std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d> image_edge;
+  ImageEdges image_edge;
   for (const ImagePairPose& pair : image_pairs) {
     init.edges.push_back({pair.image_i,
                           pair.image_j,
@@ -291,20 +208,24 @@ PoseInitialization InitializePoses(const std::string& database_path,
   init.num_image_edges = static_cast<int>(image_pairs.size());
 
   // A_l.
-  std::vector<std::tuple<colmap::image_t, colmap::image_t, colmap::Rigid3d, double>> lidar_edges;
+  std::vector<LidarEdge> lidar_edges;
   if (!registration_path.empty()) {
     for (const LidarPairRecord& pair :
          ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
       if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) {
         continue;
       }
-      lidar_edges.emplace_back(image_of_station.at(pair.target),
-                               image_of_station.at(pair.source),
-                               pair.target_from_source,
-                               pair.num_inliers);
+      lidar_edges.push_back({image_of_station.at(pair.target),
+                             image_of_station.at(pair.source),
+                             pair.target_from_source,
+                             static_cast<double>(pair.num_inliers)});
     }
   }
-  DropContradictedLidarEdges(image_edge, images.names, options, &lidar_edges, &init);
+  lidar_edges = DropContradictedLidarEdges(image_edge,
+                                           lidar_edges,
+                                           images.names,
+                                           options.max_lidar_image_angle_deg,
+                                           &init.contradicted_lidar_edges);
   init.num_lidar_edges = static_cast<int>(lidar_edges.size());
 
   // cam_from_lidar.
