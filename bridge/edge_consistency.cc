@@ -52,15 +52,15 @@ std::map<colmap::image_t, ChainedRotation> ImageComponentRotations(const ImageEd
 
 }  // namespace
 
-std::vector<LidarEdge> DropContradictedLidarEdges(
+std::vector<LidarStationEdge> DropContradictedLidarEdges(
     const ImageEdges& image_edges,
-    const std::vector<LidarEdge>& lidar_edges,
+    const std::vector<LidarStationEdge>& lidar_edges,
     const std::map<colmap::image_t, std::string>& names,
     double max_angle_deg,
     std::vector<std::string>* contradicted) {
   const auto world_from_cam = ImageComponentRotations(image_edges);
-  std::vector<LidarEdge> kept;
-  for (const LidarEdge& edge : lidar_edges) {
+  std::vector<LidarStationEdge> kept;
+  for (const LidarStationEdge& edge : lidar_edges) {
     const auto cam_i = world_from_cam.find(edge.image_i);
     const auto cam_j = world_from_cam.find(edge.image_j);
     if (cam_i == world_from_cam.end() || cam_j == world_from_cam.end() ||

@@ -19,7 +19,7 @@ namespace colmap_lidar {
 using ImageEdges = std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d>;
 
 // An edge of A_l between the stations of two images.
-struct LidarEdge {
+struct LidarStationEdge {
   colmap::image_t image_i = 0, image_j = 0;
   colmap::Rigid3d lidar_i_from_lidar_j;
   double weight = 0;  // inliers
@@ -31,9 +31,9 @@ struct LidarEdge {
 // differs from it by more than max_angle_deg (plus 0.25 deg per chained edge) is left out and described
 // in `contradicted` ("name_i name_j: LiDAR x deg, images y deg"). Edges between stations that no image
 // edges connect are kept: there the LiDAR bridges the images.
-std::vector<LidarEdge> DropContradictedLidarEdges(
+std::vector<LidarStationEdge> DropContradictedLidarEdges(
     const ImageEdges& image_edges,
-    const std::vector<LidarEdge>& lidar_edges,
+    const std::vector<LidarStationEdge>& lidar_edges,
     const std::map<colmap::image_t, std::string>& names,
     double max_angle_deg,
     std::vector<std::string>* contradicted);

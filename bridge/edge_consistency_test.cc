@@ -22,7 +22,7 @@ TEST(EdgeConsistency, DropsLidarEdgesThatContradictTheImagesDirectlyOrThroughACh
   // Image edges 1-2 and 2-3, each a 60 deg turn; station 4 has no image edge.
   const ImageEdges images = {{{1, 2}, TurnAboutZ(60)}, {{2, 3}, TurnAboutZ(60)}};
   const std::map<colmap::image_t, std::string> names = {{1, "a"}, {2, "b"}, {3, "c"}, {4, "d"}};
-  const std::vector<LidarEdge> lidar = {
+  const std::vector<LidarStationEdge> lidar = {
       {2, 1, TurnAboutX(61), 10},   // the direct image edge agrees within 5 deg: kept
       {1, 3, TurnAboutX(118), 10},  // the chain 1-2-3 (120 deg) agrees: kept
       {1, 3, TurnAboutX(1), 10},    // slid on the ground: contradicted by the chain
@@ -30,7 +30,7 @@ TEST(EdgeConsistency, DropsLidarEdgesThatContradictTheImagesDirectlyOrThroughACh
       {3, 4, TurnAboutX(5), 10},    // nothing to compare with: the LiDAR bridges, kept
   };
   std::vector<std::string> contradicted;
-  const std::vector<LidarEdge> kept =
+  const std::vector<LidarStationEdge> kept =
       DropContradictedLidarEdges(images, lidar, names, 5.0, &contradicted);
   ASSERT_EQ(kept.size(), 3u);
   EXPECT_EQ(kept[0].image_i, 2u);

@@ -208,7 +208,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
   init.num_image_edges = static_cast<int>(image_pairs.size());
 
   // A_l.
-  std::vector<LidarEdge> lidar_edges;
+  std::vector<LidarStationEdge> lidar_edges;
   if (!registration_path.empty()) {
     for (const LidarPairRecord& pair :
          ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
