@@ -5,6 +5,7 @@
 #   bridge/      no tests/ (only the CLI main, bridge/exe/colmap_lidar_main.cc, links the simulator)
 #   bridge/exe/  the commands: nothing outside it includes bridge/exe/ (algorithms never include a
 #                command), and the bridge library's sources list none of its files
+#   all layers   no struct or class name defined in two headers (one namespace: an ODR violation)
 # Prints every violation as file:line and exits 1 if there is any.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -45,6 +46,14 @@ grep -qE 'colmap_lidar::(lidar|bridge|simulator)' colmap_ext/CMakeLists.txt &&
 sed -n '/add_library(colmap_lidar_bridge/,/^)/p;/target_link_libraries(colmap_lidar_bridge/,/)/p' \
   bridge/CMakeLists.txt | grep -q 'simulator' &&
   violation "the bridge library links the simulator"
+
+# One definition per type name: the layers share the namespace colmap_lidar, and two headers defining
+# one struct or class name is an ODR violation the linker does not report (it merges their inline
+# functions: a vector of one type reallocated with the other's layout).
+hits=$(grep -HnoE '^(struct|class) [A-Za-z0-9_]+( final)? ?[:{]' lidar/*.h colmap_ext/*.h bridge/*.h \
+         bridge/exe/*.h | awk -F'[: ]' '{print $4, $1 ":" $2}' | sort |
+       awk '{n[$1]++; where[$1] = where[$1] " " $2} END {for (t in n) if (n[t] > 1) print t ":" where[t]}')
+[ -z "$hits" ] || violation "type names defined in more than one header:"$'\n'"$hits"
 
 [ $status -eq 0 ] && echo "layering: ok (lidar | colmap_ext -> bridge -> bridge/exe (CLI))"
 exit $status
