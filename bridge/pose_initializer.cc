@@ -162,6 +162,24 @@ void SolveCameraPoseGraph(const std::map<std::string, colmap::image_t>& image_of
   }
 }
 
+// The LiDAR edges of lidar_registrator's pairs.txt (none when `registration_path` is empty) between
+// stations that have an image.
+std::vector<LidarStationEdge> ReadLidarEdges(
+    const std::string& registration_path,
+    const std::map<std::string, colmap::image_t>& image_of_station) {
+  std::vector<LidarStationEdge> lidar_edges;
+  if (registration_path.empty()) return lidar_edges;
+  for (const LidarPairRecord& pair :
+       ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
+    if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) continue;
+    lidar_edges.push_back({image_of_station.at(pair.target),
+                           image_of_station.at(pair.source),
+                           pair.target_from_source,
+                           static_cast<double>(pair.num_inliers)});
+  }
+  return lidar_edges;
+}
+
 }  // namespace
 
 bool PoseInitializerOptions::Check() const {
@@ -207,25 +225,13 @@ PoseInitialization InitializePoses(const std::string& database_path,
   }
   init.num_image_edges = static_cast<int>(image_pairs.size());
 
-  // A_l.
-  std::vector<LidarStationEdge> lidar_edges;
-  if (!registration_path.empty()) {
-    for (const LidarPairRecord& pair :
-         ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
-      if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) {
-        continue;
-      }
-      lidar_edges.push_back({image_of_station.at(pair.target),
-                             image_of_station.at(pair.source),
-                             pair.target_from_source,
-                             static_cast<double>(pair.num_inliers)});
-    }
-  }
-  lidar_edges = DropContradictedLidarEdges(image_edge,
-                                           lidar_edges,
-                                           images.names,
-                                           options.max_lidar_image_angle_deg,
-                                           &init.contradicted_lidar_edges);
+  // A_l, without the edges the images contradict.
+  const std::vector<LidarStationEdge> lidar_edges =
+      DropContradictedLidarEdges(image_edge,
+                                 ReadLidarEdges(registration_path, image_of_station),
+                                 images.names,
+                                 options.max_lidar_image_angle_deg,
+                                 &init.contradicted_lidar_edges);
   init.num_lidar_edges = static_cast<int>(lidar_edges.size());
 
   // cam_from_lidar.

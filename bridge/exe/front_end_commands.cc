@@ -26,7 +26,8 @@ void AddImportStepOptions(const std::string& prefix,
   add.Add("matcher",
           &options->import.matcher,
           "exhaustive | sequential (frames of a moving platform, by name) | spatial "
-          "(stations near in --lidar_registration_path)");
+          "(stations near in --lidar_registration_path); pipeline: auto (exhaustive up to "
+          "Import.max_exhaustive_stations, spatial beyond)");
   add.Add("lidar_registration_path",
           &options->lidar_registration_path,
           "lidar_registrator's output folder, for --matcher spatial");
