@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <set>
@@ -264,6 +265,42 @@ void MatchFeatures(const DatasetImportOptions& options, const std::string& datab
   matcher->Wait();
 }
 
+// Spatial matching gives a station without a position (outside the LiDAR registration's largest
+// component) no pair: such stations are matched with every other image by COLMAP's image-pairs
+// matcher on a list (DATABASE.pairs.txt, removed with the partial database), so that they can still
+// join the model through their images: (stations without a position) x N pairs at most.
+void MatchStationsWithoutPosition(const StationDataset& dataset,
+                                  const std::vector<std::string>& names,
+                                  const DatasetImportOptions& options,
+                                  const std::string& database_path) {
+  std::vector<size_t> unplaced;
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (options.station_positions.count(dataset.stations[i]) == 0) unplaced.push_back(i);
+  }
+  if (unplaced.empty()) return;
+  colmap::ImagePairsMatchingOptions pairs;
+  pairs.match_list_path = database_path + ".pairs.txt";
+  std::set<std::pair<size_t, size_t>> listed;
+  {
+    std::ofstream list(pairs.match_list_path);
+    for (size_t i : unplaced) {
+      for (size_t j = 0; j < names.size(); ++j) {
+        if (j != i && listed.insert({std::min(i, j), std::max(i, j)}).second) {
+          list << names[i] << " " << names[j] << "\n";
+        }
+      }
+    }
+    if (!list.good()) throw std::runtime_error("Cannot write " + pairs.match_list_path);
+  }
+  std::cout << "COLMAP image-pairs matching: " << unplaced.size()
+            << " stations without a LiDAR position, each with every image (" << listed.size()
+            << " pairs)" << std::endl;
+  const std::unique_ptr<colmap::Thread> matcher = colmap::CreateImagePairsFeatureMatcher(
+      pairs, options.sift_matching, options.two_view_geometry, database_path);
+  matcher->Start();
+  matcher->Wait();
+}
+
 // Our tables: the stereo rig and each station's LiDAR frame.
 void WriteRigAndLidarFrames(const StationDataset& dataset,
                             colmap::camera_t camera_id,
@@ -350,7 +387,7 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
   const std::string partial = database_path + ".import-partial";
   const auto remove_partial = [&partial]() {
     std::error_code ignored;
-    for (const char* suffix : {"", "-journal", "-wal", "-shm"}) {
+    for (const char* suffix : {"", "-journal", "-wal", "-shm", ".pairs.txt"}) {
       fs::remove(partial + suffix, ignored);
     }
   };
@@ -382,6 +419,9 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
 
     if (options.matcher == "spatial") WritePosePriors(dataset, image_ids, options, partial);
     MatchFeatures(options, partial);
+    if (options.matcher == "spatial") {
+      MatchStationsWithoutPosition(dataset, names, options, partial);
+    }
 
     WriteRigAndLidarFrames(dataset, summary.camera_id, image_ids, partial);
     {

@@ -41,7 +41,8 @@ struct DatasetImportOptions {
   // COLMAP's defaults except ignore_z = false (LiDAR positions, unlike GPS, have a good z).
   colmap::SpatialMatchingOptions spatial_matching = LidarSpatialMatchingOptions();
   // "spatial": the position of each station's camera in one world frame, by station name (e.g. from
-  // lidar_registrator's lidar_poses.txt). Stations without one get no pose prior and so no pair.
+  // lidar_registrator's lidar_poses.txt). Stations without one get no pose prior; they are matched
+  // with every other image instead.
   std::map<std::string, Eigen::Vector3d> station_positions;
   // The database name of each station's image, "{station}" standing for the station's name: e.g.
   // "{station}.png" or "cam0/{station}.jpg" for a database made by the user's own `colmap

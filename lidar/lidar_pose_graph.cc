@@ -6,6 +6,8 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <set>
 #include <stdexcept>
@@ -27,35 +29,87 @@ std::vector<double> GlobalHistogram(const StationCloud& station) {
   return histogram;
 }
 
-std::vector<std::pair<size_t, size_t>> CandidatePairs(
-    const std::vector<const StationCloud*>& stations, size_t max_neighbors, size_t sequential) {
-  std::set<std::pair<size_t, size_t>> pairs;
-  const size_t n = stations.size();
+using StationPair = std::pair<size_t, size_t>;
+
+double HistogramDistance(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
+  double l1 = 0;
+  for (size_t k = 0; k < a.size(); ++k) l1 += std::abs(a[k] - b[k]);
+  return l1;
+}
+
+// The `k` stations most similar to station i by global histogram among those `allowed`.
+std::vector<size_t> MostSimilar(const std::vector<std::vector<double>>& histograms,
+                                size_t i,
+                                size_t k,
+                                const std::function<bool(size_t)>& allowed) {
+  std::vector<std::pair<double, size_t>> distances;
+  for (size_t j = 0; j < histograms.size(); ++j) {
+    if (j == i || !allowed(j)) continue;
+    const double d = HistogramDistance(histograms[i], histograms[j]);
+    if (std::isfinite(d)) distances.push_back({d, j});
+  }
+  const size_t m = std::min(k, distances.size());
+  std::partial_sort(distances.begin(), distances.begin() + m, distances.end());
+  std::vector<size_t> nearest;
+  for (size_t r = 0; r < m; ++r) nearest.push_back(distances[r].second);
+  return nearest;
+}
+
+StationPair Ordered(size_t i, size_t j) { return {std::min(i, j), std::max(i, j)}; }
+
+std::vector<StationPair> CandidatePairs(const std::vector<std::vector<double>>& histograms,
+                                        size_t max_neighbors,
+                                        size_t sequential) {
+  std::set<StationPair> pairs;
+  const size_t n = histograms.size();
   for (size_t i = 0; i < n; ++i) {
     for (size_t j = i + 1; j <= std::min(n - 1, i + sequential); ++j) pairs.insert({i, j});
   }
   if (sequential > 0 && max_neighbors == 0) return {pairs.begin(), pairs.end()};
-  if (max_neighbors == 0 || max_neighbors + 1 >= n) {
-    for (size_t i = 0; i < n; ++i) {
+  const bool all_pairs = max_neighbors == 0 || max_neighbors + 1 >= n;
+  for (size_t i = 0; i < n; ++i) {
+    if (all_pairs) {
       for (size_t j = i + 1; j < n; ++j) pairs.insert({i, j});
+      continue;
     }
-  } else {
-    std::vector<std::vector<double>> histograms;
-    for (const StationCloud* s : stations) histograms.push_back(GlobalHistogram(*s));
-    for (size_t i = 0; i < n; ++i) {
-      std::vector<std::pair<double, size_t>> distances;
-      for (size_t j = 0; j < n; ++j) {
-        if (j == i || histograms[i].size() != histograms[j].size()) continue;
-        double l1 = 0;
-        for (size_t b = 0; b < histograms[i].size(); ++b)
-          l1 += std::abs(histograms[i][b] - histograms[j][b]);
-        distances.push_back({l1, j});
-      }
-      std::sort(distances.begin(), distances.end());
-      for (size_t k = 0; k < std::min(max_neighbors, distances.size()); ++k) {
-        pairs.insert({std::min(i, distances[k].second), std::max(i, distances[k].second)});
-      }
+    for (size_t j : MostSimilar(histograms, i, max_neighbors, [](size_t) { return true; })) {
+      pairs.insert(Ordered(i, j));
     }
+  }
+  return {pairs.begin(), pairs.end()};
+}
+
+// Connected components of the accepted edges (union-find): a label per station; `largest` is the
+// label of the largest component.
+std::vector<size_t> EdgeComponents(size_t n, const std::vector<LidarEdge>& edges, size_t* largest) {
+  std::vector<size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  const std::function<size_t(size_t)> find = [&](size_t x) {
+    return parent[x] == x ? x : parent[x] = find(parent[x]);
+  };
+  for (const LidarEdge& e : edges) parent[find(e.target)] = find(e.source);
+  std::vector<size_t> label(n), size(n, 0);
+  for (size_t i = 0; i < n; ++i) ++size[label[i] = find(i)];
+  *largest = static_cast<size_t>(std::max_element(size.begin(), size.end()) - size.begin());
+  return label;
+}
+
+// Pairs that may join the components: each station outside the largest component with its `k`
+// most similar stations of other components not tried yet (at most k per such station).
+std::vector<StationPair> BridgePairs(const std::vector<std::vector<double>>& histograms,
+                                     const std::vector<LidarEdge>& edges,
+                                     size_t k,
+                                     const std::set<StationPair>& tried) {
+  size_t largest = 0;
+  const std::vector<size_t> label = EdgeComponents(histograms.size(), edges, &largest);
+  std::set<StationPair> pairs;
+  for (size_t i = 0; i < histograms.size(); ++i) {
+    if (label[i] == largest) continue;
+    const auto other_untried = [&](size_t j) {
+      return label[j] != label[i] && tried.count(Ordered(i, j)) == 0;
+    };
+    for (size_t j : MostSimilar(histograms, i, k, other_untried)) pairs.insert(Ordered(i, j));
   }
   return {pairs.begin(), pairs.end()};
 }
@@ -73,12 +127,13 @@ Eigen::Matrix<double, 6, 6> SqrtInformation(const PairRegistration& r) {
   return eigen.eigenvectors() * roots.asDiagonal() * eigen.eigenvectors().transpose();
 }
 
-// Pairs registered and sorted into accepted and refused edges.
+// Pairs registered and sorted into accepted and refused edges; progress counts from `done_before`.
 void RegisterPairs(const std::vector<const StationCloud*>& stations,
+                   const std::vector<StationPair>& pairs,
                    const LidarGraphOptions& options,
                    const std::function<void(size_t, size_t)>& progress,
+                   size_t done_before,
                    LidarGraph* graph) {
-  const auto pairs = CandidatePairs(stations, options.max_neighbors, options.sequential);
   for (size_t k = 0; k < pairs.size(); ++k) {
     const auto [i, j] = pairs[k];
     LidarEdge edge;
@@ -87,7 +142,7 @@ void RegisterPairs(const std::vector<const StationCloud*>& stations,
     edge.registration = RegisterStationClouds(*stations[j], *stations[i], options.pair);
     edge.target_from_source = edge.registration.target_from_source;
     (edge.registration.accepted ? graph->edges : graph->refused).push_back(edge);
-    if (progress) progress(k + 1, pairs.size());
+    if (progress) progress(done_before + k + 1, done_before + pairs.size());
   }
 }
 
@@ -142,6 +197,7 @@ double LidarEdge::Weight() const {
 
 bool LidarGraphOptions::Check() const {
   LIDAR_CHECK_OPTION_GT(robust_loss_sigmas, 0);
+  LIDAR_CHECK_OPTION_GE(max_bridge_rounds, 0);
   return pair.Check() && cycles.Check();
 }
 
@@ -151,9 +207,23 @@ LidarGraph RegisterAllStations(const std::vector<const StationCloud*>& stations,
   ThrowUnlessValid(options, "LidarGraphOptions");
   const size_t n = stations.size();
   if (n == 0) throw std::invalid_argument("RegisterAllStations: no stations");
+  std::vector<std::vector<double>> histograms;
+  for (const StationCloud* s : stations) histograms.push_back(GlobalHistogram(*s));
   LidarGraph graph;
-  RegisterPairs(stations, options, progress, &graph);
+  const std::vector<StationPair> pairs =
+      CandidatePairs(histograms, options.max_neighbors, options.sequential);
+  std::set<StationPair> tried(pairs.begin(), pairs.end());
+  RegisterPairs(stations, pairs, options, progress, 0, &graph);
   if (options.check_cycles) RemoveInconsistentEdges(options.cycles, &graph);
+  for (int round = 0; round < options.max_bridge_rounds; ++round) {
+    const std::vector<StationPair> bridges =
+        BridgePairs(histograms, graph.edges, options.bridge_neighbors, tried);
+    if (bridges.empty()) break;
+    tried.insert(bridges.begin(), bridges.end());
+    graph.num_bridge_pairs += bridges.size();
+    RegisterPairs(stations, bridges, options, progress, tried.size() - bridges.size(), &graph);
+    if (options.check_cycles) RemoveInconsistentEdges(options.cycles, &graph);
+  }
   SolveLidarPoseGraph(n, options, &graph);
   return graph;
 }

@@ -34,6 +34,13 @@ struct LidarGraphOptions {
   // > 0: also register each frame with its `sequential` successors (sweeps of a moving platform);
   // with max_neighbors = 0 only these pairs are registered.
   size_t sequential = 0;
+  // When the accepted edges leave several components, each station outside the largest one is
+  // registered with its `bridge_neighbors` most similar stations of the other components (pairs not
+  // tried yet), for up to `max_bridge_rounds` rounds while the stations stay disconnected: bounded
+  // by k per station, as the candidates are. Stations seen from another attitude (a tilted pod)
+  // describe each other best and would otherwise form a component of their own.
+  size_t bridge_neighbors = 4;
+  int max_bridge_rounds = 2;
   // Remove edges inconsistent around 3-cycles before the spanning tree (CheckThreeCycles).
   bool check_cycles = true;
   CycleConsistencyOptions cycles;
@@ -51,6 +58,7 @@ struct LidarGraph {
   std::vector<Eigen::Isometry3d> world_from_lidar;  // per station
   std::vector<int> component;  // per station, 0-based; component 0 holds station 0
   int num_components = 0;
+  size_t num_bridge_pairs = 0;  // pairs tried to join components (LidarGraphOptions)
   double refinement_initial_cost = 0, refinement_final_cost = 0;
   // 3-cycles of the registered edges, and the worst loop error among those left after the check.
   size_t num_cycles = 0;

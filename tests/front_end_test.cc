@@ -322,20 +322,31 @@ TEST(FrontEndTest, SpatialMatcherPairsStationsNearInTheLidarRegistration) {
   std::vector<std::pair<colmap::image_t, colmap::image_t>> image_pairs;
   std::vector<int> num_inliers;
   database.ReadTwoViewGeometryNumInliers(&image_pairs, &num_inliers);
-  size_t num_verified = 0;
+  size_t num_verified = 0, num_unplaced_pairs = 0;
+  bool unplaced_pair_verified = false;
   for (size_t k = 0; k < image_pairs.size(); ++k) {
     const auto frame = [&database](colmap::image_t id) {
       return std::stoi(fs::path(database.ReadImage(id).Name()).stem().string());
     };
     const int a = frame(image_pairs[k].first), b = frame(image_pairs[k].second);
-    EXPECT_LE(std::max(a, b), 5) << a << "-" << b;
+    if (std::max(a, b) >= 6) {
+      // 006 and 007 have no position: matched with every image, and with each other.
+      ++num_unplaced_pairs;
+      if (std::min(a, b) == 6) unplaced_pair_verified = num_inliers[k] > 0;
+      continue;
+    }
     EXPECT_LE(std::abs(a - b), 2) << a << "-" << b;
     num_verified += num_inliers[k] > 0;
   }
-  std::cout << num_verified << " of " << image_pairs.size() << " pairs verified" << std::endl;
-  // Measured: 7 of 7 (each of the 6 frames with its 2 nearest); exhaustive matching would try 28.
+  std::cout << num_verified << " of " << image_pairs.size() - num_unplaced_pairs
+            << " spatial pairs verified; " << num_unplaced_pairs
+            << " pairs of the stations without a position" << std::endl;
+  // Measured: 7 of 7 (each of the 6 frames with its 2 nearest); exhaustive matching would try 15.
   EXPECT_GE(num_verified, 6u);
-  EXPECT_LE(image_pairs.size(), 9u);
+  EXPECT_LE(image_pairs.size() - num_unplaced_pairs, 9u);
+  // 006 with 000-005 and 007, 007 with 000-005; adjacent frames 006-007 share most of the view.
+  EXPECT_EQ(num_unplaced_pairs, 13u);
+  EXPECT_TRUE(unplaced_pair_verified);
 }
 
 // Bad stereo pairs: one clear error naming the station; the database is left exactly as it was.

@@ -65,8 +65,9 @@ std::string Summary(const std::vector<std::string>& names,
                     double seconds) {
   std::ostringstream summary;
   summary << "stations " << names.size() << "\npairs_attempted "
-          << graph.edges.size() + graph.refused.size() << "\nedges_accepted " << graph.edges.size()
-          << "\ncomponents " << graph.num_components << "\n";
+          << graph.edges.size() + graph.refused.size() << "\nbridge_pairs_attempted "
+          << graph.num_bridge_pairs << "\nedges_accepted " << graph.edges.size() << "\ncomponents "
+          << graph.num_components << "\n";
   for (int c = 0; c < graph.num_components; ++c) {
     summary << "component " << c << ":";
     for (size_t i = 0; i < names.size(); ++i) {
@@ -108,6 +109,8 @@ std::vector<fs::path> StationCloudFiles(const std::string& lidar_path) {
 bool LidarRegistratorStepOptions::Check() {
   CHECK_OPTION_GE(max_neighbors, 0);
   CHECK_OPTION_GE(sequential, 0);
+  CHECK_OPTION_GE(bridge_neighbors, 0);
+  graph.bridge_neighbors = static_cast<size_t>(bridge_neighbors);
   graph.max_neighbors = static_cast<size_t>(max_neighbors);
   graph.sequential = static_cast<size_t>(sequential);
   return sweep_timing.Check();
@@ -125,6 +128,10 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("max_neighbors",
           &options->max_neighbors,
           "0: all pairs; k: the k most similar stations each");
+  add.Add("bridge_neighbors",
+          &options->bridge_neighbors,
+          "disconnected stations: register each with its k most similar of other components");
+  add.Add("max_bridge_rounds", &options->graph.max_bridge_rounds);
   add.Add("sequential",
           &options->sequential,
           "k > 0: register each frame with its k successors (sweeps)");

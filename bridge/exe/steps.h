@@ -87,13 +87,14 @@ struct LidarRegistratorStepOptions {
   // Parsed as int (the OptionManager has no size_t); copied into `graph` by Check().
   int max_neighbors = 0;
   int sequential = 0;
+  int bridge_neighbors = 4;
   // Sweeps of a moving platform (frames in name order): register, de-skew every sweep with the motion
   // to its neighbour (lidar/sweep_deskew.h), write OUTPUT/deskewed/<station>.pcd and register again;
   // the later steps of `pipeline` use the de-skewed clouds.
   bool deskew_sweeps = false;
   SweepTimingOptions sweep_timing;
 
-  // Validates and copies max_neighbors and sequential into `graph`.
+  // Validates and copies max_neighbors, sequential and bridge_neighbors into `graph`.
   bool Check();
 };
 void AddLidarRegistratorOptions(const std::string& prefix,
