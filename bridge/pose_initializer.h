@@ -18,6 +18,7 @@
 #include "bridge/hand_eye.h"
 #include "bridge/image_pair_poses.h"
 #include "colmap_ext/station_dataset.h"
+#include "lidar/cycle_consistency.h"
 
 #include "colmap/scene/reconstruction.h"
 
@@ -48,6 +49,21 @@ struct PoseInitializerOptions {
   // is left out of the hand-eye and the pose graph. Wrong registrations differ by tens of degrees;
   // a chain of image edges between stations 130 deg apart was measured 2.6 deg off on the seed's scale.
   double max_lidar_image_angle_deg = 5.0;
+  // LiDAR edges that lidar_registrator accepted as degenerate (a direction its ICP barely
+  // constrains: a ground plane leaves the yaw free) enter the pose graph as full 6-DoF edges, and on
+  // sparse clouds they were wrong by up to 180 deg (7 of 7 on an 8-station, 100 k-ray capture and
+  // on B). They are left out unless this is set; a station only they reach is then unreachable.
+  bool use_degenerate_lidar_edges = false;
+  // Once cam_from_lidar is chosen, image and LiDAR edges are motions of one camera: an edge that
+  // breaks every cycle (3 stations, or an image and a LiDAR edge of one pair) it lies on within these
+  // tolerances is left out of the pose graph (lidar/cycle_consistency.h). Wider than the LiDAR
+  // graph's own (0.15 m, 1 deg): image edges from 3-point RANSAC on depth priors are coarser.
+  CycleConsistencyOptions mixed_cycles = [] {
+    CycleConsistencyOptions options;
+    options.max_translation_m = 0.25;
+    options.max_rotation_deg = 3.0;
+    return options;
+  }();
   // pose-graph edge weights
   double sigma_rotation_deg = 0.1;
   double sigma_translation_m = 0.005;
@@ -77,6 +93,14 @@ struct PoseInitialization {
   // LiDAR edges left out because an image edge of the same pair contradicts them: "target source:
   // LiDAR x deg, images y deg".
   std::vector<std::string> contradicted_lidar_edges;
+  // Degenerate LiDAR edges left out (PoseInitializerOptions::use_degenerate_lidar_edges).
+  std::vector<std::string> degenerate_lidar_edges;
+  // Edges of A_c v A_l left out by the cycle check after the hand-eye: "target source (LiDAR|images):
+  // why".
+  std::vector<std::string> inconsistent_edges;
+  // Edges the solved pose graph does not reproduce within those tolerances (a longer loop that does
+  // not close): "target source (LiDAR|images): x deg, y m ...". Not empty: the model may be wrong.
+  std::vector<std::string> disagreeing_edges;
 };
 
 // `registration_path`: lidar_registrator's output folder (pairs.txt); may be empty (no LiDAR edges).

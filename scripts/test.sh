@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs what is missing (scripts/setup.sh), builds colmap-lidar and runs every test: the layering
 # check, the unit tests beside the sources and the integration tests under tests/.
-#   scripts/test.sh           every test (CTest labels unit, integration, slow)
-#   scripts/test.sh --quick   without the slow ones (ctest -LE slow): a few minutes
+#   scripts/test.sh           every test (CTest labels unit, integration, slow), then the unit and
+#                             integration tests again under ASan + UBSan (scripts/sanitize.sh)
+#   scripts/test.sh --quick   without the slow ones (ctest -LE slow) nor the sanitizer pass: a few minutes
+#   SANITIZE=0                skips the sanitizer pass
 #   BUILD_DIR  build directory (default: build)
 #   JOBS       parallel build jobs (default: nproc)
 set -euo pipefail
@@ -26,3 +28,8 @@ cmake --build "$kBuildDir" -j "${JOBS:-$(nproc)}"
 echo "[test] running the tests"
 cd "$kBuildDir"
 ctest --output-on-failure -j "${JOBS:-$(nproc)}" "${ctest_selection[@]}"
+cd ..
+if [[ ${#ctest_selection[@]} -eq 0 && "${SANITIZE:-1}" != 0 ]]; then
+  echo "[test] the sanitizer pass (scripts/sanitize.sh)"
+  bash scripts/sanitize.sh
+fi

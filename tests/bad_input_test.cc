@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -304,6 +305,80 @@ TEST(WorkspaceLockTest, ASecondPipelineOnTheWorkspaceIsRefused) {
     std::this_thread::sleep_for(std::chrono::seconds(1));
   }
   EXPECT_EQ(rerun.output.find("in use by another pipeline"), std::string::npos) << rerun.output;
+}
+
+// True while another connection holds the write lock on `database` (sqlite3 without a busy timeout
+// fails at once to begin a write transaction then).
+bool WriteLocked(const std::string& database) {
+  return RunCommand("sqlite3 " + database + " 'BEGIN IMMEDIATE; ROLLBACK;'").exit_code != 0;
+}
+
+// A database that another program is writing to (sqlite3 holding an exclusive transaction open):
+// import_dataset waits 5 s for the lock, then gives one error naming the database; the database
+// keeps its bytes and no partial copy is left beside it.
+TEST(LockedDatabaseTest, ImportIntoADatabaseAnotherProgramWritesIsRefused) {
+  testing::ScopedTempDir dir("colmap_lidar_locked_database");
+  sim::SimulateSmallDataset(dir.File("dataset"), 3, 0.25, 20000);
+  const std::string database = dir.File("database.db");
+  const std::string import = kCli + " import_dataset --dataset_path " + dir.File("dataset") +
+                             " --database_path " + database;
+  const testing::CommandResult first = RunCommand(import);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const std::string before = ReadBytes(database);
+  ASSERT_EQ(std::system(("(echo 'BEGIN EXCLUSIVE;'; sleep 15) | sqlite3 " + database +
+                         " > /dev/null 2>&1 &")
+                            .c_str()),
+            0);
+  for (int i = 0; i < 100 && !WriteLocked(database); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_TRUE(WriteLocked(database)) << "sqlite3 did not take the lock";
+  const testing::CommandResult result = RunCommand(import);
+  EXPECT_NE(result.exit_code, -1) << "killed by a signal:\n" << result.output;
+  EXPECT_NE(result.exit_code, 0) << result.output;
+  const std::vector<std::string> errors = ErrorLines(result.output);
+  ASSERT_EQ(errors.size(), 1u) << result.output;
+  EXPECT_NE(errors[0].find(database), std::string::npos) << errors[0];
+  EXPECT_NE(errors[0].find("locked"), std::string::npos) << errors[0];
+  for (int i = 0; i < 300 && WriteLocked(database); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_EQ(ReadBytes(database), before) << "the locked database changed";
+  for (const auto& entry : fs::directory_iterator(dir.Path())) {
+    EXPECT_EQ(entry.path().filename().string().find("partial"), std::string::npos)
+        << "left behind: " << entry.path();
+  }
+}
+
+// A read-only output folder. Root writes anywhere, so as root the command runs as `nobody`
+// (util-linux's setpriv) on a dataset it may read, below a folder it may not write.
+TEST(ReadOnlyOutputTest, AnOutputBelowAReadOnlyFolderIsOneClearError) {
+  testing::ScopedTempDir dir("colmap_lidar_read_only");
+  std::string as_user;
+  if (geteuid() == 0) {
+    if (RunCommand("command -v setpriv").exit_code != 0) {
+      GTEST_SKIP() << "running as root without setpriv: the read-only case is skipped";
+    }
+    as_user = "setpriv --reuid=nobody --regid=nogroup --clear-groups ";
+  }
+  fs::permissions(dir.Path(),
+                  fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                      fs::perms::others_read | fs::perms::others_exec);
+  sim::SimulateSmallDataset(dir.File("dataset"), 3, 0.25, 20000);
+  const fs::path read_only = dir.Path() / "read_only";
+  fs::create_directories(read_only);
+  fs::permissions(read_only,
+                  fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                      fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  const testing::CommandResult result =
+      RunCommand(as_user + kCli + " lidar_registrator --lidar_path " + dir.File("dataset/lidar") +
+                 " --output_path " + (read_only / "out").string());
+  EXPECT_NE(result.exit_code, -1) << "killed by a signal:\n" << result.output;
+  EXPECT_NE(result.exit_code, 0) << result.output;
+  const std::vector<std::string> errors = ErrorLines(result.output);
+  ASSERT_EQ(errors.size(), 1u) << result.output;
+  EXPECT_NE(errors[0].find("read_only/out"), std::string::npos) << errors[0];
+  EXPECT_TRUE(fs::is_empty(read_only)) << "output left in " << read_only;
 }
 
 INSTANTIATE_TEST_SUITE_P(Matrix,

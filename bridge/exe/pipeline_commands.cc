@@ -36,6 +36,13 @@ void AddPoseInitializerOptions(const std::string& prefix,
   add.Add("max_lidar_image_angle_deg",
           &options->max_lidar_image_angle_deg,
           "a LiDAR edge whose rotation angle differs from the image edge's by more is left out");
+  add.Add("use_degenerate_lidar_edges",
+          &options->use_degenerate_lidar_edges,
+          "LiDAR edges with a weakly constrained direction in the pose graph (0: left out)");
+  add.Add("max_cycle_translation_m",
+          &options->mixed_cycles.max_translation_m,
+          "image and LiDAR edges: an edge breaking every cycle it is on by more is left out");
+  add.Add("max_cycle_rotation_deg", &options->mixed_cycles.max_rotation_deg);
   add.Add("sigma_rotation_deg", &options->sigma_rotation_deg, "pose-graph edge weight");
   add.Add("sigma_translation_m", &options->sigma_translation_m, "pose-graph edge weight");
 }
@@ -55,6 +62,9 @@ void WriteInitializationReport(const std::string& path,
   report["image_edges"] = init.num_image_edges;
   report["lidar_edges"] = init.num_lidar_edges;
   report["lidar_edges_contradicted_by_images"] = init.contradicted_lidar_edges;
+  report["edges_breaking_cycles"] = init.inconsistent_edges;
+  report["degenerate_lidar_edges_left_out"] = init.degenerate_lidar_edges;
+  report["edges_disagreeing_with_the_pose_graph"] = init.disagreeing_edges;
   report["stations"] = init.cam_from_world.size();
   report["unreachable"] = init.unreachable;
   report["input_model"] = input_path;
@@ -107,6 +117,11 @@ void RunPoseInitializerStep(const StationDataset& dataset,
   }
   std::cout << "cam_from_lidar: " << init.extrinsic_source
             << "; hand-eye: " << init.hand_eye.message << std::endl;
+  for (const std::string& edge : init.disagreeing_edges) {
+    std::cout << "WARNING: edge " << edge
+              << ": a loop of edges does not close; the stations it joins may be placed wrong"
+              << std::endl;
+  }
   for (const std::string& name : init.unreachable) {
     const auto reason = init.unreachable_reason.find(name);
     std::cout << "WARNING: station image " << name << " is not in the model ("
