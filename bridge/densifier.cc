@@ -496,8 +496,7 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
     summary.stations[k] = std::move(station);
   });
 
-  PointCloud lidar_cloud = lidar_map.Extract();
-  lidar_map.Clear();
+  PointCloud lidar_cloud = lidar_map.ExtractAndClear();
   lidar_cloud.normals.clear();
   summary.lidar_map_points = lidar_cloud.Size();
   WritePointCloud(partial.File("lidar_map.ply"), lidar_cloud);
@@ -510,8 +509,7 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
     summary.stations[k].seconds += SecondsSince(station_start);
   }
   const size_t num_fused_points = fused.NumPointsAdded();
-  const PointCloud fused_cloud = fused.Extract();
-  fused.Clear();
+  const PointCloud fused_cloud = fused.ExtractAndClear();
   summary.fused_points = fused_cloud.Size();
   std::cout << "densifier: fused " << num_fused_points << " points into " << fused_cloud.Size()
             << " voxels of " << options.fused_voxel_size_m * 1000 << " mm" << std::endl;

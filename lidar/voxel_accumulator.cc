@@ -56,7 +56,7 @@ void VoxelAccumulator::Add(const Eigen::Vector3d& point,
   if (!point.allFinite()) return;
   pending_.push_back({VoxelKey(point, voxel_size_), point, normal, color.cast<float>(), 1});
   ++num_added_;
-  if (pending_.size() >= std::max(min_buffered_points_, voxels_.size() / 4)) Compact();
+  if (pending_.size() >= std::max(min_buffered_points_, num_voxels_ / 4)) Compact();
 }
 
 void VoxelAccumulator::Compact() const {
@@ -70,49 +70,73 @@ void VoxelAccumulator::Compact() const {
   for (size_t p = 0; p < pending_.size();) {
     Voxel run = pending_[p++];
     while (p < pending_.size() && pending_[p].key == run.key) Accumulate(pending_[p++], &run);
-    while (v < voxels_.size() && voxels_[v].key < run.key) ++v;
-    if (v < voxels_.size() && voxels_[v].key == run.key) {
-      Accumulate(run, &voxels_[v]);
+    while (v < num_voxels_ && At(v).key < run.key) ++v;
+    if (v < num_voxels_ && At(v).key == run.key) {
+      Accumulate(run, &At(v));
     } else {
       pending_[num_runs++] = run;
     }
   }
   // The new voxels merged in from the back: no second copy of the voxels.
-  size_t old_end = voxels_.size();
-  voxels_.resize(old_end + num_runs);
-  for (size_t out = voxels_.size(); num_runs > 0;) {
-    if (old_end > 0 && voxels_[old_end - 1].key > pending_[num_runs - 1].key) {
-      voxels_[--out] = voxels_[--old_end];
+  size_t old_end = num_voxels_;
+  Resize(old_end + num_runs);
+  for (size_t out = num_voxels_; num_runs > 0;) {
+    if (old_end > 0 && At(old_end - 1).key > pending_[num_runs - 1].key) {
+      At(--out) = At(--old_end);
     } else {
-      voxels_[--out] = pending_[--num_runs];
+      At(--out) = pending_[--num_runs];
     }
   }
   pending_.clear();
 }
 
+void VoxelAccumulator::Resize(size_t n) const {
+  while ((chunks_.size() << kChunkBits) < n) chunks_.emplace_back(size_t(1) << kChunkBits);
+  num_voxels_ = n;
+}
+
 size_t VoxelAccumulator::NumVoxels() const {
   Compact();
-  return voxels_.size();
+  return num_voxels_;
+}
+
+void VoxelAccumulator::AppendPoint(size_t i, int min_points, PointCloud* cloud) const {
+  const Voxel& voxel = At(i);
+  if (voxel.count < static_cast<uint32_t>(std::max(1, min_points))) return;
+  cloud->points.push_back(voxel.sum_point / voxel.count);
+  const Eigen::Vector3f normal = voxel.sum_normal;
+  cloud->normals.push_back(normal.norm() > 0 ? Eigen::Vector3d(normal.normalized().cast<double>())
+                                             : Eigen::Vector3d::Zero());
+  const Eigen::Vector3f color = voxel.sum_color / float(voxel.count);
+  cloud->colors.push_back((color.array() + 0.5f).min(255.f).cast<uint8_t>().matrix());
 }
 
 PointCloud VoxelAccumulator::Extract(int min_points) const {
   Compact();
   PointCloud cloud;
-  cloud.Reserve(voxels_.size(), true, true, false);
-  for (const Voxel& voxel : voxels_) {
-    if (voxel.count < static_cast<uint32_t>(std::max(1, min_points))) continue;
-    cloud.points.push_back(voxel.sum_point / voxel.count);
-    const Eigen::Vector3f normal = voxel.sum_normal;
-    cloud.normals.push_back(normal.norm() > 0 ? Eigen::Vector3d(normal.normalized().cast<double>())
-                                              : Eigen::Vector3d::Zero());
-    const Eigen::Vector3f color = voxel.sum_color / float(voxel.count);
-    cloud.colors.push_back((color.array() + 0.5f).min(255.f).cast<uint8_t>().matrix());
+  cloud.Reserve(num_voxels_, true, true, false);
+  for (size_t i = 0; i < num_voxels_; ++i) AppendPoint(i, min_points, &cloud);
+  return cloud;
+}
+
+PointCloud VoxelAccumulator::ExtractAndClear(int min_points) {
+  Compact();
+  std::vector<Voxel>().swap(pending_);
+  PointCloud cloud;
+  // Reserved, not touched: the pages become resident as the chunks are freed.
+  cloud.Reserve(num_voxels_, true, true, false);
+  for (size_t i = 0; i < num_voxels_; ++i) {
+    AppendPoint(i, min_points, &cloud);
+    const bool chunk_done = ((i + 1) & ((size_t(1) << kChunkBits) - 1)) == 0;
+    if (chunk_done) std::vector<Voxel>().swap(chunks_[i >> kChunkBits]);
   }
+  Clear();
   return cloud;
 }
 
 void VoxelAccumulator::Clear() {
-  std::vector<Voxel>().swap(voxels_);
+  std::vector<std::vector<Voxel>>().swap(chunks_);
+  num_voxels_ = 0;
   std::vector<Voxel>().swap(pending_);
   num_added_ = 0;
 }

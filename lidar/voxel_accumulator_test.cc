@@ -71,9 +71,27 @@ TEST(VoxelAccumulator, MergesThroughManyBufferFlushesLikeAMap) {
   }
 }
 
+// 1.2 M voxels span two chunks of 2^20: extracting while freeing the chunks gives the same cloud as
+// extracting, and leaves the accumulator empty.
+TEST(VoxelAccumulator, ExtractAndClearGivesExtractsCloudAcrossChunks) {
+  VoxelAccumulator accumulator(0.01, 300000);
+  for (int i = 0; i < 1200000; ++i) {
+    const Eigen::Vector3d point(0.01 * (i % 1000) + 0.005, 0.01 * (i / 1000) + 0.005, 0.005);
+    accumulator.Add(point, Eigen::Vector3f(0, 0, 1), Color3ub(i % 256, 0, 0));
+  }
+  const PointCloud extracted = accumulator.Extract();
+  const PointCloud taken = accumulator.ExtractAndClear();
+  ASSERT_EQ(extracted.Size(), 1200000u);
+  ASSERT_EQ(taken.Size(), extracted.Size());
+  EXPECT_TRUE(taken.points == extracted.points);
+  EXPECT_TRUE(taken.colors == extracted.colors);
+  EXPECT_EQ(accumulator.NumVoxels(), 0u);
+  EXPECT_EQ(accumulator.Extract().Size(), 0u);
+}
+
 TEST(VoxelAccumulator, NeighbourKeysStepOneVoxelAlongEachAxis) {
   const Eigen::Vector3d point(-0.35, 0.12, 7.01);
-  for (const Eigen::Vector3i offset : {Eigen::Vector3i(1, 0, 0),
+  for (const Eigen::Vector3i& offset : {Eigen::Vector3i(1, 0, 0),
                                        Eigen::Vector3i(0, -1, 0),
                                        Eigen::Vector3i(-1, 1, 1),
                                        Eigen::Vector3i(0, 0, -1)}) {
