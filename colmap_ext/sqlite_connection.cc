@@ -24,11 +24,19 @@ SqliteConnection::SqliteConnection(const std::string& path, Mode mode, int busy_
   }
   sqlite3_busy_timeout(db_, busy_timeout_ms);
   sqlite3_extended_result_codes(db_, 1);
-  // Foreign keys are per connection in SQLite; COLMAP enables them on its own.
-  Execute("PRAGMA foreign_keys=ON");
-  // Fails early, with a clear message, on a file that is not an SQLite database.
-  Check(sqlite3_exec(db_, "SELECT count(*) FROM sqlite_master", nullptr, nullptr, nullptr),
-        "Reading the schema");
+  try {
+    // Foreign keys are per connection in SQLite; COLMAP enables them on its own.
+    Execute("PRAGMA foreign_keys=ON");
+    // Fails early, with a clear message, on a file that is not an SQLite database.
+    Check(sqlite3_exec(db_, "SELECT count(*) FROM sqlite_master", nullptr, nullptr, nullptr),
+          "Reading the schema");
+  } catch (...) {
+    // A constructor that throws runs no destructor: close the handle here (AddressSanitizer's leak
+    // check found it open after "file is not a database").
+    sqlite3_close_v2(db_);
+    db_ = nullptr;
+    throw;
+  }
 }
 
 SqliteConnection::~SqliteConnection() { sqlite3_close_v2(db_); }

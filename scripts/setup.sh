@@ -15,7 +15,7 @@ readonly kPackages=(
   libfreeimage-dev libflann-dev libmetis-dev libsqlite3-dev sqlite3 libsuitesparse-dev libglew-dev
   libpcl-dev libopencv-dev libgtest-dev libgmock-dev libomp-dev
   libnanoflann-dev nlohmann-json3-dev
-  clang libfuzzer-14-dev
+  clang libfuzzer-14-dev ccache
 )
 
 log() { printf '[setup] %s\n' "$*"; }

@@ -22,7 +22,8 @@ readonly kBuildDir="${BUILD_DIR:-build}"
 echo "[test] layering check"
 bash scripts/check_layering.sh
 echo "[test] configuring and building in $kBuildDir"
-cmake -S . -B "$kBuildDir" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+source scripts/ccache_env.sh
+cmake -S . -B "$kBuildDir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${ccache_launcher[@]}" \
   -DCMAKE_PREFIX_PATH="$kColmapPrefix${CMAKE_PREFIX_PATH:+;$CMAKE_PREFIX_PATH}" >/dev/null
 cmake --build "$kBuildDir" -j "${JOBS:-$(nproc)}"
 echo "[test] running the tests"
