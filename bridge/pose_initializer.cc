@@ -3,6 +3,7 @@
 #include "bridge/edge_consistency.h"
 #include "bridge/lidar_registration_files.h"
 #include "bridge/model_completion.h"
+#include "bridge/pose_graph_checks.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "lidar/pose_graph.h"
@@ -128,33 +129,6 @@ void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
   }
 }
 
-// Edges that the solved graph does not reproduce within the cycle tolerances: a loop longer than a
-// 3-cycle does not close, and the stations on it may be placed wrong (said, not hidden).
-void ListDisagreeingEdges(const std::vector<RelativePoseEdge>& edges,
-                          const PoseGraphSolution& solution,
-                          const std::vector<std::string>& node_names,
-                          const CycleConsistencyOptions& tolerance,
-                          PoseInitialization* init) {
-  for (size_t k = 0; k < edges.size(); ++k) {
-    const RelativePoseEdge& e = edges[k];
-    if (solution.component[e.target] != solution.component[0]) continue;
-    const Eigen::Isometry3d error = e.target_from_source.inverse() *
-                                    solution.world_from_node[e.target].inverse() *
-                                    solution.world_from_node[e.source];
-    const double angle_deg = Eigen::AngleAxisd(error.linear()).angle() * 180 / M_PI;
-    const double translation_m = error.translation().norm();
-    if (angle_deg <= tolerance.max_rotation_deg && translation_m <= tolerance.max_translation_m) {
-      continue;
-    }
-    std::ostringstream described;
-    described << node_names[e.target] << " " << node_names[e.source]
-              << (init->edges[k].from_lidar ? " (LiDAR): " : " (images): ") << std::fixed
-              << std::setprecision(1) << angle_deg << " deg, " << std::setprecision(3)
-              << translation_m << " m from the solved pose graph";
-    init->disagreeing_edges.push_back(described.str());
-  }
-}
-
 // The camera pose graph A_c v A_l (lidar/pose_graph.h): nodes are the stations in name order, the
 // first one is the world frame; stations outside its component are unreachable.
 void SolveCameraPoseGraph(const std::map<std::string, colmap::image_t>& image_of_station,
@@ -191,59 +165,6 @@ void SolveCameraPoseGraph(const std::map<std::string, colmap::image_t>& image_of
     }
     init->cam_from_world[image_of_node[k]] = ToRigid3d(solution.world_from_node[k].inverse());
   }
-}
-
-// The reason of a station unreachable once its degenerate LiDAR edges are left out.
-void ExplainDegenerateOnly(const std::map<std::string, colmap::image_t>& image_of_station,
-                           const std::map<colmap::image_t, std::string>& names,
-                           PoseInitialization* init) {
-  for (const auto& [station, image_id] : image_of_station) {
-    const std::string& name = names.at(image_id);
-    if (std::find(init->unreachable.begin(), init->unreachable.end(), name) ==
-        init->unreachable.end()) {
-      continue;
-    }
-    for (const std::string& edge : init->degenerate_lidar_edges) {
-      std::istringstream pair(edge);
-      std::string target, source;
-      pair >> target >> source;
-      if (target == station || source == station) {
-        init->unreachable_reason[name] =
-            "only degenerate LiDAR edges reach it (PoseInitializer.use_degenerate_lidar_edges 1 "
-            "uses them)";
-      }
-    }
-  }
-}
-
-// Edges of A_c v A_l, all cam_i_from_cam_j once cam_from_lidar is chosen, that break every cycle they
-// lie on (lidar/cycle_consistency.h): a LiDAR edge that slid along the ground of sparse clouds between
-// stations that no image edge joins still breaks the 3-cycles it forms with its neighbours' edges.
-void RemoveInconsistentEdges(const std::map<colmap::image_t, std::string>& names,
-                             const CycleConsistencyOptions& options,
-                             PoseInitialization* init) {
-  std::map<colmap::image_t, size_t> node;
-  for (const auto& [image_id, name] : names) node.emplace(image_id, node.size());
-  std::vector<RelativePose> poses;
-  for (const PoseGraphEdge& e : init->edges) {
-    poses.push_back(
-        {node.at(e.image_i), node.at(e.image_j), ToIsometry(e.cam_i_from_cam_j), e.weight});
-  }
-  const CycleCheck check = CheckThreeCycles(poses, options);
-  std::vector<PoseGraphEdge> kept;
-  for (size_t k = 0; k < init->edges.size(); ++k) {
-    const PoseGraphEdge& e = init->edges[k];
-    if (!check.removed[k]) {
-      kept.push_back(e);
-      continue;
-    }
-    const std::string described = names.at(e.image_i) + " " + names.at(e.image_j) +
-                                  (e.from_lidar ? " (LiDAR): " : " (images): ") + check.reason[k];
-    std::cout << "pose_initializer: edge " << described << "; left out" << std::endl;
-    init->inconsistent_edges.push_back(described);
-    (e.from_lidar ? init->num_lidar_edges : init->num_image_edges)--;
-  }
-  init->edges = std::move(kept);
 }
 
 // The LiDAR edges of lidar_registrator's pairs.txt (none when `registration_path` is empty) between
