@@ -9,6 +9,14 @@
 #include <sstream>
 
 namespace colmap_lidar {
+namespace {
+
+// "name_i name_j (LiDAR): " or "... (images): ".
+std::string EdgeLabel(const std::string& name_i, const std::string& name_j, bool from_lidar) {
+  return name_i + " " + name_j + (from_lidar ? " (LiDAR): " : " (images): ");
+}
+
+}  // namespace
 
 void RemoveInconsistentEdges(const std::map<colmap::image_t, std::string>& names,
                              const CycleConsistencyOptions& options,
@@ -28,8 +36,8 @@ void RemoveInconsistentEdges(const std::map<colmap::image_t, std::string>& names
       kept.push_back(e);
       continue;
     }
-    const std::string described = names.at(e.image_i) + " " + names.at(e.image_j) +
-                                  (e.from_lidar ? " (LiDAR): " : " (images): ") + check.reason[k];
+    const std::string described =
+        EdgeLabel(names.at(e.image_i), names.at(e.image_j), e.from_lidar) + check.reason[k];
     std::cout << "pose_initializer: edge " << described << "; left out" << std::endl;
     init->inconsistent_edges.push_back(described);
     (e.from_lidar ? init->num_lidar_edges : init->num_image_edges)--;
@@ -54,9 +62,8 @@ void ListDisagreeingEdges(const std::vector<RelativePoseEdge>& edges,
       continue;
     }
     std::ostringstream described;
-    described << node_names[e.target] << " " << node_names[e.source]
-              << (init->edges[k].from_lidar ? " (LiDAR): " : " (images): ") << std::fixed
-              << std::setprecision(1) << angle_deg << " deg, " << std::setprecision(3)
+    described << EdgeLabel(node_names[e.target], node_names[e.source], init->edges[k].from_lidar)
+              << std::fixed << std::setprecision(1) << angle_deg << " deg, " << std::setprecision(3)
               << translation_m << " m from the solved pose graph";
     init->disagreeing_edges.push_back(described.str());
   }
@@ -71,11 +78,8 @@ void ExplainDegenerateOnly(const std::map<std::string, colmap::image_t>& image_o
         init->unreachable.end()) {
       continue;
     }
-    for (const std::string& edge : init->degenerate_lidar_edges) {
-      std::istringstream pair(edge);
-      std::string target, source;
-      pair >> target >> source;
-      if (target == station || source == station) {
+    for (const LidarPairRecord& pair : init->degenerate_lidar_edges) {
+      if (pair.target == station || pair.source == station) {
         init->unreachable_reason[name] =
             "only degenerate LiDAR edges reach it (PoseInitializer.use_degenerate_lidar_edges 1 "
             "uses them)";

@@ -32,7 +32,7 @@ void ListDisagreeingEdges(const std::vector<RelativePoseEdge>& edges,
                           PoseInitialization* init);
 
 // The reason of each unreachable station that only left-out degenerate LiDAR edges
-// (init->degenerate_lidar_edges, "target source: ...") reached.
+// (init->degenerate_lidar_edges) reached.
 void ExplainDegenerateOnly(const std::map<std::string, colmap::image_t>& image_of_station,
                            const std::map<colmap::image_t, std::string>& names,
                            PoseInitialization* init);

@@ -174,16 +174,16 @@ std::vector<LidarStationEdge> ReadLidarEdges(
     const std::string& registration_path,
     const std::map<std::string, colmap::image_t>& image_of_station,
     bool use_degenerate,
-    std::vector<std::string>* left_out) {
+    std::vector<LidarPairRecord>* left_out) {
   std::vector<LidarStationEdge> lidar_edges;
   if (registration_path.empty()) return lidar_edges;
   for (const LidarPairRecord& pair :
        ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
     if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) continue;
     if (pair.degenerate && !use_degenerate) {
-      left_out->push_back(pair.target + " " + pair.source + ": degenerate (weakest direction " +
-                          pair.weakest_axis + ")");
-      std::cout << "pose_initializer: LiDAR edge " << left_out->back() << ", left out" << std::endl;
+      left_out->push_back(pair);
+      std::cout << "pose_initializer: LiDAR edge " << DescribeDegenerateEdge(pair) << ", left out"
+                << std::endl;
       continue;
     }
     lidar_edges.push_back({image_of_station.at(pair.target),
@@ -195,6 +195,11 @@ std::vector<LidarStationEdge> ReadLidarEdges(
 }
 
 }  // namespace
+
+std::string DescribeDegenerateEdge(const LidarPairRecord& pair) {
+  return pair.target + " " + pair.source + ": degenerate (weakest direction " + pair.weakest_axis +
+         ")";
+}
 
 bool PoseInitializerOptions::Check() const {
   CHECK_OPTION(image_pairs.Check());

@@ -17,6 +17,7 @@
 
 #include "bridge/hand_eye.h"
 #include "bridge/image_pair_poses.h"
+#include "bridge/lidar_registration_files.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cycle_consistency.h"
 
@@ -94,7 +95,7 @@ struct PoseInitialization {
   // LiDAR x deg, images y deg".
   std::vector<std::string> contradicted_lidar_edges;
   // Degenerate LiDAR edges left out (PoseInitializerOptions::use_degenerate_lidar_edges).
-  std::vector<std::string> degenerate_lidar_edges;
+  std::vector<LidarPairRecord> degenerate_lidar_edges;
   // Edges of A_c v A_l left out by the cycle check after the hand-eye: "target source (LiDAR|images):
   // why".
   std::vector<std::string> inconsistent_edges;
@@ -102,6 +103,9 @@ struct PoseInitialization {
   // not close): "target source (LiDAR|images): x deg, y m ...". Not empty: the model may be wrong.
   std::vector<std::string> disagreeing_edges;
 };
+
+// "target source: degenerate (weakest direction ty)", for the console and initialization.json.
+std::string DescribeDegenerateEdge(const LidarPairRecord& pair);
 
 // `registration_path`: lidar_registrator's output folder (pairs.txt); may be empty (no LiDAR edges).
 PoseInitialization InitializePoses(const std::string& database_path,

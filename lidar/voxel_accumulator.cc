@@ -121,14 +121,14 @@ PointCloud VoxelAccumulator::Extract(int min_points) const {
 
 PointCloud VoxelAccumulator::ExtractAndClear(int min_points) {
   Compact();
-  std::vector<Voxel>().swap(pending_);
+  std::vector<Voxel>().swap(
+      pending_);  // the merge buffer's capacity (up to a quarter of the voxels)
   PointCloud cloud;
   // Reserved, not touched: the pages become resident as the chunks are freed.
   cloud.Reserve(num_voxels_, true, true, false);
   for (size_t i = 0; i < num_voxels_; ++i) {
     AppendPoint(i, min_points, &cloud);
-    const bool chunk_done = ((i + 1) & ((size_t(1) << kChunkBits) - 1)) == 0;
-    if (chunk_done) std::vector<Voxel>().swap(chunks_[i >> kChunkBits]);
+    if (((i + 1) & kChunkMask) == 0) std::vector<Voxel>().swap(chunks_[i >> kChunkBits]);
   }
   Clear();
   return cloud;

@@ -54,11 +54,10 @@ class VoxelAccumulator {
     uint32_t count = 0;
   };
   static constexpr int kChunkBits = 20;
+  static constexpr size_t kChunkMask = (size_t(1) << kChunkBits) - 1;
   // Merges the buffer into the voxels (const: it changes the representation, not the content).
   void Compact() const;
-  Voxel& At(size_t i) const {
-    return chunks_[i >> kChunkBits][i & ((size_t(1) << kChunkBits) - 1)];
-  }
+  Voxel& At(size_t i) const { return chunks_[i >> kChunkBits][i & kChunkMask]; }
   // Grows to n voxels (new ones default), adding chunks; existing voxels stay where they are.
   void Resize(size_t n) const;
   // Appends voxel i's point, normal and colour to `cloud` if it has at least `min_points`.

@@ -92,9 +92,9 @@ TEST(VoxelAccumulator, ExtractAndClearGivesExtractsCloudAcrossChunks) {
 TEST(VoxelAccumulator, NeighbourKeysStepOneVoxelAlongEachAxis) {
   const Eigen::Vector3d point(-0.35, 0.12, 7.01);
   for (const Eigen::Vector3i& offset : {Eigen::Vector3i(1, 0, 0),
-                                       Eigen::Vector3i(0, -1, 0),
-                                       Eigen::Vector3i(-1, 1, 1),
-                                       Eigen::Vector3i(0, 0, -1)}) {
+                                        Eigen::Vector3i(0, -1, 0),
+                                        Eigen::Vector3i(-1, 1, 1),
+                                        Eigen::Vector3i(0, 0, -1)}) {
     EXPECT_EQ(NeighbourVoxelKey(VoxelKey(point, 0.1), offset),
               VoxelKey(point + 0.1 * offset.cast<double>(), 0.1));
   }

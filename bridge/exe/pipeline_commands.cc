@@ -63,7 +63,10 @@ void WriteInitializationReport(const std::string& path,
   report["lidar_edges"] = init.num_lidar_edges;
   report["lidar_edges_contradicted_by_images"] = init.contradicted_lidar_edges;
   report["edges_breaking_cycles"] = init.inconsistent_edges;
-  report["degenerate_lidar_edges_left_out"] = init.degenerate_lidar_edges;
+  report["degenerate_lidar_edges_left_out"] = nlohmann::json::array();
+  for (const LidarPairRecord& pair : init.degenerate_lidar_edges) {
+    report["degenerate_lidar_edges_left_out"].push_back(DescribeDegenerateEdge(pair));
+  }
   report["edges_disagreeing_with_the_pose_graph"] = init.disagreeing_edges;
   report["stations"] = init.cam_from_world.size();
   report["unreachable"] = init.unreachable;
