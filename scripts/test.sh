@@ -27,9 +27,8 @@ cmake -S . -B "$kBuildDir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${ccache_launche
   -DCMAKE_PREFIX_PATH="$kColmapPrefix${CMAKE_PREFIX_PATH:+;$CMAKE_PREFIX_PATH}" >/dev/null
 cmake --build "$kBuildDir" -j "${JOBS:-$(nproc)}"
 echo "[test] running the tests"
-cd "$kBuildDir"
-ctest --output-on-failure -j "${JOBS:-$(nproc)}" "${ctest_selection[@]}"
-cd ..
+# In a subshell: BUILD_DIR may be nested or absolute, and the sanitizer pass runs from the root.
+(cd "$kBuildDir" && ctest --output-on-failure -j "${JOBS:-$(nproc)}" "${ctest_selection[@]}")
 if [[ ${#ctest_selection[@]} -eq 0 && "${SANITIZE:-1}" != 0 ]]; then
   echo "[test] the sanitizer pass (scripts/sanitize.sh)"
   bash scripts/sanitize.sh
