@@ -46,6 +46,37 @@ double Curvature(const Pca& pca) {
   return sum > 0 ? std::max(0.0, pca.eigenvalues(0)) / sum : 0.0;
 }
 
+// Each sample's own neighbourhood plane (`valid` false with fewer than min_neighbors samples in the
+// radius) and the mean distance to its 4 nearest other samples (a count in the radius would double
+// the spacing at a border, where half the disc is empty, and fatten the border's splats).
+void OwnNeighbourhoods(const std::vector<Eigen::Vector3d>& samples,
+                       const KdTree3& tree,
+                       const LidarSurfaceOptions& options,
+                       std::vector<Pca>* pcas,
+                       std::vector<char>* valid,
+                       std::vector<float>* spacing) {
+  pcas->assign(samples.size(), Pca());
+  valid->assign(samples.size(), 0);
+  spacing->assign(samples.size(), 0.f);
+#pragma omp parallel
+  {
+    std::vector<size_t> indices, nearest;
+    std::vector<double> squared;
+#pragma omp for schedule(dynamic, 256)
+    for (size_t i = 0; i < samples.size(); ++i) {
+      tree.RadiusSearch(samples[i], options.radius_m, &indices);
+      if (static_cast<int>(indices.size()) < options.min_neighbors) continue;
+      (*pcas)[i] = NeighbourhoodPca(samples, indices, options.max_neighbors);
+      (*valid)[i] = 1;
+      tree.KNearest(samples[i], 5, &nearest, &squared);
+      double sum = 0;
+      for (size_t k = 1; k < nearest.size(); ++k) sum += std::sqrt(squared[k]);
+      (*spacing)[i] =
+          float(nearest.size() > 1 ? sum / (nearest.size() - 1) : options.sample_spacing_m);
+    }
+  }
+}
+
 }  // namespace
 
 bool LidarSurfaceOptions::Check() const {
@@ -67,31 +98,27 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
   const PointCloud thinned = VoxelDownsample(raw, options.sample_spacing_m);
   const std::vector<Eigen::Vector3d>& samples = thinned.points;
   const KdTree3 tree(samples);
+  // Every neighbourhood once: a shifted neighbourhood centred on sample j is sample j's own.
+  std::vector<Pca> own;
+  std::vector<char> valid;
+  std::vector<float> spacing;
+  OwnNeighbourhoods(samples, tree, options, &own, &valid, &spacing);
 
   std::vector<Eigen::Vector3d> points(samples.size());
   std::vector<Eigen::Vector3d> normals(samples.size());
   std::vector<float> curvature(samples.size(), -1.f);  // -1: dropped
-  std::vector<float> spacing(samples.size(), 0.f);
 #pragma omp parallel
   {
-    std::vector<size_t> indices, candidates, shifted, nearest;
-    std::vector<double> squared;
+    std::vector<size_t> indices, candidates;
 #pragma omp for schedule(dynamic, 256)
     for (size_t i = 0; i < samples.size(); ++i) {
-      tree.RadiusSearch(samples[i], options.radius_m, &indices);
-      if (static_cast<int>(indices.size()) < options.min_neighbors) continue;
-      Pca pca = NeighbourhoodPca(samples, indices, options.max_neighbors);
-      // Spacing: mean distance to the 4 nearest other samples (a count in the radius would double
-      // it at a border, where half the disc is empty, and fatten the border's splats).
-      tree.KNearest(samples[i], 5, &nearest, &squared);
-      double sum = 0;
-      for (size_t k = 1; k < nearest.size(); ++k) sum += std::sqrt(squared[k]);
-      spacing[i] =
-          float(nearest.size() > 1 ? sum / (nearest.size() - 1) : options.sample_spacing_m);
+      if (!valid[i]) continue;
+      const Pca* pca = &own[i];
       if (options.num_shifted_neighbourhoods > 0) {
-        // Neighbourhood shifting: also fit the neighbourhoods centred on samples half a radius
+        // Neighbourhood shifting: also take the neighbourhoods centred on samples half a radius
         // away and keep the flattest. Near a corner that is a neighbourhood on the sample's own face,
         // so the corner stays sharp instead of being rounded off by a radius.
+        tree.RadiusSearch(samples[i], options.radius_m, &indices);
         candidates.clear();
         for (size_t j : indices) {
           const double d = (samples[j] - samples[i]).norm();
@@ -101,20 +128,18 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
         }
         const size_t stride =
             std::max<size_t>(1, candidates.size() / options.num_shifted_neighbourhoods);
-        double best = Curvature(pca);
+        double best = Curvature(*pca);
         for (size_t k = 0; k < candidates.size(); k += stride) {
-          tree.RadiusSearch(samples[candidates[k]], options.radius_m, &shifted);
-          if (static_cast<int>(shifted.size()) < options.min_neighbors) continue;
-          const Pca other = NeighbourhoodPca(samples, shifted, options.max_neighbors);
-          const double c = Curvature(other);
-          if (c < best) best = c, pca = other;
+          if (!valid[candidates[k]]) continue;
+          const double c = Curvature(own[candidates[k]]);
+          if (c < best) best = c, pca = &own[candidates[k]];
         }
       }
-      Eigen::Vector3d normal = pca.normal;
+      Eigen::Vector3d normal = pca->normal;
       if (normal.dot(samples[i]) > 0) normal = -normal;  // face the camera
-      points[i] = samples[i] - normal * normal.dot(samples[i] - pca.mean);
+      points[i] = samples[i] - normal * normal.dot(samples[i] - pca->mean);
       normals[i] = normal;
-      double c = Curvature(pca);
+      double c = Curvature(*pca);
       if (options.curvature_radius_m != options.radius_m) {
         tree.RadiusSearch(samples[i], options.curvature_radius_m, &indices);
         c = Curvature(NeighbourhoodPca(samples, indices, options.max_neighbors));
