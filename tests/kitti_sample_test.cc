@@ -193,3 +193,40 @@ TEST(KittiSampleTest, DepthEdgesProjectOntoImageEdgesThroughTheImportedCalibrati
 
 }  // namespace
 }  // namespace colmap_lidar
+
+namespace colmap_lidar {
+namespace {
+
+// calibrate_edges (Levinson & Thrun's baseline) on the real sweeps and images: from import_kitti's
+// seeded guess, 3 deg / 5 cm off KITTI's reference. Measured: rotation 0.36 deg, translation 108 mm
+// (six frames; the translation moves a 15 m edge by 5 px per 10 cm and is not recovered: see
+// docs/edge_calibration.md).
+TEST(KittiSampleTest, EdgeCalibrationRecoversTheRotationFromAThreeDegreeGuess) {
+  if (!std::filesystem::is_directory(kSample)) {
+    GTEST_SKIP() << "no KITTI sample at " << kSampleRoot;
+  }
+  testing::ScopedTempDir dir;
+  const std::string cli = COLMAP_LIDAR_CLI_EXE;
+  const auto import = testing::RunCommand(
+      cli + " import_kitti --kitti_path " + kSampleRoot + " --calib_path " + kSampleRoot +
+      "/calibration" + " --output_path " + dir.File("dataset") + " --camera 0 --write_guess 1");
+  ASSERT_EQ(import.exit_code, 0) << import.output;
+  const auto run = testing::RunCommand(cli + " calibrate_edges --dataset_path " +
+                                       dir.File("dataset") + " --output_path " + dir.File("edges"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const StationDataset dataset = ReadStationDataset(dir.File("dataset"));
+  const colmap::Rigid3d reference = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  const colmap::Rigid3d estimate = ReadPoseFile(dir.File("edges/cam_from_lidar.txt"));
+  auto rotation_deg = [&](const colmap::Rigid3d& pose) {
+    return reference.rotation.angularDistance(pose.rotation) * 180 / M_PI;
+  };
+  std::cout << "guess " << rotation_deg(*dataset.rig.cam_from_lidar_guess)
+            << " deg; calibrate_edges " << rotation_deg(estimate) << " deg, "
+            << (estimate.translation - reference.translation).norm() * 1000 << " mm" << std::endl;
+  EXPECT_GT(rotation_deg(*dataset.rig.cam_from_lidar_guess), 2.5);
+  EXPECT_LT(rotation_deg(estimate), 1.0);
+  EXPECT_TRUE(std::filesystem::exists(dir.File("edges/report.json")));
+}
+
+}  // namespace
+}  // namespace colmap_lidar

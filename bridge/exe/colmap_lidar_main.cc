@@ -83,6 +83,9 @@ const std::vector<Command>& Commands() {
       {"evaluate_calibration",
        &RunEvaluateCalibration,
        "Error of cam_from_lidar and of station poses against ground truth"},
+      {"calibrate_edges",
+       &RunCalibrateEdges,
+       "cam_from_lidar from image edges and LiDAR depth discontinuities (Levinson & Thrun)"},
   };
   return kCommands;
 }

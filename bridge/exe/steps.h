@@ -9,6 +9,7 @@
 #pragma once
 
 #include "bridge/densifier.h"
+#include "bridge/edge_calibration.h"
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
 #include "bridge/pose_initializer.h"
@@ -170,6 +171,14 @@ struct DensifierPaths {
 void RunDensifierStep(const StationDataset& dataset,
                       const DensifierPaths& paths,
                       const DensifierOptions& options);
+
+// calibrate_edges: cam_from_lidar by Levinson & Thrun's edge alignment from a start (the file, or
+// rig.json's guess), over all stations or those registered in `input_path`.
+void RunCalibrateEdgesStep(const std::string& dataset_path,
+                           const std::string& input_path,
+                           const std::string& cam_from_lidar_path,
+                           const std::string& output_path,
+                           const EdgeCalibrationOptions& options);
 
 // evaluate_calibration: cam_from_lidar and station poses against ground_truth/. `output_path` empty:
 // print the metrics only. `alignment`: rigid | similarity.
