@@ -78,7 +78,8 @@ EdgeStation PrepareEdgeStation(const std::string& name,
   EdgeStation station;
   station.name = name;
   station.camera = camera;
-  station.transform = InverseDistanceTransform(EdgeImage(image, options.transform.blur_sigma_px), options.transform);
+  station.transform = InverseDistanceTransform(EdgeImage(image, options.transform.blur_sigma_px),
+                                               options.transform);
   station.discontinuities = DetectDepthDiscontinuities(points_in_lidar, options.discontinuities);
   return station;
 }

@@ -5,7 +5,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <cmath>
 
 namespace colmap_lidar {
 
@@ -28,21 +27,15 @@ cv::Mat EdgeImage(const cv::Mat& image, double blur_sigma_px) {
   }
   THROW_CHECK_EQ(grey.type(), CV_8UC1);
   if (blur_sigma_px > 0) cv::GaussianBlur(grey, grey, cv::Size(), blur_sigma_px);
-  cv::Mat edges(grey.size(), CV_32F, cv::Scalar(0));
-  for (int row = 0; row < grey.rows; ++row) {
-    for (int col = 0; col < grey.cols; ++col) {
-      const int value = grey.at<uint8_t>(row, col);
-      int largest = 0;
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int r = row + dy, c = col + dx;
-          if (r < 0 || c < 0 || r >= grey.rows || c >= grey.cols) continue;
-          largest = std::max(largest, std::abs(value - int(grey.at<uint8_t>(r, c))));
-        }
-      }
-      edges.at<float>(row, col) = float(largest);
-    }
-  }
+  // max_q |I(p) - I(q)| over the 3x3 neighbourhood = max(dilate(I) - I, I - erode(I)); OpenCV's
+  // default border of dilate/erode leaves pixels outside the image out.
+  cv::Mat dilated, eroded, edges;
+  cv::dilate(grey, dilated, cv::Mat());
+  cv::erode(grey, eroded, cv::Mat());
+  cv::subtract(dilated, grey, dilated);
+  cv::subtract(grey, eroded, eroded);
+  cv::max(dilated, eroded, edges);
+  edges.convertTo(edges, CV_32F);
   return edges;
 }
 

@@ -16,7 +16,7 @@ struct Cell {
   size_t index = 0;
 };
 
-double Elevation(const Eigen::Vector3d& p, double range) { return std::asin(p.z() / range); }
+double Elevation(const Eigen::Vector3d& p) { return std::atan2(p.z(), p.head<2>().norm()); }
 
 // Mean cell size at which the points, spread evenly over the elevations they cover, fill each
 // cell once, times 1.5.
@@ -26,7 +26,7 @@ double AutomaticResolution(const std::vector<Eigen::Vector3d>& points, double mi
   for (const Eigen::Vector3d& p : points) {
     const double range = p.norm();
     if (!(range >= min_range)) continue;
-    const double elevation = Elevation(p, range);
+    const double elevation = Elevation(p);
     low = std::min(low, elevation), high = std::max(high, elevation);
     ++count;
   }
@@ -45,7 +45,7 @@ std::vector<Cell> RangeImage(const std::vector<Eigen::Vector3d>& points,
     const Eigen::Vector3d& p = points[i];
     const double range = p.norm();
     if (!(range >= min_range) || !p.allFinite()) continue;
-    const int row = static_cast<int>(std::floor((Elevation(p, range) + M_PI / 2) / resolution));
+    const int row = static_cast<int>(std::floor((Elevation(p) + M_PI / 2) / resolution));
     const int col = std::min(
         num_cols - 1, static_cast<int>(std::floor((std::atan2(p.y(), p.x()) + M_PI) / resolution)));
     auto [it, inserted] =
@@ -107,7 +107,6 @@ std::vector<DepthDiscontinuity> DetectDepthDiscontinuities(
   for (size_t k = 0; k < cells.size(); ++k) {
     RowRanges(cells, k, -1, options, &before);
     RowRanges(cells, k, +1, options, &after);
-    if (before.empty() && after.empty()) continue;
     // Levinson & Thrun's X_i from the adjacent cells.
     const double to_before = before.empty() ? 0.0 : before[0] - cells[k].range;
     const double to_after = after.empty() ? 0.0 : after[0] - cells[k].range;
