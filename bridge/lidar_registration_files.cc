@@ -139,11 +139,14 @@ std::map<std::string, Eigen::Vector3d> StationCameraPositions(
   return positions;
 }
 
-StationDataset WithDeskewedClouds(StationDataset dataset, const std::string& registration_path) {
+StationDataset WithRegistratorClouds(StationDataset dataset, const std::string& registration_path) {
+  if (registration_path.empty()) return dataset;
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
-    const std::filesystem::path deskewed =
-        std::filesystem::path(registration_path) / "deskewed" / (dataset.stations[i] + ".pcd");
-    if (std::filesystem::is_regular_file(deskewed)) dataset.cloud_paths[i] = deskewed.string();
+    for (const char* folder : {"deskewed", "static"}) {  // the later one wins
+      const std::filesystem::path cloud =
+          std::filesystem::path(registration_path) / folder / (dataset.stations[i] + ".pcd");
+      if (std::filesystem::is_regular_file(cloud)) dataset.cloud_paths[i] = cloud.string();
+    }
   }
   return dataset;
 }

@@ -71,8 +71,9 @@ std::map<std::string, colmap::Rigid3d> LargestComponentLidarPoses(
 std::map<std::string, Eigen::Vector3d> StationCameraPositions(
     const std::string& registration_path, const colmap::Rigid3d& cam_from_lidar);
 
-// `dataset` with each station's cloud replaced by `registration_path`/deskewed/<station>.pcd where
-// lidar_registrator --deskew_sweeps 1 wrote one.
-StationDataset WithDeskewedClouds(StationDataset dataset, const std::string& registration_path);
+// `dataset` with each station's cloud replaced by the one lidar_registrator wrote for it:
+// `registration_path`/static/<station>.pcd (--remove_moving_points 1: moving objects left out), else
+// `registration_path`/deskewed/<station>.pcd (--deskew_sweeps 1). An empty path changes nothing.
+StationDataset WithRegistratorClouds(StationDataset dataset, const std::string& registration_path);
 
 }  // namespace colmap_lidar

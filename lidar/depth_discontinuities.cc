@@ -1,10 +1,10 @@
 #include "lidar/depth_discontinuities.h"
 
 #include "lidar/check_option.h"
+#include "lidar/spherical_range_image.h"
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 namespace colmap_lidar {
 namespace {
@@ -16,49 +16,16 @@ struct Cell {
   size_t index = 0;
 };
 
-double Elevation(const Eigen::Vector3d& p) { return std::atan2(p.z(), p.head<2>().norm()); }
-
-// Mean cell size at which the points, spread evenly over the elevations they cover, fill each
-// cell once, times 1.5.
-double AutomaticResolution(const std::vector<Eigen::Vector3d>& points, double min_range) {
-  double low = M_PI / 2, high = -M_PI / 2;
-  size_t count = 0;
-  for (const Eigen::Vector3d& p : points) {
-    const double range = p.norm();
-    if (!(range >= min_range)) continue;
-    const double elevation = Elevation(p);
-    low = std::min(low, elevation), high = std::max(high, elevation);
-    ++count;
+// The occupied cells of the range image, sorted by row, then column.
+std::vector<Cell> OccupiedCells(const SphericalRangeImage& image) {
+  std::vector<Cell> cells;
+  for (int row = image.FirstRow(); row < image.FirstRow() + image.NumRows(); ++row) {
+    for (int col = 0; col < image.NumCols(); ++col) {
+      const int64_t index = image.Index(row, col);
+      if (index >= 0) cells.push_back(Cell{row, col, image.Range(row, col), size_t(index)});
+    }
   }
-  if (count == 0) return M_PI / 180;
-  const double solid_angle = 2 * M_PI * (std::sin(high) - std::sin(low));
-  return 1.5 * std::sqrt(std::max(solid_angle, 1e-9) / double(count));
-}
-
-// The nearest point of each cell of the spherical range image, sorted by row, then column.
-std::vector<Cell> RangeImage(const std::vector<Eigen::Vector3d>& points,
-                             double resolution,
-                             double min_range) {
-  std::unordered_map<int64_t, Cell> cells;
-  const int num_cols = static_cast<int>(std::ceil(2 * M_PI / resolution));
-  for (size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3d& p = points[i];
-    const double range = p.norm();
-    if (!(range >= min_range) || !p.allFinite()) continue;
-    const int row = static_cast<int>(std::floor((Elevation(p) + M_PI / 2) / resolution));
-    const int col = std::min(
-        num_cols - 1, static_cast<int>(std::floor((std::atan2(p.y(), p.x()) + M_PI) / resolution)));
-    auto [it, inserted] =
-        cells.try_emplace(int64_t(row) * num_cols + col, Cell{row, col, range, i});
-    if (!inserted && range < it->second.range) it->second = Cell{row, col, range, i};
-  }
-  std::vector<Cell> sorted;
-  sorted.reserve(cells.size());
-  for (const auto& [key, cell] : cells) sorted.push_back(cell);
-  std::sort(sorted.begin(), sorted.end(), [](const Cell& a, const Cell& b) {
-    return a.row != b.row ? a.row < b.row : a.col < b.col;
-  });
-  return sorted;
+  return cells;
 }
 
 // The ranges of up to context_cells occupied cells next to cell k in its row, nearest first, in
@@ -98,10 +65,12 @@ bool DepthDiscontinuityOptions::Check() const {
 std::vector<DepthDiscontinuity> DetectDepthDiscontinuities(
     const std::vector<Eigen::Vector3d>& points_in_lidar, const DepthDiscontinuityOptions& options) {
   ThrowUnlessValid(options, "DepthDiscontinuityOptions");
-  const double resolution = options.angular_resolution_deg > 0
-                                ? options.angular_resolution_deg * M_PI / 180
-                                : AutomaticResolution(points_in_lidar, options.min_range_m);
-  const std::vector<Cell> cells = RangeImage(points_in_lidar, resolution, options.min_range_m);
+  const double resolution =
+      options.angular_resolution_deg > 0
+          ? options.angular_resolution_deg * M_PI / 180
+          : SphericalRangeImage::AutomaticResolution(points_in_lidar, options.min_range_m);
+  const std::vector<Cell> cells =
+      OccupiedCells(SphericalRangeImage(points_in_lidar, resolution, options.min_range_m));
   std::vector<DepthDiscontinuity> result;
   std::vector<double> before, after;
   for (size_t k = 0; k < cells.size(); ++k) {

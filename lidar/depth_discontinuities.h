@@ -3,11 +3,10 @@
 // gets X_i = max(r_{i-1} - r_i, r_{i+1} - r_i, 0)^gamma from the ranges r of its neighbours, so a
 // point in front of its neighbours (the near side of a depth edge) scores and the far side does not.
 //
-// The scan lines are recovered from the points themselves (a cloud on disk rarely keeps its firing
-// order, and a station's accumulated cloud has none): a spherical range image about the sensor origin,
-// rows of constant elevation, one point (the nearest) per cell; a point's neighbours along the line are
-// the nearest occupied cells left and right in its row within max_gap_cells. With the angular
-// resolution of one ring (e.g. 0.4 deg for an HDL-64) the rows are the rings.
+// The scan lines are recovered from the points themselves (a station's accumulated cloud has no
+// firing order): the rows of a spherical range image (lidar/spherical_range_image.h); a point's
+// neighbours along the line are the nearest occupied cells left and right in its row within
+// max_gap_cells.
 #pragma once
 
 #include <Eigen/Core>

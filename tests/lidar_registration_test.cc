@@ -339,5 +339,38 @@ TEST_F(StreetDriveTest, DeskewedSweepsRegisterCloserToTheTruth) {
   EXPECT_LT(worst_deskewed_m, 0.5 * worst_raw_m);
 }
 
+// The street's two driving cars (6 m/s ahead in our lane, 9 m/s oncoming; at most 1.5 m high, in
+// the lanes 0.9-2.7 m either side of the centre line) leave free space where they stood. With
+// de-skewing, lidar_registrator flags what a neighbouring sweep saw through, writes it to
+// moving_points.ply and leaves it out of static/. Measured: 0.61 % of the points flagged, 97.3 % of
+// them inside the cars' corridor (bound: 3x the 2.7 % outside).
+TEST_F(StreetDriveTest, MovingCarsAreLeftOutOfTheStaticClouds) {
+  double worst_m = 0;
+  const std::string output = RegisterAndCheck(" --sequential 3 --deskew_sweeps 1", &worst_m);
+  const std::string out = dir_->File("out" + std::to_string(runs_ - 1));
+  EXPECT_NE(output.find("saw free space"), std::string::npos) << output;
+  const PointCloud moving = ReadPointCloud(out + "/moving_points.ply");
+  // moving_points.ply is in the first station's LiDAR frame.
+  const Eigen::Isometry3d& world_from_first = world_from_lidar_.begin()->second;
+  size_t in_corridor = 0;
+  for (const Eigen::Vector3d& point : moving.points) {
+    const Eigen::Vector3d p = world_from_first * point;
+    in_corridor += p.z() > 0.1 && p.z() < 1.7 && std::abs(p.y()) > 0.7 && std::abs(p.y()) < 2.9;
+  }
+  size_t num_kept = 0, num_deskewed = 0;
+  for (const auto& [station, pose] : world_from_lidar_) {
+    num_kept += ReadPointCloud(out + "/static/" + station + ".pcd").Size();
+    num_deskewed += ReadPointCloud(out + "/deskewed/" + station + ".pcd").Size();
+  }
+  const double share = double(moving.Size()) / num_deskewed;
+  const double precision = double(in_corridor) / std::max<size_t>(moving.Size(), 1);
+  std::cout << "moving points: " << moving.Size() << " (" << 100 * share << " %), "
+            << 100 * precision << " % of them in the cars' corridor" << std::endl;
+  EXPECT_EQ(num_kept + moving.Size(), num_deskewed);
+  EXPECT_GE(share, 0.002);
+  EXPECT_LE(share, 0.02);
+  EXPECT_GE(precision, 0.92);
+}
+
 }  // namespace
 }  // namespace colmap_lidar

@@ -2,6 +2,7 @@
 // This executable (not the bridge library) is the only place that links the simulator.
 #include "bridge/exe/commands.h"
 #include "tests/simulator/simulator_commands.h"
+#include "tests/simulator/survey_planner_command.h"
 
 #include "colmap/util/logging.h"
 #include "colmap/util/version.h"
@@ -45,6 +46,9 @@ const std::vector<Command>& Commands() {
       {"simulate_dataset",
        &RunSimulateDataset,
        "Simulate a stereo + LiDAR station dataset with ground truth"},
+      {"plan_survey",
+       &RunPlanSurvey,
+       "Predict the calibration of planned stations before field work; the best extra station"},
       {"import_dataset",
        &RunImportDataset,
        "Import a station dataset into a COLMAP database (camera, SIFT, "

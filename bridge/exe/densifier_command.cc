@@ -1,6 +1,7 @@
 // colmap-lidar densifier: the dense model of a refined sparse model (bridge/densifier.h).
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
+#include "bridge/lidar_registration_files.h"
 #include "colmap_ext/logging.h"
 
 #include <filesystem>
@@ -71,7 +72,7 @@ void RunDensifierStep(const StationDataset& dataset,
 }
 
 int RunDensifier(int argc, char** argv) {
-  std::string dataset_path;
+  std::string dataset_path, registration_path;
   DensifierPaths paths;
   DensifierOptions densifier;
   colmap::OptionManager options;
@@ -86,10 +87,12 @@ int RunDensifier(int argc, char** argv) {
   options.AddDefaultOption("cam_from_lidar",
                            &paths.cam_from_lidar_path,
                            "qw qx qy qz tx ty tz file; default INPUT/cam_from_lidar.txt");
+  options.AddDefaultOption("registration_path", &registration_path, kRegistrationPathHelp);
   AddDensifierOptions("", &options, &densifier);
   options.Parse(argc, argv);
   THROW_CHECK(densifier.Check());  // before any file is read
-  RunDensifierStep(ReadStationDataset(dataset_path), paths, densifier);
+  RunDensifierStep(
+      WithRegistratorClouds(ReadStationDataset(dataset_path), registration_path), paths, densifier);
   return EXIT_SUCCESS;
 }
 

@@ -3,6 +3,7 @@
 #include "bridge/exe/steps.h"
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
+#include "bridge/lidar_registration_files.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/plot.h"
@@ -398,7 +399,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
 }
 
 int RunJointAdjuster(int argc, char** argv) {
-  std::string dataset_path;
+  std::string dataset_path, registration_path;
   JointAdjusterPaths paths;
   JointAdjusterStepOptions joint;
   colmap::OptionManager options;
@@ -411,11 +412,13 @@ int RunJointAdjuster(int argc, char** argv) {
                            &paths.cam_from_lidar_path,
                            "qw qx qy qz tx ty tz file; default: INPUT/cam_from_lidar.txt, else "
                            "rig.json's cam_from_lidar_guess");
+  options.AddDefaultOption("registration_path", &registration_path, kRegistrationPathHelp);
   AddJointAdjusterOptions("", &options, &joint);
   options.Parse(argc, argv);
   THROW_CHECK(joint.Check());  // before any file is read
   paths.database_path = *options.database_path;
-  RunJointAdjusterStep(ReadStationDataset(dataset_path), paths, joint);
+  RunJointAdjusterStep(
+      WithRegistratorClouds(ReadStationDataset(dataset_path), registration_path), paths, joint);
   return EXIT_SUCCESS;
 }
 

@@ -7,6 +7,7 @@
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
 #include "lidar/lidar_pose_graph.h"
+#include "lidar/preprocessing.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/scene/reconstruction.h"
@@ -113,7 +114,9 @@ bool LidarRegistratorStepOptions::Check() {
   graph.bridge_neighbors = static_cast<size_t>(bridge_neighbors);
   graph.max_neighbors = static_cast<size_t>(max_neighbors);
   graph.sequential = static_cast<size_t>(sequential);
-  return sweep_timing.Check();
+  CHECK_OPTION_GE(remove_moving_points, -1);
+  CHECK_OPTION_LE(remove_moving_points, 1);
+  return sweep_timing.Check() && moving.Check();
 }
 
 void AddLidarRegistratorOptions(const std::string& prefix,
@@ -152,6 +155,15 @@ void AddLidarRegistratorOptions(const std::string& prefix,
           &options->sweep_timing.start_azimuth_deg,
           "where a revolution starts (LiDAR frame; 180: behind)");
   add.Add("sweep_counter_clockwise", &options->sweep_timing.counter_clockwise);
+  add.Add("remove_moving_points",
+          &options->remove_moving_points,
+          "1: flag moving objects by free space, write static/<station>.pcd without them; -1: "
+          "with deskew_sweeps");
+  add.Add("moving_neighbour_clouds",
+          &options->moving.num_neighbour_clouds,
+          "clouds compared on each side (name order)");
+  add.Add("moving_margin_m", &options->moving.margin_m, "plus moving_margin_ratio x range");
+  add.Add("moving_margin_ratio", &options->moving.margin_ratio);
 }
 
 namespace {
@@ -218,6 +230,45 @@ std::vector<SweepMotion> SweepMotions(const std::vector<std::string>& names,
   return SweepMotionsFromPoses(graph.world_from_lidar, FrameIndices(names), graph.component);
 }
 
+// Flags the moving points of the registered clouds (`cloud_paths`, in station order), writes every
+// cloud without them to `static_path`/<station>.pcd and all of them, in the world of the first
+// station's component, to `moving_ply`; prints the share removed.
+void RemoveMovingPoints(const std::vector<std::string>& names,
+                        const std::vector<std::string>& cloud_paths,
+                        const LidarGraph& graph,
+                        const MovingPointOptions& options,
+                        const fs::path& static_path,
+                        const fs::path& moving_ply) {
+  std::vector<PointCloud> clouds(names.size());
+  std::vector<const std::vector<Eigen::Vector3d>*> points(names.size());
+  for (size_t i = 0; i < names.size(); ++i) {
+    clouds[i] = ReadStationCloud(cloud_paths[i]);
+    points[i] = &clouds[i].points;
+  }
+  const auto flags = FlagMovingPoints(points, graph.world_from_lidar, graph.component, options);
+  fs::create_directories(static_path);
+  PointCloud moving;
+  size_t num_points = 0;
+  for (size_t i = 0; i < names.size(); ++i) {
+    std::vector<size_t> kept;
+    for (size_t k = 0; k < flags[i].size(); ++k) {
+      if (!flags[i][k]) {
+        kept.push_back(k);
+      } else if (graph.component[i] == graph.component[0]) {
+        moving.points.push_back(graph.world_from_lidar[i] * clouds[i].points[k]);
+      }
+    }
+    num_points += flags[i].size();
+    WritePointCloud((static_path / (names[i] + ".pcd")).string(), SelectPoints(clouds[i], kept));
+  }
+  WritePointCloud(moving_ply.string(), moving);
+  std::cout << "lidar_registrator: " << moving.Size() << " of " << num_points << " points ("
+            << std::setprecision(2) << 100.0 * moving.Size() / std::max<size_t>(num_points, 1)
+            << std::setprecision(6) << " %) lie where a neighbouring cloud saw free space: moving "
+            << "objects, left out of " << static_path.string() << " (they are in "
+            << moving_ply.string() << ")" << std::endl;
+}
+
 }  // namespace
 
 void RunLidarRegistratorStep(const std::string& lidar_path,
@@ -229,7 +280,9 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
   std::vector<std::string> names;
   for (const fs::path& file : files) names.push_back(file.stem().string());
   const fs::path deskewed_path = fs::path(output_path) / "deskewed";
+  const fs::path static_path = fs::path(output_path) / "static";
   fs::remove_all(deskewed_path);
+  fs::remove_all(static_path);
   LidarGraph graph = RegisterClouds(files, options, nullptr, "", start);
   if (options.deskew_sweeps) {
     std::cout << "lidar_registrator: de-skewing every sweep with the registered motion and "
@@ -241,6 +294,21 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
   }
 
   fs::create_directories(output_path);
+  if (options.remove_moving_points == 1 ||
+      (options.remove_moving_points == -1 && options.deskew_sweeps)) {
+    std::vector<std::string> cloud_paths;
+    for (const fs::path& file : files) {
+      cloud_paths.push_back(options.deskew_sweeps
+                                ? (deskewed_path / (file.stem().string() + ".pcd")).string()
+                                : file.string());
+    }
+    RemoveMovingPoints(names,
+                       cloud_paths,
+                       graph,
+                       options.moving,
+                       static_path,
+                       fs::path(output_path) / "moving_points.ply");
+  }
   WritePairsAndPoses(output_path, names, graph);
   const std::string summary = Summary(names, graph, SecondsSince(start));
   WriteFileAtomically((fs::path(output_path) / "summary.txt").string(), summary);

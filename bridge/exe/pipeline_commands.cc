@@ -264,11 +264,11 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
       {"joint_adjuster",
        [=, &dataset] {
          RunJointAdjusterStep(
-             WithDeskewedClouds(dataset, lidar), {database, initial, "", joint}, options.joint);
+             WithRegistratorClouds(dataset, lidar), {database, initial, "", joint}, options.joint);
        }},
       {"densifier",
        [=, &dataset] {
-         RunDensifierStep(WithDeskewedClouds(dataset, lidar),
+         RunDensifierStep(WithRegistratorClouds(dataset, lidar),
                           {joint, "", stereo_rig ? stereo : "", dense},
                           options.densifier);
        }},

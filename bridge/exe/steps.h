@@ -20,6 +20,7 @@
 #include "colmap_ext/stereo_depth.h"
 #include "lidar/lidar_pose_graph.h"
 #include "lidar/model_evaluation.h"
+#include "lidar/moving_points.h"
 #include "lidar/station_cloud.h"
 #include "lidar/sweep_deskew.h"
 
@@ -94,6 +95,12 @@ struct LidarRegistratorStepOptions {
   // the later steps of `pipeline` use the de-skewed clouds.
   bool deskew_sweeps = false;
   SweepTimingOptions sweep_timing;
+  // After registration, flag the points of moving objects by free space (lidar/moving_points.h) and
+  // write each cloud without them to OUTPUT/static/<station>.pcd (and all flagged points, in the
+  // first station's frame, to OUTPUT/moving_points.ply); the later steps of `pipeline` use them.
+  // 1: on, 0: off, -1: on for sweeps of a moving platform (with deskew_sweeps).
+  int remove_moving_points = -1;
+  MovingPointOptions moving;
 
   // Validates and copies max_neighbors, sequential and bridge_neighbors into `graph`.
   bool Check();
@@ -118,6 +125,12 @@ struct PoseInitializerPaths {
 void RunPoseInitializerStep(const StationDataset& dataset,
                             const PoseInitializerPaths& paths,
                             const PoseInitializerOptions& options);
+
+// Help of the joint_adjuster and densifier commands' --registration_path.
+inline constexpr char kRegistrationPathHelp[] =
+    "lidar_registrator's output: its static/ (moving points removed) or deskewed/ clouds replace "
+    "the "
+    "dataset's; empty: the dataset's clouds";
 
 // joint_adjuster: the joint problem on a sparse model.
 struct JointAdjusterStepOptions {

@@ -101,6 +101,16 @@ colmap::Rigid3d TrueCamFromLidar() {
                          Eigen::Vector3d(0.19, -0.25, -0.05));
 }
 
+colmap::Rigid3d CamLookingAt(const Eigen::Vector3d& eye,
+                             const Eigen::Vector3d& target,
+                             double roll_deg) {
+  const Eigen::Vector3d d = target - eye;
+  return CamFromWorld(
+      WorldFromCamRotation(
+          std::atan2(d.y(), d.x()), std::atan2(d.z(), d.head<2>().norm()), roll_deg * kDegToRad),
+      eye);
+}
+
 std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
                                           int num_stations,
                                           Motion motion,

@@ -40,6 +40,12 @@ colmap::Rigid3d TrueCamFromLidar();
 
 using colmap_lidar::PerturbPose;  // colmap_ext/pose_perturbation.h
 
+// cam_from_world of a camera at `eye` whose optical axis points at `target`, its x axis level
+// (perpendicular to world z), then rolled by `roll_deg` about the optical axis.
+colmap::Rigid3d CamLookingAt(const Eigen::Vector3d& eye,
+                             const Eigen::Vector3d& target,
+                             double roll_deg);
+
 // cam_from_world of the left camera of each station, 2-3 m from the structure and looking at it; for
 // kDrive, of the forward camera at 1.65 m above the street at each frame's mid-sweep time.
 std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,

@@ -1,0 +1,127 @@
+#include "tests/simulator/synthetic_joint_problem.h"
+
+#include "colmap_ext/depth_prior_extractor.h"
+#include "tests/simulator/renderer.h"
+
+#include <random>
+
+namespace colmap_lidar {
+namespace sim {
+namespace {
+
+bool Occluded(const Scene& scene, const Eigen::Vector3d& center, const Eigen::Vector3d& point) {
+  RayHit hit;
+  const double distance = (point - center).norm();
+  return scene.Intersect(center, (point - center) / distance, distance + 1, &hit) &&
+         hit.t < distance - 1e-3;
+}
+
+}  // namespace
+
+std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
+    const Scene& scene,
+    const std::vector<colmap::Rigid3d>& true_cam_from_world,
+    const SyntheticJointOptions& options) {
+  auto problem = std::make_unique<SyntheticJointProblem>();
+  const StationRig& rig = options.rig;
+  problem->true_cam_from_world = true_cam_from_world;
+  problem->true_cam_from_lidar = options.true_cam_from_lidar;
+  const std::vector<colmap::Rigid3d>& truth = problem->true_cam_from_world;
+  std::mt19937 rng(options.noise_seed);
+  std::normal_distribution<double> normal(0, 1);
+
+  colmap::Camera camera = rig.left;
+  camera.camera_id = 1;
+  problem->reconstruction.AddCamera(camera);
+  // Landmarks seen (unoccluded, inside the image) by at least two stations.
+  std::vector<std::vector<Eigen::Vector2d>> points2D(truth.size());
+  std::vector<std::vector<std::pair<size_t, size_t>>> tracks;  // (station, point2D index)
+  std::vector<Eigen::Vector3d> landmarks;
+  const PointCloud surface = scene.SampleObjectSurface(options.landmark_spacing_m);
+  for (size_t p = 0; p < surface.Size(); p += options.landmark_stride) {
+    const Eigen::Vector3d& point = surface.points[p];
+    std::vector<std::pair<size_t, size_t>> track;
+    for (size_t s = 0; s < truth.size(); ++s) {
+      const Eigen::Vector3d in_cam = truth[s] * point;
+      if (in_cam.z() < 0.5) continue;
+      const Eigen::Vector2d xy = camera.ImgFromCam(in_cam.hnormalized());
+      if (xy.x() < 1 || xy.y() < 1 || xy.x() > camera.width - 1 || xy.y() > camera.height - 1 ||
+          Occluded(scene, colmap::Inverse(truth[s]).translation, point)) {
+        continue;
+      }
+      track.emplace_back(s, points2D[s].size());
+      points2D[s].push_back(xy + options.pixel_noise * Eigen::Vector2d(normal(rng), normal(rng)));
+    }
+    if (track.size() >= 2) {
+      tracks.push_back(track);
+      landmarks.push_back(point);
+    } else {
+      for (const auto& [s, index] : track) points2D[s].pop_back();
+    }
+  }
+  for (size_t s = 0; s < truth.size(); ++s) {
+    colmap::Image image;
+    image.SetImageId(static_cast<colmap::image_t>(s + 1));
+    image.SetName("left/" + std::to_string(s) + ".png");
+    image.SetCameraId(1);
+    image.SetPoints2D(points2D[s]);
+    image.CamFromWorld() = s == 0 ? truth[s]
+                                  : PerturbPose(truth[s],
+                                                options.pose_rotation_deg,
+                                                options.pose_translation_m,
+                                                100 + s + 1000 * options.noise_seed);
+    problem->reconstruction.AddImage(image);
+    problem->reconstruction.RegisterImage(image.ImageId());
+  }
+  const double baseline = rig.BaselineMeters();
+  const double focal = rig.left.params[0];
+  for (size_t k = 0; k < landmarks.size(); ++k) {
+    colmap::Track track;
+    for (const auto& [s, index] : tracks[k]) {
+      const colmap::image_t image_id = static_cast<colmap::image_t>(s + 1);
+      track.AddElement(image_id, static_cast<colmap::point2D_t>(index));
+      if (!rig.IsStereo()) continue;  // a monocular rig has no depth priors
+      const double depth = (truth[s] * landmarks[k]).z();
+      const double sigma = DepthSigma(depth, baseline, focal, options.depth_sigma_pixels);
+      problem->data.depth_priors[image_id][index] = {
+          static_cast<colmap::point2D_t>(index),
+          depth * (1 + options.depth_scale_error) +
+              options.depth_noise_sigmas * sigma * normal(rng),
+          sigma};
+    }
+    problem->reconstruction.AddPoint3D(
+        landmarks[k] +
+            options.landmark_offset_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)),
+        track);
+  }
+
+  StationCloudOptions cloud_options;
+  cloud_options.compute_features = false;
+  for (size_t s = 0; s < truth.size(); ++s) {
+    LidarOptions lidar;
+    lidar.num_points = options.lidar_points;
+    lidar.range_noise_m = options.lidar_range_noise_m;
+    lidar.seed = s + 1000 * options.noise_seed;
+    const PointCloud scan =
+        ScanLidar(scene, colmap::Inverse(truth[s]) * problem->true_cam_from_lidar, lidar);
+    problem->clouds.push_back(PrepareStationCloud(scan, cloud_options));
+    problem->data.clouds[static_cast<colmap::image_t>(s + 1)] = problem->clouds.back().get();
+    for (size_t t = s + 1; t < truth.size(); ++t) problem->data.pairs.emplace_back(s + 1, t + 1);
+  }
+  problem->cam_from_lidar = PerturbPose(problem->true_cam_from_lidar,
+                                        options.extrinsic_rotation_deg,
+                                        options.extrinsic_translation_m,
+                                        42 + options.noise_seed);
+  return problem;
+}
+
+std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
+    const Scene& scene, const SyntheticJointOptions& options) {
+  return MakeSyntheticJointProblem(
+      scene,
+      MakeStations(scene, options.num_stations, options.motion, options.station_seed),
+      options);
+}
+
+}  // namespace sim
+}  // namespace colmap_lidar
