@@ -10,8 +10,9 @@
 # Each row: cam_from_lidar error, station position error (mean), dense model mean error and
 # completeness at 5 mm against the true surface, and the back end's time. A row that fails says so.
 # Writes docs/benchmarks/paper_table.md (replaced; the figures are this run's) from the raw rows in
-# TABLE_DIR/rows.tsv.
-#   scripts/paper_table.sh            the five columns below (about 45 min on 2 cores)
+# TABLE_DIR/rows.tsv (copied to docs/benchmarks/paper_table_rows.tsv), with the reading in
+# scripts/paper_table_reading.md below the tables (it names the run it was written for).
+#   scripts/paper_table.sh            the five columns below (about 30 min on 2 cores)
 #   COLUMNS="t_specimen:0.01:1" scripts/paper_table.sh   chosen columns, scene:range_noise_m:grey
 #   TABLE_DIR  datasets and workspaces (default /tmp/colmap-lidar-paper-table)
 #   BUILD_DIR  build directory (default build)
@@ -145,4 +146,5 @@ print(round(sum(float(r[2]) for r in csv.reader(open(sys.argv[1])) if r[0] in ('
 for column in "${columns[@]}"; do run_column "$column"; done
 python3 scripts/paper_table.py "$rows" "$kStations" "$kRays" "$(git rev-parse --short HEAD)" >"$kDoc.tmp"
 mv "$kDoc.tmp" "$kDoc"
+cp "$rows" docs/benchmarks/paper_table_rows.tsv
 echo "[paper_table] wrote $kDoc" >&2
