@@ -2,7 +2,7 @@
 
 #include "colmap_ext/logging.h"
 #include "tests/simulator/sensor_pod.h"
-#include "tests/simulator/synthetic_joint_problem.h"
+#include "tests/simulator/surface_world.h"
 
 #include <algorithm>
 #include <cmath>
@@ -33,10 +33,11 @@ void FindWorstAxis(const ObservabilityOptions& thresholds, CalibrationPrediction
 }
 
 // Where the plan's stations stand: their mean horizontal distance from the structure's centre.
-double MeanStationDistance(const Scene& scene, const std::vector<colmap::Rigid3d>& stations) {
+double MeanStationDistance(const SurveyTarget& target,
+                           const std::vector<colmap::Rigid3d>& stations) {
   double sum = 0;
   for (const colmap::Rigid3d& station : stations) {
-    sum += (colmap::Inverse(station).translation - scene.ObjectCenter()).head<2>().norm();
+    sum += (colmap::Inverse(station).translation - target.center).head<2>().norm();
   }
   return sum / stations.size();
 }
@@ -50,6 +51,28 @@ std::string Describe(const char* kind, double azimuth_deg, double distance, cons
 }
 
 }  // namespace
+
+SurveyTarget TargetOfScene(const Scene& scene) {
+  SurveyTarget target;
+  target.world = WorldOfScene(scene);
+  target.center = scene.ObjectCenter();
+  target.height = scene.ObjectHeight();
+  return target;
+}
+
+SurveyTarget TargetOfSurface(std::shared_ptr<const PointCloud> surface) {
+  SurveyTarget target;
+  if (surface->Empty()) throw std::invalid_argument("The surface has no points");
+  Eigen::Vector3d low = surface->points[0], high = low;
+  for (const Eigen::Vector3d& p : surface->points) {
+    low = low.cwiseMin(p), high = high.cwiseMax(p);
+  }
+  target.world = WorldOfSurface(surface, low.z());
+  target.center = 0.5 * (low + high);
+  target.height = high.z() - low.z();
+  target.ground_z = low.z();
+  return target;
+}
 
 JointAdjusterOptions SurveyPlanOptions::DefaultAdjusterOptions() {
   // As in the coverage test that validates the reported sigmas at this noise.
@@ -74,7 +97,7 @@ bool SurveyPlanOptions::Check() const {
   return adjuster.Check();
 }
 
-CalibrationPrediction PredictCalibration(const Scene& scene,
+CalibrationPrediction PredictCalibration(const SurveyTarget& target,
                                          const std::vector<colmap::Rigid3d>& stations,
                                          const SurveyPlanOptions& options) {
   THROW_CHECK(options.Check());
@@ -89,7 +112,7 @@ CalibrationPrediction PredictCalibration(const Scene& scene,
   // A start near the truth: the prediction is of the uncertainty at convergence.
   synthetic.extrinsic_rotation_deg = 0.5;
   synthetic.extrinsic_translation_m = 0.01;
-  auto problem = MakeSyntheticJointProblem(scene, stations, synthetic);
+  auto problem = MakeSyntheticJointProblem(target.world, stations, synthetic);
   colmap::Rigid3d cam_from_lidar = problem->cam_from_lidar;
   const JointAdjustmentSummary summary =
       JointAdjuster(options.adjuster).Run(problem->data, &problem->reconstruction, &cam_from_lidar);
@@ -107,16 +130,16 @@ CalibrationPrediction PredictCalibration(const Scene& scene,
   return prediction;
 }
 
-std::vector<CandidateStation> CandidateStations(const Scene& scene,
+std::vector<CandidateStation> CandidateStations(const SurveyTarget& target,
                                                 const std::vector<colmap::Rigid3d>& stations,
                                                 const SurveyPlanOptions& options) {
   THROW_CHECK(options.Check());
-  const Eigen::Vector3d& center = scene.ObjectCenter();
-  const double distance = MeanStationDistance(scene, stations);
+  const Eigen::Vector3d& center = target.center;
+  const double distance = MeanStationDistance(target, stations);
   double mean_height = 0;
   for (const colmap::Rigid3d& s : stations) mean_height += colmap::Inverse(s).translation.z();
   mean_height /= stations.size();
-  const double look_height = std::min(1.2, 0.5 * scene.ObjectHeight());
+  const double look_height = target.ground_z + std::min(1.2, 0.5 * target.height);
   std::vector<CandidateStation> candidates;
   for (int k = 0; k < options.num_candidate_positions; ++k) {
     const double azimuth = 2 * M_PI * (k + 0.5) / options.num_candidate_positions;
@@ -129,7 +152,8 @@ std::vector<CandidateStation> CandidateStations(const Scene& scene,
          Describe("level", azimuth * 180 / M_PI, distance, ", at the plan's height"),
          {}});
     // Tilted: low, looking up past the structure's middle, rolled.
-    const Eigen::Vector3d low_eye(ground.x(), ground.y(), options.tilted_height_m);
+    const Eigen::Vector3d low_eye(
+        ground.x(), ground.y(), target.ground_z + options.tilted_height_m);
     const Eigen::Vector3d up_target =
         look_at +
         distance * std::tan(options.candidate_tilt_deg * M_PI / 180) * Eigen::Vector3d::UnitZ();
@@ -143,19 +167,19 @@ std::vector<CandidateStation> CandidateStations(const Scene& scene,
   return candidates;
 }
 
-SurveyPlan PlanSurvey(const Scene& scene,
+SurveyPlan PlanSurvey(const SurveyTarget& target,
                       const std::vector<colmap::Rigid3d>& stations,
                       const SurveyPlanOptions& options,
                       const std::function<void(int, int)>& progress) {
   SurveyPlan plan;
-  plan.candidates = CandidateStations(scene, stations, options);
+  plan.candidates = CandidateStations(target, stations, options);
   const int total = 1 + static_cast<int>(plan.candidates.size());
-  plan.planned = PredictCalibration(scene, stations, options);
+  plan.planned = PredictCalibration(target, stations, options);
   if (progress) progress(1, total);
   for (size_t k = 0; k < plan.candidates.size(); ++k) {
     std::vector<colmap::Rigid3d> extended = stations;
     extended.push_back(plan.candidates[k].cam_from_world);
-    plan.candidates[k].prediction = PredictCalibration(scene, extended, options);
+    plan.candidates[k].prediction = PredictCalibration(target, extended, options);
     if (progress) progress(static_cast<int>(k) + 2, total);
   }
   std::stable_sort(plan.candidates.begin(),

@@ -17,17 +17,36 @@
 
 #include "bridge/extrinsic_observability.h"
 #include "bridge/joint_adjuster.h"
+#include "lidar/point_cloud.h"
 #include "tests/simulator/scene.h"
+#include "tests/simulator/synthetic_joint_problem.h"
 
 #include "colmap/geometry/rigid3.h"
 
 #include <Eigen/Core>
 
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace colmap_lidar {
 namespace sim {
+
+// The structure to survey: the world the capture is simulated in, and where the structure stands
+// (for the candidate stations).
+struct SurveyTarget {
+  SyntheticWorld world;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // the candidates look at it
+  double height = 0;                                 // above ground_z
+  double ground_z = 0;
+};
+
+// One of the simulator's scenes (it must outlive the target).
+SurveyTarget TargetOfScene(const Scene& scene);
+// A structure given as points (world frame, z up; e.g. a prior scan): the ground is a plane at its
+// lowest point.
+SurveyTarget TargetOfSurface(std::shared_ptr<const PointCloud> surface);
 
 struct SurveyPlanOptions {
   // The predicted capture's noise: keypoints [px], depth priors [their sigma_d], LiDAR range [m].
@@ -75,18 +94,18 @@ struct SurveyPlan {
 };
 
 // The prediction for `stations` (cam_from_world of the left camera; at least 2).
-CalibrationPrediction PredictCalibration(const Scene& scene,
+CalibrationPrediction PredictCalibration(const SurveyTarget& target,
                                          const std::vector<colmap::Rigid3d>& stations,
                                          const SurveyPlanOptions& options);
 
 // The candidate stations around the structure for a plan (see the file comment).
-std::vector<CandidateStation> CandidateStations(const Scene& scene,
+std::vector<CandidateStation> CandidateStations(const SurveyTarget& target,
                                                 const std::vector<colmap::Rigid3d>& stations,
                                                 const SurveyPlanOptions& options);
 
 // The prediction for the plan and for the plan plus each candidate, ranked. `progress` (may be
 // empty) is called after each prediction with (done, total).
-SurveyPlan PlanSurvey(const Scene& scene,
+SurveyPlan PlanSurvey(const SurveyTarget& target,
                       const std::vector<colmap::Rigid3d>& stations,
                       const SurveyPlanOptions& options,
                       const std::function<void(int, int)>& progress = {});

@@ -7,6 +7,7 @@
 #include "colmap_ext/atomic_file.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
+#include "lidar/cloud_io.h"
 #include "tests/simulator/survey_planner.h"
 
 #include "colmap/controllers/option_manager.h"
@@ -94,12 +95,14 @@ void WriteOutputs(const std::string& output_path,
 }  // namespace
 
 int RunPlanSurvey(int argc, char** argv) {
-  std::string scene_name = "t_specimen", stations_path, output_path;
+  std::string scene_name = "t_specimen", surface_path, stations_path, output_path;
   sim::SurveyPlanOptions options;
   int lidar_points = static_cast<int>(options.lidar_points), seed = 1;
   colmap::OptionManager manager;
   manager.AddDefaultOption(
       "scene", &scene_name, "t_specimen | square_pillar | cylinder_pillar | bridge_pier | street");
+  manager.AddDefaultOption(
+      "surface", &surface_path, "instead of --scene: the structure as points (.ply/.pcd, z up)");
   manager.AddRequiredOption(
       "stations", &stations_path, "planned stations: name qw qx qy qz tx ty tz (cam_from_world)");
   manager.AddRequiredOption("output_path", &output_path, "folder for report.json, best_plan.txt");
@@ -115,7 +118,13 @@ int RunPlanSurvey(int argc, char** argv) {
   options.lidar_points = static_cast<size_t>(std::max(0, lidar_points));
   options.seed = static_cast<uint64_t>(seed);
   THROW_CHECK(options.Check());  // before any file is read
-  const sim::Scene scene = sim::Scene::Create(scene_name);
+  // The scene outlives the target that refers to it.
+  const sim::Scene scene = sim::Scene::Create(surface_path.empty() ? scene_name : "t_specimen");
+  const sim::SurveyTarget target =
+      surface_path.empty()
+          ? sim::TargetOfScene(scene)
+          : sim::TargetOfSurface(std::make_shared<const PointCloud>(ReadPointCloud(surface_path)));
+  const std::string structure = surface_path.empty() ? scene_name : surface_path;
   const std::map<std::string, colmap::Rigid3d> planned = ReadNamedPoses(stations_path);
   std::vector<colmap::Rigid3d> stations;
   for (const auto& [name, pose] : planned) stations.push_back(pose);
@@ -123,9 +132,9 @@ int RunPlanSurvey(int argc, char** argv) {
     throw std::invalid_argument(stations_path + " holds " + std::to_string(stations.size()) +
                                 " station(s); a plan needs at least 2");
   }
-  std::cout << "plan_survey: " << stations.size() << " planned stations of " << scene_name << ", "
+  std::cout << "plan_survey: " << stations.size() << " planned stations of " << structure << ", "
             << 2 * options.num_candidate_positions << " candidates" << std::endl;
-  const sim::SurveyPlan plan = sim::PlanSurvey(scene, stations, options, [](int done, int total) {
+  const sim::SurveyPlan plan = sim::PlanSurvey(target, stations, options, [](int done, int total) {
     std::cout << "plan_survey: predicted " << done << "/" << total << std::endl;
   });
   PrintPrediction("The plan", plan.planned);
@@ -134,7 +143,7 @@ int RunPlanSurvey(int argc, char** argv) {
         "Candidate " + std::to_string(k + 1) + " (" + plan.candidates[k].description + ")",
         plan.candidates[k].prediction);
   }
-  const nlohmann::json settings = {{"scene", scene_name},
+  const nlohmann::json settings = {{"structure", structure},
                                    {"stations", stations_path},
                                    {"pixel_noise", options.pixel_noise},
                                    {"lidar_range_noise_m", options.lidar_range_noise_m},

@@ -18,8 +18,27 @@ bool Occluded(const Scene& scene, const Eigen::Vector3d& center, const Eigen::Ve
 
 }  // namespace
 
+SyntheticWorld WorldOfScene(const Scene& scene) {
+  SyntheticWorld world;
+  world.sample_surface = [&scene](double spacing) { return scene.SampleObjectSurface(spacing); };
+  world.visible = [&scene](const Eigen::Vector3d& center, const Eigen::Vector3d& point) {
+    return !Occluded(scene, center, point);
+  };
+  world.scan = [&scene](const colmap::Rigid3d& world_from_lidar, const LidarOptions& options) {
+    return ScanLidar(scene, world_from_lidar, options);
+  };
+  return world;
+}
+
 std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
     const Scene& scene,
+    const std::vector<colmap::Rigid3d>& true_cam_from_world,
+    const SyntheticJointOptions& options) {
+  return MakeSyntheticJointProblem(WorldOfScene(scene), true_cam_from_world, options);
+}
+
+std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
+    const SyntheticWorld& world,
     const std::vector<colmap::Rigid3d>& true_cam_from_world,
     const SyntheticJointOptions& options) {
   auto problem = std::make_unique<SyntheticJointProblem>();
@@ -37,7 +56,7 @@ std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
   std::vector<std::vector<Eigen::Vector2d>> points2D(truth.size());
   std::vector<std::vector<std::pair<size_t, size_t>>> tracks;  // (station, point2D index)
   std::vector<Eigen::Vector3d> landmarks;
-  const PointCloud surface = scene.SampleObjectSurface(options.landmark_spacing_m);
+  const PointCloud surface = world.sample_surface(options.landmark_spacing_m);
   for (size_t p = 0; p < surface.Size(); p += options.landmark_stride) {
     const Eigen::Vector3d& point = surface.points[p];
     std::vector<std::pair<size_t, size_t>> track;
@@ -46,7 +65,7 @@ std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
       if (in_cam.z() < 0.5) continue;
       const Eigen::Vector2d xy = camera.ImgFromCam(in_cam.hnormalized());
       if (xy.x() < 1 || xy.y() < 1 || xy.x() > camera.width - 1 || xy.y() > camera.height - 1 ||
-          Occluded(scene, colmap::Inverse(truth[s]).translation, point)) {
+          !world.visible(colmap::Inverse(truth[s]).translation, point)) {
         continue;
       }
       track.emplace_back(s, points2D[s].size());
@@ -103,7 +122,7 @@ std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
     lidar.range_noise_m = options.lidar_range_noise_m;
     lidar.seed = s + 1000 * options.noise_seed;
     const PointCloud scan =
-        ScanLidar(scene, colmap::Inverse(truth[s]) * problem->true_cam_from_lidar, lidar);
+        world.scan(colmap::Inverse(truth[s]) * problem->true_cam_from_lidar, lidar);
     problem->clouds.push_back(PrepareStationCloud(scan, cloud_options));
     problem->data.clouds[static_cast<colmap::image_t>(s + 1)] = problem->clouds.back().get();
     for (size_t t = s + 1; t < truth.size(); ++t) problem->data.pairs.emplace_back(s + 1, t + 1);

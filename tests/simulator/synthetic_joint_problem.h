@@ -8,12 +8,15 @@
 
 #include "bridge/joint_adjuster.h"
 #include "colmap_ext/station_dataset.h"
+#include "lidar/point_cloud.h"
 #include "lidar/station_cloud.h"
+#include "tests/simulator/renderer.h"
 #include "tests/simulator/scene.h"
 #include "tests/simulator/sensor_pod.h"
 
 #include "colmap/scene/reconstruction.h"
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -59,12 +62,32 @@ struct SyntheticJointProblem {
   colmap::Rigid3d cam_from_lidar;  // the perturbed start
 };
 
+// What the problem is built from: the structure's surface, its occlusions and LiDAR scans of it.
+struct SyntheticWorld {
+  // Points on the structure's surface about `spacing` apart (the landmark candidates).
+  std::function<PointCloud(double spacing)> sample_surface;
+  // Whether nothing hides `point` from a camera at `center`.
+  std::function<bool(const Eigen::Vector3d& center, const Eigen::Vector3d& point)> visible;
+  // A LiDAR scan from `world_from_lidar`, points in the LiDAR frame.
+  std::function<PointCloud(const colmap::Rigid3d& world_from_lidar, const LidarOptions& options)>
+      scan;
+};
+
+// The simulator's scene (ray-cast; the scene must outlive the world).
+SyntheticWorld WorldOfScene(const Scene& scene);
+
+// The problem for given true stations (cam_from_world of the left camera) of any world. Every station
+// pair is a LiDAR pair.
+std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
+    const SyntheticWorld& world,
+    const std::vector<colmap::Rigid3d>& true_cam_from_world,
+    const SyntheticJointOptions& options);
+
 // The problem for the stations of sim::MakeStations(scene, num_stations, motion, station_seed).
 std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
     const Scene& scene, const SyntheticJointOptions& options);
 
-// The problem for given true stations (cam_from_world of the left camera). Every station pair is a
-// LiDAR pair.
+// The problem for given true stations of the scene.
 std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
     const Scene& scene,
     const std::vector<colmap::Rigid3d>& true_cam_from_world,
