@@ -2,6 +2,7 @@
 // translation along that axis (camera y) is missing, and that a tilted extra station fixes it; bad
 // plans are refused with the file named and nothing written.
 #include "colmap_ext/station_dataset.h"
+#include "lidar/cloud_io.h"
 #include "tests/simulator/scene.h"
 #include "tests/simulator/sensor_pod.h"
 #include "tests/testing/run_command.h"
@@ -74,6 +75,25 @@ TEST(SurveyPlannerTest, AOneAxisPlanIsToldWhatIsMissingAndThatATiltedStationFixe
   const auto best_plan = ReadNamedPoses(dir.File("plan/best_plan.txt"));
   EXPECT_EQ(best_plan.size(), 7u);
   EXPECT_EQ(ReadNamedPoses(dir.File("plan/candidates.txt")).size(), 4u);
+}
+
+// The same plan with the structure given as points (--surface: the T specimen's surface samples, no
+// background objects): the missing axis is named the same way.
+TEST(SurveyPlannerTest, ASurfaceCloudInsteadOfASceneNamesTheSameMissingAxis) {
+  testing::ScopedTempDir dir;
+  const std::string stations = WritePlan(dir, 6, sim::Motion::kOneAxis);
+  WritePointCloud(dir.File("surface.ply"),
+                  sim::Scene::Create("t_specimen").SampleObjectSurface(0.005));
+  const auto result =
+      RunCommand(kCli + " plan_survey --surface " + dir.File("surface.ply") + " --stations " +
+                 stations + " --output_path " + dir.File("plan") + " --num_candidate_positions 1");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json report = ReadJson(dir.File("plan/report.json"));
+  EXPECT_FALSE(report["planned"]["motion_unique"].get<bool>());
+  EXPECT_EQ(report["planned"]["worst_axis"], "translation along y");
+  EXPECT_NE(result.output.find("UNOBSERVABLE: translation along the camera y axis"),
+            std::string::npos);
+  EXPECT_EQ(report["settings"]["structure"], dir.File("surface.ply"));
 }
 
 TEST(SurveyPlannerTest, RefusesABadPlanNamingTheFile) {
