@@ -116,14 +116,19 @@ std::string RunDrive(const testing::ScopedTempDir& dir, int num_frames, bool gue
 // The guess is 1 deg / 5 cm off: from the simulator's usual 3 deg, 20 frames ended at 1.47 deg in one
 // of about six runs (COLMAP's matching differs from run to run; the associations of the first round
 // start 1 m off at 20 m range). What this test checks is the hold of the unobservable directions; the
-// convergence without any guess is the 40-frame test's.
+// convergence without any guess is the 40-frame test's. Since the moving cars are left out of the
+// LiDAR term (2026-12-02), the vertical translation's sigma sits at the 5 mm threshold (4.7 mm in one
+// run, 5.8 mm with the cars kept): a run either holds it at the guess or observes it, and then it
+// must be better than the guess (one run: 7.3 mm, 0.20 deg; held: 48.3 mm, 0.44 deg).
 TEST(PipelineMonoTest, KittiLayoutDriveHoldsWhatItCannotSee) {
   testing::ScopedTempDir dir;
   RunDrive(dir, 20, true);
   const std::string dataset = dir.File("dataset");
   const std::string ws = dir.File("ws");
   const nlohmann::json report = ReadJson(ws + "/sparse/joint/report.json");
-  EXPECT_GE(report["held_at_initial"].size(), 1u);
+  // Held, or called observable by the adjuster's own uncertainty: never left to drift.
+  EXPECT_TRUE(!report["held_at_initial"].empty() || report["unobservable"].empty())
+      << report["unobservable"].dump();
   const nlohmann::json metrics = ReadJson(ws + "/evaluation/metrics.json");
   const double guess_error_mm =
       1000 * (ReadStationDataset(dataset).rig.cam_from_lidar_guess->translation -
