@@ -37,25 +37,31 @@ std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
   return MakeSyntheticJointProblem(WorldOfScene(scene), true_cam_from_world, options);
 }
 
-std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
-    const SyntheticWorld& world,
-    const std::vector<colmap::Rigid3d>& true_cam_from_world,
-    const SyntheticJointOptions& options) {
-  auto problem = std::make_unique<SyntheticJointProblem>();
-  const StationRig& rig = options.rig;
-  problem->true_cam_from_world = true_cam_from_world;
-  problem->true_cam_from_lidar = options.true_cam_from_lidar;
-  const std::vector<colmap::Rigid3d>& truth = problem->true_cam_from_world;
-  std::mt19937 rng(options.noise_seed);
-  std::normal_distribution<double> normal(0, 1);
+namespace {
 
-  colmap::Camera camera = rig.left;
-  camera.camera_id = 1;
-  problem->reconstruction.AddCamera(camera);
-  // Landmarks seen (unoccluded, inside the image) by at least two stations.
-  std::vector<std::vector<Eigen::Vector2d>> points2D(truth.size());
+// The noise source: one distribution throughout (it caches a second value between draws), so that a
+// seed gives the same problem however the steps are split.
+struct Noise {
+  std::mt19937 rng;
+  std::normal_distribution<double> normal{0, 1};
+  double Draw() { return normal(rng); }
+};
+
+// Keypoints of the landmarks seen (unoccluded, inside the image) by at least two stations, with pixel
+// noise in landmark order.
+struct Observations {
+  std::vector<std::vector<Eigen::Vector2d>> points2D;          // per station
   std::vector<std::vector<std::pair<size_t, size_t>>> tracks;  // (station, point2D index)
   std::vector<Eigen::Vector3d> landmarks;
+};
+
+Observations ObserveLandmarks(const SyntheticWorld& world,
+                              const std::vector<colmap::Rigid3d>& truth,
+                              const colmap::Camera& camera,
+                              const SyntheticJointOptions& options,
+                              Noise* noise) {
+  Observations seen;
+  seen.points2D.resize(truth.size());
   const PointCloud surface = world.sample_surface(options.landmark_spacing_m);
   for (size_t p = 0; p < surface.Size(); p += options.landmark_stride) {
     const Eigen::Vector3d& point = surface.points[p];
@@ -68,54 +74,78 @@ std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
           !world.visible(colmap::Inverse(truth[s]).translation, point)) {
         continue;
       }
-      track.emplace_back(s, points2D[s].size());
-      points2D[s].push_back(xy + options.pixel_noise * Eigen::Vector2d(normal(rng), normal(rng)));
+      track.emplace_back(s, seen.points2D[s].size());
+      seen.points2D[s].push_back(xy + options.pixel_noise *
+                                          Eigen::Vector2d(noise->Draw(), noise->Draw()));
     }
     if (track.size() >= 2) {
-      tracks.push_back(track);
-      landmarks.push_back(point);
+      seen.tracks.push_back(track);
+      seen.landmarks.push_back(point);
     } else {
-      for (const auto& [s, index] : track) points2D[s].pop_back();
+      for (const auto& [s, index] : track) seen.points2D[s].pop_back();
     }
   }
+  return seen;
+}
+
+// The registered images: the first at its true pose, the others perturbed (seeded).
+void AddImages(const std::vector<colmap::Rigid3d>& truth,
+               const Observations& seen,
+               const SyntheticJointOptions& options,
+               colmap::Reconstruction* reconstruction) {
   for (size_t s = 0; s < truth.size(); ++s) {
     colmap::Image image;
     image.SetImageId(static_cast<colmap::image_t>(s + 1));
     image.SetName("left/" + std::to_string(s) + ".png");
     image.SetCameraId(1);
-    image.SetPoints2D(points2D[s]);
+    image.SetPoints2D(seen.points2D[s]);
     image.CamFromWorld() = s == 0 ? truth[s]
                                   : PerturbPose(truth[s],
                                                 options.pose_rotation_deg,
                                                 options.pose_translation_m,
                                                 100 + s + 1000 * options.noise_seed);
-    problem->reconstruction.AddImage(image);
-    problem->reconstruction.RegisterImage(image.ImageId());
+    reconstruction->AddImage(image);
+    reconstruction->RegisterImage(image.ImageId());
   }
-  const double baseline = rig.BaselineMeters();
-  const double focal = rig.left.params[0];
-  for (size_t k = 0; k < landmarks.size(); ++k) {
+}
+
+// The landmarks (offset by noise) with their tracks, and a depth prior per observation for a stereo
+// rig (true z-depth, noise of its own sigma_d and the common scale error).
+void AddLandmarks(const Observations& seen,
+                  const SyntheticJointOptions& options,
+                  Noise* noise,
+                  SyntheticJointProblem* problem) {
+  const StationRig& rig = options.rig;
+  const std::vector<colmap::Rigid3d>& truth = problem->true_cam_from_world;
+  for (size_t k = 0; k < seen.landmarks.size(); ++k) {
     colmap::Track track;
-    for (const auto& [s, index] : tracks[k]) {
+    for (const auto& [s, index] : seen.tracks[k]) {
       const colmap::image_t image_id = static_cast<colmap::image_t>(s + 1);
       track.AddElement(image_id, static_cast<colmap::point2D_t>(index));
       if (!rig.IsStereo()) continue;  // a monocular rig has no depth priors
-      const double depth = (truth[s] * landmarks[k]).z();
-      const double sigma = DepthSigma(depth, baseline, focal, options.depth_sigma_pixels);
+      const double depth = (truth[s] * seen.landmarks[k]).z();
+      const double sigma =
+          DepthSigma(depth, rig.BaselineMeters(), rig.left.params[0], options.depth_sigma_pixels);
       problem->data.depth_priors[image_id][index] = {
           static_cast<colmap::point2D_t>(index),
           depth * (1 + options.depth_scale_error) +
-              options.depth_noise_sigmas * sigma * normal(rng),
+              options.depth_noise_sigmas * sigma * noise->Draw(),
           sigma};
     }
     problem->reconstruction.AddPoint3D(
-        landmarks[k] +
-            options.landmark_offset_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)),
+        seen.landmarks[k] + options.landmark_offset_m *
+                                Eigen::Vector3d(noise->Draw(), noise->Draw(), noise->Draw()),
         track);
   }
+}
 
+// A LiDAR scan per station from its true pose; every station pair a LiDAR pair.
+void AddLidarScans(const SyntheticWorld& world,
+                   const SyntheticJointOptions& options,
+                   SyntheticJointProblem* problem) {
   StationCloudOptions cloud_options;
   cloud_options.compute_features = false;
+  const std::vector<colmap::Rigid3d>& truth = problem->true_cam_from_world;
   for (size_t s = 0; s < truth.size(); ++s) {
     LidarOptions lidar;
     lidar.num_points = options.lidar_points;
@@ -127,6 +157,26 @@ std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
     problem->data.clouds[static_cast<colmap::image_t>(s + 1)] = problem->clouds.back().get();
     for (size_t t = s + 1; t < truth.size(); ++t) problem->data.pairs.emplace_back(s + 1, t + 1);
   }
+}
+
+}  // namespace
+
+std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
+    const SyntheticWorld& world,
+    const std::vector<colmap::Rigid3d>& true_cam_from_world,
+    const SyntheticJointOptions& options) {
+  auto problem = std::make_unique<SyntheticJointProblem>();
+  problem->true_cam_from_world = true_cam_from_world;
+  problem->true_cam_from_lidar = options.true_cam_from_lidar;
+  Noise noise{std::mt19937(options.noise_seed)};
+  colmap::Camera camera = options.rig.left;
+  camera.camera_id = 1;
+  problem->reconstruction.AddCamera(camera);
+  const Observations seen =
+      ObserveLandmarks(world, problem->true_cam_from_world, camera, options, &noise);
+  AddImages(problem->true_cam_from_world, seen, options, &problem->reconstruction);
+  AddLandmarks(seen, options, &noise, problem.get());
+  AddLidarScans(world, options, problem.get());
   problem->cam_from_lidar = PerturbPose(problem->true_cam_from_lidar,
                                         options.extrinsic_rotation_deg,
                                         options.extrinsic_translation_m,
