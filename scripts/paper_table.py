@@ -6,6 +6,7 @@ Plain Python (no numpy). The comparison sentences below the tables are computed 
 """
 import csv
 import datetime
+import os
 import sys
 
 
@@ -87,7 +88,8 @@ def main():
     for line in comparisons(by_column):
         print(line)
     print()
-    print(open(sys.argv[0].replace(".py", "_reading.md")).read().strip())
+    reading = os.path.join(os.path.dirname(os.path.abspath(__file__)), "paper_table_reading.md")
+    print(open(reading).read().strip())
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
 #include "lidar/kd_tree.h"
 #include "lidar/spherical_range_image.h"
+#include "lidar/voxel_accumulator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,18 +18,12 @@ namespace colmap_lidar {
 namespace sim {
 namespace {
 
-struct VoxelHash {
-  size_t operator()(const std::tuple<int64_t, int64_t, int64_t>& key) const {
-    return std::hash<int64_t>()(std::get<0>(key) * 73856093 ^ std::get<1>(key) * 19349663 ^
-                                std::get<2>(key) * 83492791);
-  }
-};
-
 // The z-buffers of one surface, built once per viewpoint.
 class SurfaceViews {
  public:
-  explicit SurfaceViews(std::shared_ptr<const PointCloud> surface)
-      : surface_(std::move(surface)), spacing_(MedianPointSpacing(*surface_)) {}
+  // `spacing`: the surface's median point spacing (> 0).
+  SurfaceViews(std::shared_ptr<const PointCloud> surface, double spacing)
+      : surface_(std::move(surface)), spacing_(spacing) {}
 
   // The surface's points about `center` (nearest per cell), and the image's cell size.
   std::shared_ptr<const SphericalRangeImage> View(const Eigen::Vector3d& center) {
@@ -115,13 +110,10 @@ PointCloud Scan(SurfaceViews* views,
 // One point of the surface per voxel (the first): real surface points, where a voxel's centroid would
 // lie inside the structure at its edges and be hidden by its own surface.
 PointCloud FirstPointPerVoxel(const PointCloud& surface, double voxel) {
-  std::unordered_set<std::tuple<int64_t, int64_t, int64_t>, VoxelHash> seen;
+  std::unordered_set<uint64_t> seen;
   PointCloud thinned;
   for (const Eigen::Vector3d& p : surface.points) {
-    const auto key = std::make_tuple(static_cast<int64_t>(std::floor(p.x() / voxel)),
-                                     static_cast<int64_t>(std::floor(p.y() / voxel)),
-                                     static_cast<int64_t>(std::floor(p.z() / voxel)));
-    if (seen.insert(key).second) thinned.points.push_back(p);
+    if (seen.insert(VoxelKey(p, voxel)).second) thinned.points.push_back(p);
   }
   return thinned;
 }
@@ -152,7 +144,12 @@ SyntheticWorld WorldOfSurface(std::shared_ptr<const PointCloud> surface, double 
                                 std::to_string(finite) + " of " + std::to_string(surface->Size()) +
                                 " finite)");
   }
-  auto views = std::make_shared<SurfaceViews>(surface);
+  const double spacing = MedianPointSpacing(*surface);
+  if (!(spacing > 0)) {
+    throw std::invalid_argument(
+        "The surface's points lie on top of each other (median spacing 0): remove the duplicates");
+  }
+  auto views = std::make_shared<SurfaceViews>(surface, spacing);
   SyntheticWorld world;
   world.sample_surface = [surface](double spacing) {
     return FirstPointPerVoxel(*surface, spacing);

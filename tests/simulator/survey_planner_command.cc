@@ -18,6 +18,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 namespace colmap_lidar {
@@ -118,11 +119,12 @@ int RunPlanSurvey(int argc, char** argv) {
   options.lidar_points = static_cast<size_t>(std::max(0, lidar_points));
   options.seed = static_cast<uint64_t>(seed);
   THROW_CHECK(options.Check());  // before any file is read
-  // The scene outlives the target that refers to it.
-  const sim::Scene scene = sim::Scene::Create(surface_path.empty() ? scene_name : "t_specimen");
+  // The scene (if any) outlives the target that refers to it.
+  std::optional<sim::Scene> scene;
+  if (surface_path.empty()) scene.emplace(sim::Scene::Create(scene_name));
   const sim::SurveyTarget target =
-      surface_path.empty()
-          ? sim::TargetOfScene(scene)
+      scene
+          ? sim::TargetOfScene(*scene)
           : sim::TargetOfSurface(std::make_shared<const PointCloud>(ReadPointCloud(surface_path)));
   const std::string structure = surface_path.empty() ? scene_name : surface_path;
   const std::map<std::string, colmap::Rigid3d> planned = ReadNamedPoses(stations_path);
