@@ -282,7 +282,8 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
   const fs::path deskewed_path = fs::path(output_path) / "deskewed";
   const fs::path static_path = fs::path(output_path) / "static";
   fs::remove_all(deskewed_path);
-  fs::remove_all(static_path);
+  fs::remove_all(static_path);  // with moving_points.ply: no stale output of an earlier run
+  fs::remove(fs::path(output_path) / "moving_points.ply");
   LidarGraph graph = RegisterClouds(files, options, nullptr, "", start);
   if (options.deskew_sweeps) {
     std::cout << "lidar_registrator: de-skewing every sweep with the registered motion and "
