@@ -53,6 +53,10 @@ int RunEvaluateModel(int argc, char** argv);
 // Error of an estimated cam_from_lidar and of a sparse model's station poses against ground truth.
 int RunEvaluateCalibration(int argc, char** argv);
 
+// The database's depth priors against ground_truth/depth/: errors in units of sigma_d, at and away
+// from depth edges (colmap_ext/depth_prior_evaluation.h).
+int RunEvaluateDepthPriors(int argc, char** argv);
+
 // cam_from_lidar from image edges and LiDAR depth discontinuities (Levinson & Thrun 2013), the
 // baseline of the paper's comparison (bridge/edge_calibration.h).
 int RunCalibrateEdges(int argc, char** argv);

@@ -288,9 +288,10 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("hold_unobservable",
           &adjuster.hold_unobservable,
           "solve again with unobservable directions of cam_from_lidar held at their initial value");
-  add.Add(
-      "hold_rotation_deg", &adjuster.hold_rotation_deg, "sigma above which a direction is held");
-  add.Add("hold_translation_mm", &adjuster.hold_translation_mm);
+  add.Add("hold_rotation_deg",
+          &options->hold_rotation_deg,
+          "sigma above which a direction is held; -1: from initialization.json (see the docs)");
+  add.Add("hold_translation_mm", &options->hold_translation_mm, "likewise; -1: automatic");
   add.Add("min_image_pair_inliers", &options->data.min_image_pair_inliers);
   add.Add("max_lidar_neighbors", &options->data.max_lidar_neighbors);
   add.Add("stereo_scale_sigma", &adjuster.observability.stereo_scale_sigma);

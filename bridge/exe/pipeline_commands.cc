@@ -280,6 +280,15 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
                        RunEvaluateCalibrationStep(dataset.root, joint, "", evaluation, "rigid");
                      }});
   }
+  // The simulator's true depth maps: how far the stereo depth priors are from the truth.
+  if (stereo_rig && fs::is_directory(dataset.GroundTruthPath("depth"))) {
+    steps.push_back({"evaluate_depth_priors", [=, &dataset] {
+                       RunEvaluateDepthPriorsStep(database,
+                                                  dataset.root,
+                                                  (fs::path(evaluation) / "depth_priors").string(),
+                                                  DepthPriorEvaluationOptions());
+                     }});
+  }
   if (!dataset.HasGroundTruth() || !fs::is_regular_file(dataset.GroundTruthPath("surface.ply"))) {
     return steps;
   }

@@ -14,6 +14,7 @@
 #include "bridge/joint_problem_data.h"
 #include "bridge/pose_initializer.h"
 #include "colmap_ext/dataset_import.h"
+#include "colmap_ext/depth_prior_evaluation.h"
 #include "colmap_ext/depth_prior_extractor.h"
 #include "colmap_ext/elapsed.h"
 #include "colmap_ext/station_dataset.h"
@@ -200,6 +201,13 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
                                 const std::string& cam_from_lidar_path,
                                 const std::string& output_path,
                                 const std::string& alignment);
+
+// evaluate_depth_priors: the database's priors against DATASET/ground_truth/depth/, metrics.json
+// and a histogram into `output_path`.
+void RunEvaluateDepthPriorsStep(const std::string& database_path,
+                                const std::string& dataset_path,
+                                const std::string& output_path,
+                                const DepthPriorEvaluationOptions& options);
 
 // evaluate_model's options but the thresholds (a list, parsed by the command).
 void AddModelEvaluationOptions(const std::string& prefix,

@@ -107,6 +107,9 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
         cam_from_lidar, options.guess_rotation_deg, options.guess_translation_m, options.seed + 1);
   }
   rig.lidar_range_noise_m = options.range_noise_m;
+  // Driving, each cloud is one revolution (from behind, counter-clockwise) while the pod moves: say
+  // so, as import_kitti does, so that the pipeline de-skews them.
+  if (drive && options.sweep_motion) rig.lidar_sweep = StationRig::LidarSweep();
   // KITTI's images are rectified: the right camera is not turned against the left one.
   if (options.layout == "kitti") rig.right_from_left.rotation = Eigen::Quaterniond::Identity();
   // Mono: the same left images and clouds as the stereo dataset of the same seed; the right camera is

@@ -315,6 +315,9 @@ TEST(SimulatorTest, DriveSweepsAgreeWithTheImagesAtTheirFiringInstant) {
   const StationDataset dataset = ReadStationDataset(dir.File("d"));
   EXPECT_EQ(dataset.rig.left.width, 621u);
   EXPECT_EQ(dataset.rig.left.height, 188u);
+  // rig.json says the clouds are sweeps (the pipeline then de-skews them), as import_kitti does.
+  ASSERT_TRUE(dataset.rig.lidar_sweep);
+  EXPECT_EQ(dataset.rig.lidar_sweep->start_azimuth_deg, 180.0);
   const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
   const colmap::Rigid3d cam_from_lidar =
       ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
