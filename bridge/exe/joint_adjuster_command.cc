@@ -136,6 +136,9 @@ void WriteReport(const std::string& directory,
   report["uncertainty"] = uncertainty;
   report["unobservable"] = u.unobservable;
   report["held_at_initial"] = summary.held_at_initial;
+  report["hold_thresholds"] = {{"enabled", options.hold_unobservable},
+                               {"rotation_deg", options.hold_rotation_deg},
+                               {"translation_mm", options.hold_translation_mm}};
   report["motion"] = {{"stations", summary.motion.num_stations},
                       {"rotating_pairs", summary.motion.num_rotating_pairs},
                       {"max_axis_angle_deg", summary.motion.max_axis_angle_deg},
