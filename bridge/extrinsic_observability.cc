@@ -57,12 +57,33 @@ bool ObservabilityOptions::Check() const {
   return true;
 }
 
+namespace {
+
+// The largest rotation about an axis perpendicular to the main axis of the rotations (the top
+// eigenvector of sum r r^T over the rotation vectors r, degrees). The axes of small rotations
+// scatter with the pose noise (a car's 2-3 deg turns: 8 deg apart), but their rotation about any
+// second axis stays a fraction of a degree; two-axis motion turns by degrees about it.
+double LargestRotationOffMainAxisDeg(const std::vector<Eigen::Vector3d>& rotation_vectors) {
+  if (rotation_vectors.empty()) return 0;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& r : rotation_vectors) scatter += r * r.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+  const Eigen::Vector3d main_axis = solver.eigenvectors().col(2);
+  double largest = 0;
+  for (const Eigen::Vector3d& r : rotation_vectors) {
+    largest = std::max(largest, (r - r.dot(main_axis) * main_axis).norm());
+  }
+  return largest;
+}
+
+}  // namespace
+
 MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
                              const ObservabilityOptions& options) {
   MotionAnalysis analysis;
   const std::vector<colmap::image_t>& ids = reconstruction.RegImageIds();
   analysis.num_stations = static_cast<int>(ids.size());
-  std::vector<Eigen::Vector3d> axes;
+  std::vector<Eigen::Vector3d> axes, rotation_vectors;
   double largest_angle = 0;
   for (size_t a = 0; a < ids.size(); ++a) {
     for (size_t b = a + 1; b < ids.size(); ++b) {
@@ -73,6 +94,7 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
       const Eigen::AngleAxisd angle_axis(rotation);
       if (angle_axis.angle() * kRadToDeg < options.min_rotation_deg) continue;
       axes.push_back(angle_axis.axis());
+      rotation_vectors.push_back(angle_axis.angle() * kRadToDeg * angle_axis.axis());
       if (angle_axis.angle() > largest_angle) {
         largest_angle = angle_axis.angle();
         analysis.common_axis_in_cam = angle_axis.axis();
@@ -87,8 +109,10 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
           std::max(analysis.max_axis_angle_deg, std::acos(cosine) * kRadToDeg);
     }
   }
-  analysis.unique =
-      analysis.num_stations >= 3 && analysis.max_axis_angle_deg > options.max_parallel_axes_deg;
+  analysis.second_axis_rotation_deg = LargestRotationOffMainAxisDeg(rotation_vectors);
+  analysis.unique = analysis.num_stations >= 3 &&
+                    analysis.max_axis_angle_deg > options.max_parallel_axes_deg &&
+                    analysis.second_axis_rotation_deg >= options.min_rotation_deg;
   std::ostringstream verdict;
   verdict << std::fixed << std::setprecision(1);
   if (analysis.num_stations < 3) {
@@ -101,8 +125,8 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
   } else if (!analysis.unique) {
     verdict << "all relative rotations share one axis ("
             << DescribeAxis(analysis.common_axis_in_cam) << ", axes within "
-            << analysis.max_axis_angle_deg
-            << " deg): T_e's translation along it is unobservable; add "
+            << analysis.max_axis_angle_deg << " deg, at most " << analysis.second_axis_rotation_deg
+            << " deg about any other): T_e's translation along it is unobservable; add "
                "stations tilted about a second axis";
   } else {
     verdict << "relative rotation axes of " << analysis.num_rotating_pairs << " station pairs span "

@@ -70,8 +70,12 @@ struct MotionAnalysis {
   int num_stations = 0;
   int num_rotating_pairs = 0;     // relative rotation above 2 deg
   double max_axis_angle_deg = 0;  // largest angle between two relative rotation axes
+  // largest relative rotation about an axis perpendicular to the main rotation axis
+  double second_axis_rotation_deg = 0;
   Eigen::Vector3d common_axis_in_cam = Eigen::Vector3d::Zero();  // if all axes are parallel
-  bool unique = false;  // the test of Zhen et al. 2019: >= 3 stations, axes not all parallel
+  // The test of Zhen et al. 2019: >= 3 stations, axes not all parallel (more than
+  // max_parallel_axes_deg apart, and some pair turning min_rotation_deg about a second axis).
+  bool unique = false;
   std::string verdict;
 };
 

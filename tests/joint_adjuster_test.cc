@@ -2,7 +2,6 @@
 // import_dataset -> depth_prior_extractor -> an initial model (true poses perturbed, landmarks
 // triangulated by the real `colmap point_triangulator`) -> joint_adjuster; accuracy against ground truth.
 #include "bridge/calibration_evaluation.h"
-#include "colmap_ext/atomic_file.h"
 #include "colmap_ext/station_dataset.h"
 #include "tests/simulator/simulate_dataset.h"
 #include "tests/testing/run_command.h"
@@ -188,14 +187,10 @@ TEST(JointAdjusterTest, OneAxisMotionLeavesTranslationAlongTheAxisUnobservable) 
   sim::SimulationOptions options = Stations(10, "one_axis");
   options.image_scale = 0.6;
   const Workspace ws = Prepare(dir, options, 0.3, 0.01);
-  // A start from rig.json's guess (as pose_initializer would say): the automatic hold thresholds
-  // are then the reporting ones, but given ones win (they were once overridden).
-  WriteFileAtomically(ws.initial_model + "/initialization.json",
-                      R"({"extrinsic_source": "rig.json guess"})");
+  // A given hold threshold is the one used (a start from the guess once overrode it).
   const JointResult joint =
       RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess + " --hold_translation_mm 30");
   EXPECT_EQ(joint.report["hold_thresholds"]["translation_mm"].get<double>(), 30);
-  EXPECT_EQ(joint.report["hold_thresholds"]["rotation_deg"].get<double>(), 0.2);
   const std::string verdict = joint.report["observability_verdict"];
   std::cout << "verdict: " << verdict << std::endl;
   EXPECT_NE(verdict.find("translation along the camera y axis is unobservable"), std::string::npos)
@@ -204,12 +199,16 @@ TEST(JointAdjusterTest, OneAxisMotionLeavesTranslationAlongTheAxisUnobservable) 
   EXPECT_FALSE(joint.report["motion"]["unique"].get<bool>());
 }
 
+// Stations that do not rotate: the paper's cost cannot observe any translation of T_e, and tripod
+// stations keep the paper's cost by default (the landmark-to-LiDAR-plane term is automatic only on
+// a moving platform; on these stations it once ended 128 mm off with a reported sigma of 7 mm).
 TEST(JointAdjusterTest, FixedRotationLeavesAllTranslationUnobservable) {
   testing::ScopedTempDir dir;
   sim::SimulationOptions options = Stations(4, "fixed_rotation");
   options.image_scale = 0.6;
   const Workspace ws = Prepare(dir, options, 0.3, 0.01);
   const JointResult joint = RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess);
+  EXPECT_EQ(joint.report["landmark_lidar_weight"].get<double>(), 0.0);
   const std::string verdict = joint.report["observability_verdict"];
   std::cout << "verdict: " << verdict << std::endl;
   EXPECT_NE(verdict.find("all translation of cam_from_lidar is unobservable"), std::string::npos)

@@ -142,14 +142,10 @@ struct JointAdjusterStepOptions {
   std::string mode = "joint";
   // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by Check().
   std::string hold_translation;
-  // w_m of the landmark-to-LiDAR-plane term; -1: 1 for a monocular rig or motion about one axis, 0
-  // otherwise (decided by RunJointAdjusterStep); into `adjuster` by Check() when >= 0.
+  // w_m of the landmark-to-LiDAR-plane term; -1: 1 for a monocular rig or stations that do not
+  // rotate about two axes, 0 otherwise (decided by RunJointAdjusterStep); into `adjuster` by Check()
+  // when >= 0.
   double landmark_lidar_weight = -1;
-  // Thresholds of hold_unobservable; -1: decided by RunJointAdjusterStep from initialization.json (a
-  // start from rig.json's guess: the reporting thresholds, 0.2 deg / 5 mm; else the adjuster's own,
-  // 0.5 deg / 20 mm); into `adjuster` by Check() when > 0.
-  double hold_rotation_deg = -1;
-  double hold_translation_mm = -1;
   // LiDAR samples per pair (int for the OptionManager); into `adjuster.association` by Check().
   int num_samples_per_pair = static_cast<int>(JointAdjusterOptions().association.num_samples);
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
