@@ -92,6 +92,7 @@ void EvaluateImagePriors(const ImageKeypoints& image,
 bool DepthPriorEvaluationOptions::Check() const {
   CHECK_OPTION_GE(edge_radius_px, 0);
   CHECK_OPTION_GE(edge_relative_jump, 0);
+  CHECK_OPTION_GT(inlier_sigmas, 0);
   return true;
 }
 
@@ -150,13 +151,15 @@ DepthPriorEvaluation EvaluateDepthPriors(const std::string& database_path,
     throw std::runtime_error("no image of " + database_path + " has a true depth map in " +
                              true_depth_path);
   }
-  std::vector<DepthPriorError> at_edges, away;
+  std::vector<DepthPriorError> at_edges, away, inliers;
   for (const DepthPriorError& error : evaluation.errors) {
     (error.at_edge ? at_edges : away).push_back(error);
+    if (std::abs(error.Normalized()) <= options.inlier_sigmas) inliers.push_back(error);
   }
   evaluation.all = SummarizeDepthPriorErrors(evaluation.errors);
   evaluation.at_edges = SummarizeDepthPriorErrors(at_edges);
   evaluation.away_from_edges = SummarizeDepthPriorErrors(away);
+  evaluation.inliers = SummarizeDepthPriorErrors(inliers);
   return evaluation;
 }
 

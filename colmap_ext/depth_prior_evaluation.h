@@ -19,6 +19,8 @@ struct DepthPriorEvaluationOptions {
   // `edge_relative_jump` of its smallest value.
   int edge_radius_px = 2;
   double edge_relative_jump = 0.05;
+  // The `inliers` statistics: priors within this many sigma_d of the truth.
+  double inlier_sigmas = 3.0;
 
   bool Check() const;
 };
@@ -56,6 +58,9 @@ struct DepthPriorEvaluation {
   // priors whose keypoint's pixel has no true depth (sky)
   size_t num_without_true_depth = 0;
   DepthPriorStatistics all, at_edges, away_from_edges;
+  // The priors within `inlier_sigmas` of the truth: what the joint adjuster's outlier gate keeps, so
+  // their mean error is the bias that reaches the solution.
+  DepthPriorStatistics inliers;
 };
 
 DepthPriorStatistics SummarizeDepthPriorErrors(const std::vector<DepthPriorError>& errors);

@@ -95,6 +95,9 @@ TEST_F(DepthPriorEvaluationTest, AFattenedEdgeShowsAsGrossErrorsAtTheEdge) {
   EXPECT_EQ(evaluation.away_from_edges.beyond_10_sigma, 0);
   // The wall's priors come out 2 m near: a negative mean error.
   EXPECT_LT(evaluation.at_edges.mean_normalized_error, -10);
+  // The gate keeps the rest: no bias reaches the solution.
+  EXPECT_EQ(evaluation.inliers.num_priors, 20u * (kWidth - 2));
+  EXPECT_NEAR(evaluation.inliers.mean_normalized_error, 0, 0.02);
 }
 
 TEST_F(DepthPriorEvaluationTest, RefusesTrueDepthOfAnotherSizeAndAFolderWithout) {

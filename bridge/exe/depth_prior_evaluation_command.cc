@@ -54,6 +54,7 @@ int RunEvaluateDepthPriors(int argc, char** argv) {
   manager.AddRequiredOption("output_path", &output_path, "directory for metrics.json and plots");
   manager.AddDefaultOption("edge_radius_px", &options.edge_radius_px);
   manager.AddDefaultOption("edge_relative_jump", &options.edge_relative_jump);
+  manager.AddDefaultOption("inlier_sigmas", &options.inlier_sigmas);
   manager.Parse(argc, argv);
   RunEvaluateDepthPriorsStep(database_path, dataset_path, output_path, options);
   return EXIT_SUCCESS;
@@ -72,12 +73,17 @@ void RunEvaluateDepthPriorsStep(const std::string& database_path,
   PrintStatistics("all", evaluation.all);
   PrintStatistics("at depth edges", evaluation.at_edges);
   PrintStatistics("away from edges", evaluation.away_from_edges);
+  PrintStatistics("within " + std::to_string(static_cast<int>(options.inlier_sigmas)) +
+                      " sigma (what the adjuster's gate keeps)",
+                  evaluation.inliers);
 
   fs::create_directories(output_path);
   nlohmann::json metrics;
   metrics["all"] = StatisticsJson(evaluation.all);
   metrics["at_edges"] = StatisticsJson(evaluation.at_edges);
   metrics["away_from_edges"] = StatisticsJson(evaluation.away_from_edges);
+  metrics["inliers"] = StatisticsJson(evaluation.inliers);
+  metrics["inlier_sigmas"] = options.inlier_sigmas;
   metrics["num_without_true_depth"] = evaluation.num_without_true_depth;
   metrics["images_without_truth"] = evaluation.images_without_truth;
   WriteFileAtomically((fs::path(output_path) / "metrics.json").string(), metrics.dump(2) + "\n");
