@@ -72,6 +72,32 @@ nlohmann::json MatrixJson(const Eigen::MatrixXd& matrix) {
   return rows;
 }
 
+// report.json's "uncertainty": the cluster-robust and formal covariances of cam_from_lidar.
+nlohmann::json UncertaintyJson(const ExtrinsicUncertainty& u,
+                               const ObservabilityOptions& observability) {
+  nlohmann::json uncertainty = {{"computed", u.computed}, {"message", u.message}};
+  if (u.computed) {
+    uncertainty["variance_factor"] = u.variance_factor;
+    uncertainty["covariance_deg_mm"] = MatrixJson(u.covariance);
+    uncertainty["cluster_robust"] = u.cluster_robust;
+    uncertainty["stereo_scale_sigma"] = observability.stereo_scale_sigma;
+    uncertainty["stereo_scale_sensitivity_deg_mm"] =
+        MatrixJson(u.stereo_scale_sensitivity.transpose());
+    uncertainty["num_clusters"] = u.num_clusters;
+    uncertainty["formal_covariance_deg_mm"] = MatrixJson(u.formal_covariance);
+    const Eigen::VectorXd formal_sigma = u.formal_covariance.diagonal().cwiseSqrt();
+    uncertainty["formal_sigma_rotation_deg"] = {formal_sigma[0], formal_sigma[1], formal_sigma[2]};
+    uncertainty["formal_sigma_translation_mm"] = {
+        formal_sigma[3], formal_sigma[4], formal_sigma[5]};
+    const Eigen::VectorXd sigma = u.covariance.diagonal().cwiseSqrt();
+    uncertainty["sigma_rotation_deg"] = {sigma[0], sigma[1], sigma[2]};
+    uncertainty["sigma_translation_mm"] = {sigma[3], sigma[4], sigma[5]};
+    uncertainty["eigen_std_devs"] = MatrixJson(u.eigenvalues.transpose());
+    uncertainty["eigenvectors_columns"] = MatrixJson(u.eigenvectors);
+  }
+  return uncertainty;
+}
+
 void WriteReport(const std::string& directory,
                  const JointAdjusterOptions& options,
                  const LoadedJointData& loaded,
@@ -113,27 +139,7 @@ void WriteReport(const std::string& directory,
                              {"landmark_lidar_residuals", summary.final_landmark_lidar_residuals}};
   report["landmark_lidar_weight"] = options.landmark_lidar_weight;
   const ExtrinsicUncertainty& u = summary.uncertainty;
-  nlohmann::json uncertainty = {{"computed", u.computed}, {"message", u.message}};
-  if (u.computed) {
-    uncertainty["variance_factor"] = u.variance_factor;
-    uncertainty["covariance_deg_mm"] = MatrixJson(u.covariance);
-    uncertainty["cluster_robust"] = u.cluster_robust;
-    uncertainty["stereo_scale_sigma"] = options.observability.stereo_scale_sigma;
-    uncertainty["stereo_scale_sensitivity_deg_mm"] =
-        MatrixJson(u.stereo_scale_sensitivity.transpose());
-    uncertainty["num_clusters"] = u.num_clusters;
-    uncertainty["formal_covariance_deg_mm"] = MatrixJson(u.formal_covariance);
-    const Eigen::VectorXd formal_sigma = u.formal_covariance.diagonal().cwiseSqrt();
-    uncertainty["formal_sigma_rotation_deg"] = {formal_sigma[0], formal_sigma[1], formal_sigma[2]};
-    uncertainty["formal_sigma_translation_mm"] = {
-        formal_sigma[3], formal_sigma[4], formal_sigma[5]};
-    const Eigen::VectorXd sigma = u.covariance.diagonal().cwiseSqrt();
-    uncertainty["sigma_rotation_deg"] = {sigma[0], sigma[1], sigma[2]};
-    uncertainty["sigma_translation_mm"] = {sigma[3], sigma[4], sigma[5]};
-    uncertainty["eigen_std_devs"] = MatrixJson(u.eigenvalues.transpose());
-    uncertainty["eigenvectors_columns"] = MatrixJson(u.eigenvectors);
-  }
-  report["uncertainty"] = uncertainty;
+  report["uncertainty"] = UncertaintyJson(u, options.observability);
   report["unobservable"] = u.unobservable;
   report["held_at_initial"] = summary.held_at_initial;
   report["hold_thresholds"] = {{"enabled", options.hold_unobservable},
