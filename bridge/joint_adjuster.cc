@@ -149,6 +149,8 @@ struct RunState {
   // This round's association gate (0 in the last round): E_m's outlier cap is never below it, so
   // that a coarse initial cam_from_lidar (a height off by 25 cm) is pulled in before the cap applies.
   double round_gate_m = 0;
+  // Whether this round's problem has E_d (see JointAdjusterOptions::first_depth_prior_round).
+  bool depth_priors_in_force = true;
 
   bool UsesExtrinsic() const { return use_lidar || use_landmark_lidar; }
 
@@ -192,7 +194,7 @@ std::pair<double*, double*> PoseBlocks(const RunState& state,
 
 // E_d, the paper's depth-prior residual, for every landmark observation with a prior in force.
 void AddDepthPriorBlocks(const RunState& state, JointProblem* joint) {
-  if (state.options.depth_weight <= 0) return;
+  if (state.options.depth_weight <= 0 || !state.depth_priors_in_force) return;
   ceres::Problem* problem = joint->problem.get();
   const double weight_scale = 1.0 / std::sqrt(state.options.depth_weight);
   for (const auto& [point3D_id, point3D] : state.reconstruction->Points3D()) {
@@ -801,6 +803,7 @@ std::string JointModeName(JointMode mode) {
 bool JointAdjusterOptions::Check() const {
   CHECK_OPTION_GT(sigma_lidar_m, 0);
   CHECK_OPTION_GE(depth_weight, 0);
+  CHECK_OPTION_GE(first_depth_prior_round, 1);
   CHECK_OPTION_GE(lidar_weight, 0);
   CHECK_OPTION_GE(landmark_lidar_weight, 0);
   CHECK_OPTION_GT(sigma_landmark_lidar_m, 0);
@@ -850,6 +853,13 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
   for (int round = 0; round < num_rounds || RoundMovedExtrinsic(options_, summary); ++round) {
     if (round >= options_.max_association_rounds) break;
     const colmap::Rigid3d before = *cam_from_lidar;
+    state.depth_priors_in_force = !state.UsesExtrinsic() ||
+                                  round + 1 >= options_.first_depth_prior_round ||
+                                  num_rounds < options_.first_depth_prior_round;
+    if (!state.depth_priors_in_force && options_.depth_weight > 0) {
+      std::cout << "Round " << round + 1 << " without the depth priors (they join in round "
+                << options_.first_depth_prior_round << ")" << std::endl;
+    }
     if (state.UsesExtrinsic()) Reassociate(round, num_rounds, &state, &associations);
     SolveWithOutliers(round, &state, &associations, &summary);
     summary.extrinsic_change_per_round.push_back(ExtrinsicChange(before, *cam_from_lidar));

@@ -59,6 +59,12 @@ struct JointAdjusterOptions {
   double sigma_lidar_m = 0.02;
   // w_c of E_d (E_f keeps weight 1).
   double depth_weight = 1.0;
+  // With LiDAR terms, E_d joins from this round on (1: from the start, as in the paper). The start's
+  // landmarks are triangulated through the initial cam_from_lidar: on the 40-frame stereo drive from
+  // a 3 deg guess their depths were ~90 sigma_d off the priors, and a first solve with E_d deformed
+  // the model (reprojection cost x100, 80 % of E_m's associations lost for good): 0.49 deg. A first
+  // round without E_d (reprojection, LiDAR, E_m) fits them first.
+  int first_depth_prior_round = 2;
   // w_l of E_l.
   double lidar_weight = 1.0;
   // w_m of E_m, the landmark-to-LiDAR-plane term; 0 = off (the paper's cost). The pipeline turns it on

@@ -157,7 +157,15 @@ void WriteReport(const std::string& directory,
   } else if (u.unobservable.empty() && summary.motion.unique) {
     verdict = "cam_from_lidar is observable";
   } else {
-    verdict = u.unobservable.empty() ? summary.motion.verdict : u.unobservable.front();
+    // A degenerate motion whose directions the data observe all the same (a car through the
+    // landmark-to-LiDAR-plane term): say both, not "unobservable" against the uncertainty.
+    verdict = !u.unobservable.empty()
+                  ? u.unobservable.front()
+                  : "cam_from_lidar is observable by its uncertainty" +
+                        std::string(options.landmark_lidar_weight > 0
+                                        ? " (with the landmark-to-LiDAR-plane term)"
+                                        : "") +
+                        ", though the motion alone is degenerate: " + summary.motion.verdict;
   }
   report["observability_verdict"] = verdict;
   nlohmann::json curves = nlohmann::json::array();
@@ -257,6 +265,9 @@ void AddJointAdjusterOptions(const std::string& prefix,
   JointAdjusterOptions& adjuster = options->adjuster;
   add.Add("sigma_lidar_m", &adjuster.sigma_lidar_m);
   add.Add("depth_weight", &adjuster.depth_weight);
+  add.Add("first_depth_prior_round",
+          &adjuster.first_depth_prior_round,
+          "with LiDAR, the depth priors join from this round (1: from the start, the paper)");
   add.Add("lidar_weight", &adjuster.lidar_weight);
   add.Add("loss", &adjuster.loss, "none | huber | cauchy");
   add.Add("loss_scale", &adjuster.loss_scale);
