@@ -856,7 +856,7 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
     state.depth_priors_in_force = !state.UsesExtrinsic() ||
                                   round + 1 >= options_.first_depth_prior_round ||
                                   num_rounds < options_.first_depth_prior_round;
-    if (!state.depth_priors_in_force && options_.depth_weight > 0) {
+    if (!state.depth_priors_in_force && options_.depth_weight > 0 && !data.depth_priors.empty()) {
       std::cout << "Round " << round + 1 << " without the depth priors (they join in round "
                 << options_.first_depth_prior_round << ")" << std::endl;
     }
