@@ -1,10 +1,10 @@
 #include "colmap_ext/depth_prior_evaluation.h"
 
+#include "colmap_ext/dense_workspace.h"
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/logging.h"
 
 #include "colmap/math/math.h"
-#include "colmap/mvs/depth_map.h"
 #include "colmap/scene/database.h"
 
 #include <algorithm>
@@ -39,18 +39,15 @@ std::map<colmap::image_t, ImageKeypoints> ReadImageKeypoints(const std::string& 
 
 // True when the true depth within `radius` of (col, row) spans more than `relative_jump` of its
 // smallest value, or has holes (sky next to a surface).
-bool AtDepthEdge(const colmap::mvs::DepthMap& truth,
+bool AtDepthEdge(const cv::Mat& truth,
                  int col,
                  int row,
                  const DepthPriorEvaluationOptions& options) {
   double lo = std::numeric_limits<double>::max(), hi = 0;
   for (int r = row - options.edge_radius_px; r <= row + options.edge_radius_px; ++r) {
     for (int c = col - options.edge_radius_px; c <= col + options.edge_radius_px; ++c) {
-      if (c < 0 || r < 0 || c >= static_cast<int>(truth.GetWidth()) ||
-          r >= static_cast<int>(truth.GetHeight())) {
-        continue;
-      }
-      const double depth = truth.Get(r, c);
+      if (c < 0 || r < 0 || c >= truth.cols || r >= truth.rows) continue;
+      const double depth = truth.at<float>(r, c);
       if (!(depth > 0)) return true;
       lo = std::min(lo, depth);
       hi = std::max(hi, depth);
@@ -62,7 +59,7 @@ bool AtDepthEdge(const colmap::mvs::DepthMap& truth,
 // The priors of one image against its true depth map; priors on pixels without truth are counted.
 void EvaluateImagePriors(const ImageKeypoints& image,
                          const std::vector<DepthPrior>& priors,
-                         const colmap::mvs::DepthMap& truth,
+                         const cv::Mat& truth,
                          const DepthPriorEvaluationOptions& options,
                          DepthPriorEvaluation* evaluation) {
   for (const DepthPrior& prior : priors) {
@@ -71,14 +68,14 @@ void EvaluateImagePriors(const ImageKeypoints& image,
     const colmap::FeatureKeypoint& keypoint = image.keypoints[prior.point2D_idx];
     const int col = static_cast<int>(std::floor(keypoint.x));
     const int row = static_cast<int>(std::floor(keypoint.y));
-    const double true_depth =
-        (col >= 0 && row >= 0 && col < image.width && row < image.height) ? truth.Get(row, col) : 0;
+    const double true_depth = (col >= 0 && row >= 0 && col < truth.cols && row < truth.rows)
+                                  ? truth.at<float>(row, col)
+                                  : 0;
     if (!(true_depth > 0)) {
       ++evaluation->num_without_true_depth;
       continue;
     }
     DepthPriorError error;
-    error.image_name = image.name;
     error.prior_depth = prior.depth;
     error.sigma = prior.sigma;
     error.true_depth = true_depth;
@@ -137,10 +134,9 @@ DepthPriorEvaluation EvaluateDepthPriors(const std::string& database_path,
       evaluation.images_without_truth.push_back(image.name);
       continue;
     }
-    colmap::mvs::DepthMap truth;
-    truth.Read(map_path.string());
-    if (static_cast<int>(truth.GetWidth()) != image.width ||
-        static_cast<int>(truth.GetHeight()) != image.height) {
+    // The fuzzed reader: a truncated or foreign file is one error naming it.
+    const cv::Mat truth = ReadColmapDepthMap(map_path.string());
+    if (truth.cols != image.width || truth.rows != image.height) {
       throw std::runtime_error(map_path.string() + " is not " + std::to_string(image.width) + "x" +
                                std::to_string(image.height) + " like image " + image.name +
                                ": the true depth belongs to another dataset");

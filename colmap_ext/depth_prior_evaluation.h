@@ -27,7 +27,6 @@ struct DepthPriorEvaluationOptions {
 
 // One prior against the truth.
 struct DepthPriorError {
-  std::string image_name;
   double prior_depth = 0;  // metres
   double sigma = 0;        // metres
   double true_depth = 0;   // metres

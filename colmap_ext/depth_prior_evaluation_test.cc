@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 namespace colmap_lidar {
@@ -100,13 +101,24 @@ TEST_F(DepthPriorEvaluationTest, AFattenedEdgeShowsAsGrossErrorsAtTheEdge) {
   EXPECT_NEAR(evaluation.inliers.mean_normalized_error, 0, 0.02);
 }
 
-TEST_F(DepthPriorEvaluationTest, RefusesTrueDepthOfAnotherSizeAndAFolderWithout) {
+TEST_F(DepthPriorEvaluationTest, RefusesTrueDepthOfAnotherSizeATruncatedOneAndAFolderWithout) {
   WritePriors(1.0, {});
   colmap::mvs::DepthMap other(kWidth / 2, kHeight, 0.f, 5.f);
   other.Write(dir_.File("truth/000.bin"));
   try {
     EvaluateDepthPriors(database_path_, dir_.File("truth"), DepthPriorEvaluationOptions());
     FAIL() << "a true depth map of another size was accepted";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("000.bin"), std::string::npos) << error.what();
+  }
+  // A truncated file: one error naming it, not a crash.
+  {
+    std::ofstream truncated(dir_.File("truth/000.bin"), std::ios::binary);
+    truncated << kWidth << "&" << kHeight << "&1&" << std::string(100, '\0');
+  }
+  try {
+    EvaluateDepthPriors(database_path_, dir_.File("truth"), DepthPriorEvaluationOptions());
+    FAIL() << "a truncated true depth map was accepted";
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find("000.bin"), std::string::npos) << error.what();
   }

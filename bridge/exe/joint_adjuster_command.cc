@@ -281,8 +281,8 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("max_point_to_plane_m", &adjuster.max_point_to_plane_m);
   add.Add("landmark_lidar_weight",
           &options->landmark_lidar_weight,
-          "w_m of the landmark-to-LiDAR-plane term; -1: 1 for a monocular rig or stations that "
-          "do not rotate about two axes, else 0");
+          "w_m of the landmark-to-LiDAR-plane term; -1: 1 for a monocular rig, or a moving "
+          "platform (sweeps) whose stations do not rotate about two axes, else 0");
   add.Add("sigma_landmark_lidar_m", &adjuster.sigma_landmark_lidar_m);
   add.Add("max_landmark_plane_m", &adjuster.max_landmark_plane_m);
   add.Add("max_landmark_plane_sigmas", &adjuster.max_landmark_plane_sigmas);
