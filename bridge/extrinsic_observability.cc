@@ -393,6 +393,16 @@ std::vector<std::string> NameUnobservable(const ExtrinsicUncertainty& result,
 
 }  // namespace
 
+std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform) {
+  if (!moving_platform || motion.unique) return "";
+  const std::string axis = motion.common_axis_in_cam.norm() > 0.5
+                               ? DescribeAxis(motion.common_axis_in_cam)
+                               : std::string("no turn of 2 deg");
+  return "not validated for a moving platform turning about one axis (" + axis +
+         "): on a simulated 40-frame street drive the errors were about 2 of these sigmas on every "
+         "axis and up to 6 about the driving direction; read them as lower bounds";
+}
+
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     ceres::Problem* problem,
     double* cam_from_lidar_rotation,

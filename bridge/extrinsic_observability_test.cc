@@ -66,5 +66,28 @@ TEST(AnalyseMotion, TiltedStationsAreTwoAxes) {
   EXPECT_TRUE(motion.unique) << motion.verdict;
 }
 
+// The reported sigmas are validated for stations that rotate about two axes, not for a car: the
+// caveat names the car's case (one axis, or no turn at all) and only it.
+TEST(UncertaintyCaveat, OnlyAMovingPlatformTurningAboutOneAxis) {
+  std::vector<Eigen::Matrix3d> car, tripod, straight;
+  for (int i = 0; i < 6; ++i) {
+    car.push_back(Rotation(1.0 * i, Eigen::Vector3d::UnitY()));
+    tripod.push_back(Rotation(i % 2 == 0 ? 0.0 : 10.0, Eigen::Vector3d::UnitX()) *
+                     Rotation(15.0 * i, Eigen::Vector3d::UnitY()));
+    straight.push_back(Eigen::Matrix3d::Identity());
+  }
+  const ObservabilityOptions options;
+  const MotionAnalysis car_motion = AnalyseMotion(ModelWithRotations(car), options);
+  const std::string caveat = UncertaintyCaveat(car_motion, true);
+  EXPECT_NE(caveat.find("not validated"), std::string::npos);
+  EXPECT_NE(caveat.find("the camera y axis"), std::string::npos) << caveat;
+  EXPECT_NE(UncertaintyCaveat(AnalyseMotion(ModelWithRotations(straight), options), true)
+                .find("no turn of 2 deg"),
+            std::string::npos);
+  // The same one-axis motion on tripods is reported by the observability sentences instead.
+  EXPECT_TRUE(UncertaintyCaveat(car_motion, false).empty());
+  EXPECT_TRUE(UncertaintyCaveat(AnalyseMotion(ModelWithRotations(tripod), options), true).empty());
+}
+
 }  // namespace
 }  // namespace colmap_lidar

@@ -42,6 +42,7 @@ TEST(PipelineMonoTest, StationsCalibrateWithoutAGuessOrAStereoPair) {
   EXPECT_EQ(init["stations"].get<int>(), 8);
   const nlohmann::json report = ReadJson(ws + "/sparse/joint/report.json");
   EXPECT_EQ(report["landmark_lidar_weight"].get<double>(), 1.0);
+  EXPECT_TRUE(report["uncertainty"]["validated_by_coverage"].get<bool>());  // tripods, two axes
   EXPECT_GT(report["final_problem"]["landmark_lidar_residuals"].get<int>(), 1000);
 
   const nlohmann::json metrics = ReadJson(ws + "/evaluation/metrics.json");
@@ -166,6 +167,12 @@ TEST(PipelineMonoTest, FortyFrameDriveCalibratesWithoutAGuess) {
   EXPECT_TRUE(init["hand_eye"].contains("unobservable_translation_axis_in_cam")) << init.dump(2);
   const nlohmann::json report = ReadJson(dir.File("ws/sparse/joint/report.json"));
   EXPECT_TRUE(report["held_at_initial"].empty()) << report["held_at_initial"].dump();
+  // A car turning about one axis: E_m at the moving platform's weight, and sigmas that say they are
+  // not validated by coverage here.
+  EXPECT_EQ(report["landmark_lidar_weight"].get<double>(), 0.25);
+  EXPECT_FALSE(report["uncertainty"]["validated_by_coverage"].get<bool>());
+  EXPECT_NE(report["uncertainty"]["caveat"].get<std::string>().find("not validated"),
+            std::string::npos);
   const nlohmann::json metrics = ReadJson(dir.File("ws/evaluation/metrics.json"));
   std::cout << "40-frame drive, no guess: cam_from_lidar "
             << metrics["cam_from_lidar_rotation_error_deg"] << " deg, "

@@ -142,9 +142,10 @@ struct JointAdjusterStepOptions {
   std::string mode = "joint";
   // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by Check().
   std::string hold_translation;
-  // w_m of the landmark-to-LiDAR-plane term; -1: 1 for a monocular rig, or a moving platform
-  // (sweeps, or a one-axis hand-eye) whose stations do not rotate about two axes; 0 otherwise, tripods
-  // included (decided by RunJointAdjusterStep); into `adjuster` by Check() when >= 0.
+  // w_m of the landmark-to-LiDAR-plane term; -1: 0.25 for a moving platform (sweeps, or a one-axis
+  // hand-eye) whose stations do not rotate about two axes, else 1 for a monocular rig and 0 for a
+  // stereo rig, tripods included (decided by RunJointAdjusterStep); into `adjuster` by Check() when
+  // >= 0.
   double landmark_lidar_weight = -1;
   // LiDAR samples per pair (int for the OptionManager); into `adjuster.association` by Check().
   int num_samples_per_pair = static_cast<int>(JointAdjusterOptions().association.num_samples);
