@@ -155,11 +155,14 @@ TEST(PipelineMonoTest, KittiLayoutDriveHoldsWhatItCannotSee) {
 
 // The drive: 40 frames (with a lane change and gentle turns), no guess. The similarity
 // hand-eye on COLMAP's two-view geometry gives a coarse start (about 1 deg, the height set to 0: 25 cm
-// off) and names the axis it cannot see from motion; the landmarks on the road and the facades (E_m)
-// observe the rest, and the association rounds continue while cam_from_lidar still moves. Measured in
-// six runs (COLMAP's threaded SIFT makes them differ): 0.034, 0.17, 0.15, 0.026, 0.30 and 0.056 deg;
-// 5.3, 11, 27, 9, 19 and 7 mm (the goal, 0.1 deg / 2 cm, is met in three of the six); the pipeline
-// took 3 min 46 s on 2 cores. Bounds: translation 3x the worst, rotation 1.7x (0.5 deg).
+// off) and names the axis it cannot see from motion; the landmarks on the road and the facades (E_m,
+// at the moving platform's weight 0.25) observe the rest, and the association rounds continue while
+// cam_from_lidar still moves. Measured in three runs (COLMAP's threaded SIFT makes them differ):
+// 0.042, 0.078 and 0.080 deg; 5.1, 7.5 and 10.7 mm (the goal, 0.1 deg / 2 cm, met in all
+// three; with E_m at weight 1, in three of six: 0.034-0.30 deg, 5-27 mm). The joint alone on five
+// initial models: 4 of 5 within 0.05 deg about the driving direction, one at 0.30 deg (its hand-eye
+// coupling through the turns alone gives 0.27: docs/mono.md). Bounds: rotation 1.7x that worst
+// case, translation about 3x the worst (14.8 mm).
 TEST(PipelineMonoTest, FortyFrameDriveCalibratesWithoutAGuess) {
   testing::ScopedTempDir dir;
   const std::string output = RunDrive(dir, 40, false);
@@ -178,7 +181,7 @@ TEST(PipelineMonoTest, FortyFrameDriveCalibratesWithoutAGuess) {
             << metrics["cam_from_lidar_rotation_error_deg"] << " deg, "
             << metrics["cam_from_lidar_translation_error_mm"] << " mm" << std::endl;
   EXPECT_LE(metrics["cam_from_lidar_rotation_error_deg"].get<double>(), 0.5);
-  EXPECT_LE(metrics["cam_from_lidar_translation_error_mm"].get<double>(), 80.0);
+  EXPECT_LE(metrics["cam_from_lidar_translation_error_mm"].get<double>(), 45.0);
 }
 
 }  // namespace
