@@ -399,8 +399,8 @@ std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform
                                ? DescribeAxis(motion.common_axis_in_cam)
                                : std::string("no turn of 2 deg");
   return "not validated for a moving platform turning about one axis (" + axis +
-         "): on a simulated 40-frame street drive the errors were about 2 of these sigmas on every "
-         "axis and up to 6 about the driving direction; read them as lower bounds";
+         "): on simulated 40-frame street drives the errors reached 4-8 of these sigmas (the "
+         "height, the rotation about the driving direction); read them as lower bounds";
 }
 
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(

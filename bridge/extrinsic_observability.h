@@ -86,10 +86,10 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
 // Empty if the reported covariance of T_e has been validated by coverage for this kind of capture
 // (stations that rotate about two axes: tests/joint_adjuster_coverage_test.cc and the T specimen end
 // to end), else one sentence saying why it has not. A moving platform (sweeps, or a one-axis
-// hand-eye) whose stations turn about one axis is not: on the simulated 40-frame street drive (one
-// camera, no guess; 4 runs of the same drive) the reported sigmas were 2x optimistic on every axis
-// and up to 6x about the driving direction (0.02-0.27 deg off with sigma 0.045 deg), the errors of
-// systematic sign across runs.
+// hand-eye) whose stations turn about one axis is not: on simulated 40-frame street drives (one
+// camera, no guess; docs/benchmarks/drive_uncertainty.md) the errors reached 4-8 reported sigmas in
+// the height and the rotation about the driving direction (0.27 deg off with sigma 0.05 deg), with
+// a sign that held across runs of one drive.
 std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform);
 
 // Marginal covariance of T_e's blocks in `problem` (both must be variable parameter blocks; the rotation
