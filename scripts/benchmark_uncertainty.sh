@@ -28,6 +28,32 @@ else
 fi
 results="$work/results.tsv"
 : > "$results"
+# One seed of tripod stations: the steps one by one (uses scene, seed, run, ws, joint, step).
+run_stations() {
+  step "$run/dataset" $cli simulate_dataset --scene "$scene" --seed "$seed" \
+    --num_stations "${STATIONS:-8}" --lidar_points "${LIDAR_POINTS:-300000}" \
+    --output_path "$run/dataset" &&
+  step "$ws/stereo" $cli stereo_depth --dataset_path "$run/dataset" --output_path "$ws/stereo" &&
+  step "$ws/db.db" $cli import_dataset --dataset_path "$run/dataset" --database_path "$ws/db.db" \
+    --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2 &&
+  step "$ws/priors.done" $cli depth_prior_extractor --database_path "$ws/db.db" \
+    --depth_path "$ws/stereo" && touch "$ws/priors.done" &&
+  step "$ws/lidar" $cli lidar_registrator --lidar_path "$run/dataset/lidar" \
+    --output_path "$ws/lidar" --max_neighbors 4 &&
+  step "$ws/initial" $cli pose_initializer --database_path "$ws/db.db" \
+    --dataset_path "$run/dataset" --registration_path "$ws/lidar" --output_path "$ws/initial" \
+    --use_guess 0 &&
+  step "$joint" $cli joint_adjuster --database_path "$ws/db.db" --input_path "$ws/initial" \
+    --dataset_path "$run/dataset" --output_path "$joint"
+}
+# One seed of the mono street drive: the whole pipeline.
+run_drive() {
+  step "$run/dataset" $cli simulate_dataset --scene street --motion drive --mono 1 \
+    --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 \
+    --write_guess 0 --output_path "$run/dataset" &&
+  step "$joint" $cli pipeline --dataset_path "$run/dataset" --workspace_path "$ws" \
+    --Import.matcher sequential
+}
 for scene in ${SCENES:-t_specimen bridge_pier}; do
   for seed in $(seq 1 "${SEEDS:-10}"); do
     run="$work/$scene-$seed"
@@ -41,30 +67,12 @@ for scene in ${SCENES:-t_specimen bridge_pier}; do
     }
     if [ "$scene" = street_drive ]; then
       joint="$ws/sparse/joint"
-      if ! { step "$run/dataset" $cli simulate_dataset --scene street --motion drive --mono 1 \
-               --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 \
-               --write_guess 0 --output_path "$run/dataset" &&
-             step "$joint" $cli pipeline --dataset_path "$run/dataset" --workspace_path "$ws" \
-               --Import.matcher sequential; }; then
-        echo "  failed (see the log below)"; tail -5 "$run/log.txt"
-        printf '%s\t%s\tFAILED\n' "$scene" "$seed" >> "$results"
-        continue
-      fi
-    elif joint="$ws/joint" && ! { step "$run/dataset" $cli simulate_dataset --scene "$scene" --seed "$seed" \
-             --num_stations "${STATIONS:-8}" --lidar_points "${LIDAR_POINTS:-300000}" \
-             --output_path "$run/dataset" &&
-           step "$ws/stereo" $cli stereo_depth --dataset_path "$run/dataset" --output_path "$ws/stereo" &&
-           step "$ws/db.db" $cli import_dataset --dataset_path "$run/dataset" --database_path "$ws/db.db" \
-             --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2 &&
-           step "$ws/priors.done" $cli depth_prior_extractor --database_path "$ws/db.db" \
-             --depth_path "$ws/stereo" && touch "$ws/priors.done" &&
-           step "$ws/lidar" $cli lidar_registrator --lidar_path "$run/dataset/lidar" \
-             --output_path "$ws/lidar" --max_neighbors 4 &&
-           step "$ws/initial" $cli pose_initializer --database_path "$ws/db.db" \
-             --dataset_path "$run/dataset" --registration_path "$ws/lidar" --output_path "$ws/initial" \
-             --use_guess 0 &&
-           step "$ws/joint" $cli joint_adjuster --database_path "$ws/db.db" --input_path "$ws/initial" \
-             --dataset_path "$run/dataset" --output_path "$ws/joint"; }; then
+      front_and_back_end=run_drive
+    else
+      joint="$ws/joint"
+      front_and_back_end=run_stations
+    fi
+    if ! "$front_and_back_end"; then
       echo "  failed (see the log below)"; tail -5 "$run/log.txt"
       printf '%s\t%s\tFAILED\n' "$scene" "$seed" >> "$results"
       continue

@@ -10,10 +10,10 @@ drive_only = all(r[0] == 'street_drive' for r in rows)
 print('Written by `scripts/benchmark_uncertainty.sh` on %s (%d cores)' %
       (datetime.date.today().isoformat(), os.cpu_count()) + ('.' if drive_only else ':'))
 if not drive_only:
-  print('Per scene and seed, %s stations, '
-      '%s LiDAR rays per station, full-resolution images; stereo depth, COLMAP SIFT, LiDAR '
-      'registration, hand-eye initialisation without a guess, joint adjustment with default '
-      'options.\n' % (stations, points))
+    print('Per scene and seed, %s stations, '
+          '%s LiDAR rays per station, full-resolution images; stereo depth, COLMAP SIFT, LiDAR '
+          'registration, hand-eye initialisation without a guess, joint adjustment with default '
+          'options.\n' % (stations, points))
 print('Errors are the rotation vector of estimate * inverse(truth) about the camera axes [deg] and the '
       'translation error [mm]; z = error / reported sigma (report.json `covariance_deg_mm`).\n')
 if any(r[0] == 'street_drive' for r in rows):

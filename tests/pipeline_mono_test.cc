@@ -157,12 +157,12 @@ TEST(PipelineMonoTest, KittiLayoutDriveHoldsWhatItCannotSee) {
 // hand-eye on COLMAP's two-view geometry gives a coarse start (about 1 deg, the height set to 0: 25 cm
 // off) and names the axis it cannot see from motion; the landmarks on the road and the facades (E_m,
 // at the moving platform's weight 0.25) observe the rest, and the association rounds continue while
-// cam_from_lidar still moves. Measured in three runs (COLMAP's threaded SIFT makes them differ):
-// 0.042, 0.078 and 0.080 deg; 5.1, 7.5 and 10.7 mm (the goal, 0.1 deg / 2 cm, met in all
-// three; with E_m at weight 1, in three of six: 0.034-0.30 deg, 5-27 mm). The joint alone on five
+// cam_from_lidar still moves. Measured in four runs (COLMAP's threaded SIFT makes them differ):
+// 0.042, 0.078, 0.080 and 0.214 deg; 5.1, 7.5, 10.7 and 16.0 mm (the goal, 0.1 deg / 2 cm,
+// met in three of four; with E_m at weight 1, in three of six: 0.034-0.30 deg, 5-27 mm). The joint alone on five
 // initial models: 4 of 5 within 0.05 deg about the driving direction, one at 0.30 deg (its hand-eye
 // coupling through the turns alone gives 0.27: docs/mono.md). Bounds: rotation 1.7x that worst
-// case, translation about 3x the worst (14.8 mm).
+// case, translation about 3x the worst (16 mm).
 TEST(PipelineMonoTest, FortyFrameDriveCalibratesWithoutAGuess) {
   testing::ScopedTempDir dir;
   const std::string output = RunDrive(dir, 40, false);

@@ -347,11 +347,10 @@ InitialisationFacts ReadInitialisationFacts(const std::string& input_path) {
   return facts;
 }
 
-// A moving platform: rig.json's clouds are sweeps, or initialization.json (in `input_path`, if
-// given) reports a one-axis hand-eye.
-bool IsMovingPlatform(const StationDataset& dataset, const std::string& input_path) {
-  return dataset.rig.lidar_sweep.has_value() ||
-         (!input_path.empty() && ReadInitialisationFacts(input_path).one_axis);
+// A moving platform: rig.json's clouds are sweeps, or initialization.json reports a one-axis
+// hand-eye.
+bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& facts) {
+  return dataset.rig.lidar_sweep.has_value() || facts.one_axis;
 }
 
 // The -1 (automatic) options. E_m: on for a monocular rig, and for a stereo rig on a moving
@@ -371,11 +370,10 @@ bool IsMovingPlatform(const StationDataset& dataset, const std::string& input_pa
 constexpr double kMovingPlatformLandmarkWeight = 0.25;
 
 void ResolveAutomaticOptions(const StationDataset& dataset,
-                             const std::string& input_path,
+                             const InitialisationFacts& facts,
                              const colmap::Reconstruction& reconstruction,
                              JointAdjusterStepOptions* options) {
   if (options->landmark_lidar_weight >= 0) return;
-  const InitialisationFacts facts = ReadInitialisationFacts(input_path);
   const MotionAnalysis motion = AnalyseMotion(reconstruction, options->adjuster.observability);
   const bool degenerate_motion =
       facts.one_axis || (!motion.unique && dataset.rig.lidar_sweep.has_value());
@@ -404,7 +402,8 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   reconstruction.Read(paths.input_path);
   THROW_CHECK_GE(reconstruction.NumRegImages(), 2)
       << paths.input_path << " has fewer than 2 registered images";
-  ResolveAutomaticOptions(dataset, paths.input_path, reconstruction, &options);
+  const InitialisationFacts facts = ReadInitialisationFacts(paths.input_path);
+  ResolveAutomaticOptions(dataset, facts, reconstruction, &options);
   colmap::Rigid3d cam_from_lidar =
       InitialCamFromLidar(paths.cam_from_lidar_path, paths.input_path, dataset);
   const colmap::Rigid3d initial = cam_from_lidar;
@@ -429,8 +428,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                 "cam_from_lidar refined by colmap-lidar joint_adjuster (" + options.mode +
                     "); qw qx qy qz tx ty tz",
                 cam_from_lidar);
-  const std::string caveat =
-      UncertaintyCaveat(summary.motion, IsMovingPlatform(dataset, paths.input_path));
+  const std::string caveat = UncertaintyCaveat(summary.motion, IsMovingPlatform(dataset, facts));
   WriteReport(partial.Path(), options.adjuster, *loaded, initial, cam_from_lidar, summary, caveat);
   WritePlots(partial.Path(), summary);
   partial.Commit();
