@@ -4,19 +4,26 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <numeric>
 #include <sstream>
+#include <tuple>
 
 namespace colmap_lidar {
 namespace {
 constexpr double kDegToRad = M_PI / 180.0;
+// A motion translating less carries no translation direction [m].
+constexpr double kMinTranslationM = 0.1;
+constexpr int kMaxPlanarRounds = 50;
 }  // namespace
 
 bool HandEyeOptions::Check() const {
   CHECK_OPTION_GT(min_rotation_deg, 0);
   CHECK_OPTION_GT(min_axis_angle_deg, 0);
   CHECK_OPTION_GT(max_axis_residual_deg, 0);
+  CHECK_OPTION_GT(max_motion_residual_deg, 0);
   return true;
 }
 
@@ -105,7 +112,8 @@ void AddTranslationDirections(const std::vector<HandEyeMotion>& motions,
         motion.lidar_i_from_lidar_j.translation -
         cam_from_lidar.rotation.inverse() *
             ((a.toRotationMatrix() - Eigen::Matrix3d::Identity()) * cam_from_lidar.translation);
-    if (a.angle() >= options.min_rotation_deg * kDegToRad || t_a.norm() == 0 || t_b.norm() < 0.1) {
+    if (a.angle() >= options.min_rotation_deg * kDegToRad || t_a.norm() == 0 ||
+        t_b.norm() < kMinTranslationM) {
       continue;
     }
     axes->in_cam.push_back(t_a.normalized());
@@ -143,8 +151,18 @@ Eigen::Vector3d SolveTranslationAndScale(const std::vector<HandEyeMotion>& motio
         rotation * motions[k].lidar_i_from_lidar_j.translation - r_a_minus_i * fixed_part;
   }
   const Eigen::VectorXd solution = lhs.colPivHouseholderQr().solve(rhs);
-  // The mean scale; -1 when a motion's scale is not positive (an inconsistent motion).
-  result->scale = solution.tail(num_scales).minCoeff() > 0 ? solution.tail(num_scales).mean() : -1;
+  // The mean scale; -1 when a motion's scale is not positive (an inconsistent motion). Per motion,
+  // only the motions that translate by kMinTranslationM count: the scale of a standstill is noise.
+  std::vector<double> scales;
+  for (int k = 0; k < num_scales; ++k) {
+    if (!per_motion_scale ||
+        motions[k].lidar_i_from_lidar_j.translation.norm() >= kMinTranslationM) {
+      scales.push_back(solution(num_free + k));
+    }
+  }
+  const bool positive = !scales.empty() && *std::min_element(scales.begin(), scales.end()) > 0;
+  result->scale =
+      positive ? std::accumulate(scales.begin(), scales.end(), 0.0) / scales.size() : -1;
   result->translation_rms_m = std::sqrt((lhs * solution - rhs).squaredNorm() / rhs.size());
   return basis.leftCols(num_free) * solution.head(num_free) + fixed_part;
 }
@@ -218,18 +236,24 @@ HandEyeResult SimilarityHandEye(const std::vector<HandEyeMotion>& motions,
       return result;
     }
   }
-  // Planar: the direction pairs depend on t_X; a few rounds converge (the correction is small).
+  // Planar: the direction pairs depend on t_X; rounds until the rotation settles (the correction is
+  // small: three rounds left 3e-5 rad).
   const Eigen::Vector3d axis = result.unobservable_axis_in_cam;
   const RotationAxes rotating = axes;
-  for (int round = 0; round < (planar ? 3 : 1); ++round) {
+  for (int round = 0; round < (planar ? kMaxPlanarRounds : 1); ++round) {
     axes = rotating;
     if (planar) AddTranslationDirections(motions, options, result.cam_from_lidar, &axes);
-    const Eigen::Matrix3d rotation = WeightedKabsch(axes);
-    result.rotation_rms_deg = AxisFitRmsDeg(axes, rotation);
-    result.cam_from_lidar = colmap::Rigid3d(
-        Eigen::Quaterniond(rotation),
-        SolveTranslationAndScale(
-            motions, rotation, axis, axis_translation_fallback, per_motion_scale, &result));
+    const Eigen::Quaterniond rotation(WeightedKabsch(axes));
+    const double change = rotation.angularDistance(result.cam_from_lidar.rotation);
+    result.rotation_rms_deg = AxisFitRmsDeg(axes, rotation.toRotationMatrix());
+    result.cam_from_lidar = colmap::Rigid3d(rotation,
+                                            SolveTranslationAndScale(motions,
+                                                                     rotation.toRotationMatrix(),
+                                                                     axis,
+                                                                     axis_translation_fallback,
+                                                                     per_motion_scale,
+                                                                     &result));
+    if (round > 0 && change < 1e-12) break;
   }
   // Planar with translation directions only: the forward translation is confounded with the motions'
   // own scales (a car drives mostly straight), so no component of t_X is trusted: all from the fallback.
@@ -241,20 +265,88 @@ HandEyeResult SimilarityHandEye(const std::vector<HandEyeMotion>& motions,
   return result;
 }
 
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) / kDegToRad;
+}
+
+// The angle [deg] by which `motion` contradicts `cam_from_lidar`: between the camera's rotation axis
+// and the rotated LiDAR axis (if it rotates enough), and between the camera's translation direction
+// and the one the LiDAR motion predicts, s a = R_X t_B - (R_A - I) t_X (if it translates enough); the
+// larger of the two, 0 when it says neither.
+double MotionResidualDeg(const HandEyeMotion& motion,
+                         const HandEyeOptions& options,
+                         const colmap::Rigid3d& cam_from_lidar) {
+  const Eigen::AngleAxisd a(motion.cam_i_from_cam_j.rotation);
+  const Eigen::AngleAxisd b(motion.lidar_i_from_lidar_j.rotation);
+  double residual = 0;
+  if (a.angle() >= options.min_rotation_deg * kDegToRad) {
+    residual = AngleDeg(a.axis(), cam_from_lidar.rotation * b.axis());
+  }
+  const Eigen::Vector3d& t_a = motion.cam_i_from_cam_j.translation;
+  const Eigen::Vector3d& t_b = motion.lidar_i_from_lidar_j.translation;
+  if (t_b.norm() >= kMinTranslationM && t_a.norm() > 0) {
+    const Eigen::Vector3d predicted =
+        cam_from_lidar.rotation * t_b -
+        (a.toRotationMatrix() - Eigen::Matrix3d::Identity()) * cam_from_lidar.translation;
+    residual = std::max(residual, AngleDeg(t_a, predicted));
+  }
+  return residual;
+}
+
+// SimilarityHandEye, leaving out the motion that contradicts the fit most (MotionResidualDeg above
+// options.max_motion_residual_deg) and fitting again, until none does. A wrong two-view geometry (a
+// flipped translation direction of forward motion) otherwise gives a negative scale or a wrong axis.
+// Fails (rotation_unique false) when more than half of the motions would be left out.
+HandEyeResult FitWithoutContradictingMotions(std::vector<HandEyeMotion> motions,
+                                             const HandEyeOptions& options,
+                                             const Eigen::Vector3d& axis_translation_fallback,
+                                             bool per_motion_scale,
+                                             bool planar) {
+  const size_t num_given = motions.size();
+  for (int left_out = 0;; ++left_out) {
+    HandEyeResult result =
+        SimilarityHandEye(motions, options, axis_translation_fallback, per_motion_scale, planar);
+    result.num_contradicting = left_out;
+    if (!result.message.empty()) return result;  // degenerate
+    size_t worst = 0;
+    double worst_deg = 0;
+    for (size_t k = 0; k < motions.size(); ++k) {
+      const double residual = MotionResidualDeg(motions[k], options, result.cam_from_lidar);
+      if (residual > worst_deg) std::tie(worst, worst_deg) = std::make_pair(k, residual);
+    }
+    if (worst_deg <= options.max_motion_residual_deg) return result;
+    if (2 * static_cast<size_t>(left_out + 1) > num_given) {
+      result.rotation_unique = result.unique = false;
+      return result;
+    }
+    motions.erase(motions.begin() + worst);
+  }
+}
+
 std::string SimilarityMessage(const HandEyeResult& result,
                               size_t num_used,
                               size_t num_given,
                               bool planar,
-                              bool per_motion_scale) {
+                              bool per_motion_scale,
+                              const HandEyeOptions& options) {
   std::ostringstream message;
-  message << std::fixed << std::setprecision(1) << "similarity hand-eye from " << num_used << " of "
-          << num_given << " motion pairs (" << result.num_motions << " rotating, axes span "
-          << result.max_axis_angle_deg << " deg): scale " << std::setprecision(4) << result.scale
-          << ", axis fit " << std::setprecision(3) << result.rotation_rms_deg
-          << " deg rms, translation residual " << 1000 * result.translation_rms_m << " mm rms";
+  message << std::fixed << std::setprecision(1) << "similarity hand-eye from "
+          << num_used - result.num_contradicting << " of " << num_given << " motion pairs (";
+  if (result.num_contradicting > 0) {
+    message << result.num_contradicting << " contradicting the fit by more than "
+            << options.max_motion_residual_deg << " deg left out, ";
+  }
+  message << result.num_motions << " rotating, axes span " << result.max_axis_angle_deg
+          << " deg): scale " << std::setprecision(4) << result.scale << ", axis fit "
+          << std::setprecision(3) << result.rotation_rms_deg << " deg rms, translation residual "
+          << 1000 * result.translation_rms_m << " mm rms";
   if (!result.rotation_unique) {
     message << "; inconsistent motions ("
-            << (result.scale > 0 ? "the axes do not fit one rotation" : "no positive scale") << ")";
+            << (result.num_contradicting > 0 && 2 * result.num_contradicting + 2 > num_used
+                    ? "more than half contradict the fit"
+                : result.scale > 0 ? "the axes do not fit one rotation"
+                                   : "no positive scale")
+            << ")";
   } else if (planar) {
     message << "; rotation about one axis only (camera " << std::setprecision(2)
             << result.unobservable_axis_in_cam.transpose() << "): the translation "
@@ -291,15 +383,16 @@ HandEyeResult SolveSimilarityHandEye(const std::vector<HandEyeMotion>& all_motio
   // a car's small turns).
   bool planar =
       axes.motions.size() < 2 || MaxAngleBetweenLinesDeg(axes.in_cam) < options.min_axis_angle_deg;
-  HandEyeResult result =
-      SimilarityHandEye(motions, options, axis_translation_fallback, per_motion_scale, planar);
+  HandEyeResult result = FitWithoutContradictingMotions(
+      motions, options, axis_translation_fallback, per_motion_scale, planar);
   if (!planar && !result.rotation_unique) {
     planar = true;
-    result = SimilarityHandEye(motions, options, axis_translation_fallback, per_motion_scale, true);
+    result = FitWithoutContradictingMotions(
+        motions, options, axis_translation_fallback, per_motion_scale, true);
   }
   if (result.message.empty()) {
-    result.message =
-        SimilarityMessage(result, motions.size(), all_motions.size(), planar, per_motion_scale);
+    result.message = SimilarityMessage(
+        result, motions.size(), all_motions.size(), planar, per_motion_scale, options);
   }
   return result;
 }

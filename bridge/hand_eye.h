@@ -27,6 +27,10 @@ struct HandEyeOptions {
   double min_axis_angle_deg = 10.0;
   // consistency of A and B rotation angles
   double max_axis_residual_deg = 2.0;
+  // Similarity variant: a motion whose rotation axis, or translation direction, contradicts the fit
+  // by more is left out, worst first, and the fit repeated (a wrong two-view geometry along a drive
+  // otherwise spoils the whole fit); the fit fails when more than half would go.
+  double max_motion_residual_deg = 10.0;
 
   bool Check() const;
 };
@@ -43,6 +47,7 @@ struct HandEyeResult {
   std::string message;  // why not unique, or a summary
   colmap::Rigid3d cam_from_lidar;
   int num_motions = 0;            // used
+  int num_contradicting = 0;      // similarity variant: left out as contradicting the fit
   double max_axis_angle_deg = 0;  // spread of the rotation axes
   double rotation_rms_deg = 0;    // residual of the axis fit
   double translation_rms_m = 0;   // residual of the linear system

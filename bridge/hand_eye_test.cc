@@ -116,6 +116,48 @@ TEST(SimilarityHandEye, PlanarDrivingRecoversRotationAndNamesTheAxis) {
   EXPECT_NEAR(result.cam_from_lidar.translation.y(), fallback.y(), 1e-9);
 }
 
+// A drive's motions from two-view geometry: unit translation directions, one scale each.
+std::vector<HandEyeMotion> DriveDirections() {
+  std::vector<HandEyeMotion> motions = Conjugate({Motion(12, {0, 1, 0}, {0.3, 0, 4.0}),
+                                                  Motion(-20, {0, 1, 0}, {-0.5, 0, 3.5}),
+                                                  Motion(0, {0, 1, 0}, {0.02, 0, 5.0}),
+                                                  Motion(0.5, {0, 1, 0}, {0.1, 0, 4.5}),
+                                                  Motion(2, {0, 1, 0}, {-0.2, 0, 3.0}),
+                                                  Motion(-1, {0, 1, 0}, {0.4, 0, 2.5}),
+                                                  Motion(7, {0, 1, 0}, {0.6, 0, 3.8})});
+  for (HandEyeMotion& motion : motions) motion.cam_i_from_cam_j.translation.normalize();
+  return motions;
+}
+
+// Two-view geometry along a drive is sometimes wrong: a flipped translation direction, a turn about a
+// tilted axis. Each is left out (and said so) instead of spoiling the fit (before: "no positive
+// scale"); a standstill's scale is noise and does not count.
+TEST(SimilarityHandEye, LeavesOutMotionsThatContradictTheFit) {
+  std::vector<HandEyeMotion> motions = DriveDirections();
+  motions[2].cam_i_from_cam_j.translation *= -1;
+  motions[6].cam_i_from_cam_j.rotation = Eigen::Quaterniond(
+      Eigen::AngleAxisd(7 * M_PI / 180, Eigen::Vector3d(0.27, 1, 0).normalized()));
+  HandEyeMotion standstill = Conjugate({Motion(0.2, {0, 1, 0}, {0.004, 0, 0.01})}).front();
+  standstill.cam_i_from_cam_j.translation = -standstill.cam_i_from_cam_j.translation.normalized();
+  motions.push_back(standstill);
+  const HandEyeResult result =
+      SolveSimilarityHandEye(motions, HandEyeOptions(), Eigen::Vector3d::Zero(), true);
+  ASSERT_TRUE(result.rotation_unique) << result.message;
+  EXPECT_EQ(result.num_contradicting, 2);
+  EXPECT_NE(result.message.find("2 contradicting the fit"), std::string::npos) << result.message;
+  EXPECT_LT(result.cam_from_lidar.rotation.angularDistance(kCamFromLidar.rotation), 1e-6);
+  EXPECT_GT(result.scale, 0);
+
+  // When most motions contradict each other, there is nothing to trust.
+  std::vector<HandEyeMotion> flipped = DriveDirections();
+  for (size_t k = 0; k < flipped.size(); k += 2) flipped[k].cam_i_from_cam_j.translation *= -1;
+  const HandEyeResult inconsistent =
+      SolveSimilarityHandEye(flipped, HandEyeOptions(), Eigen::Vector3d::Zero(), true);
+  EXPECT_FALSE(inconsistent.rotation_unique);
+  EXPECT_NE(inconsistent.message.find("inconsistent motions"), std::string::npos)
+      << inconsistent.message;
+}
+
 TEST(SimilarityHandEye, StraightDrivingIsDegenerate) {
   const HandEyeResult result = SolveSimilarityHandEye(
       UpToScale(Conjugate({Motion(0, {0, 1, 0}, {0, 0, 4.0}), Motion(0, {0, 1, 0}, {0, 0, 5.0})}),

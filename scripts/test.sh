@@ -17,6 +17,14 @@ elif [[ $# -gt 0 ]]; then
   exit 2
 fi
 bash scripts/setup.sh
+# The tests write their datasets under the temporary directory (a 40-frame drive takes about 350 MB
+# at its peak): a full disk shows up as a failed image or cloud write, so say how much there is.
+readonly kTmpDir="${TMPDIR:-/tmp}"
+readonly kFreeGb=$(df -P -BG "$kTmpDir" | awk 'NR == 2 { sub("G", "", $4); print $4 }')
+echo "[test] $kFreeGb GB free in $kTmpDir"
+if [[ "$kFreeGb" -lt 5 ]]; then
+  echo "[test] warning: less than 5 GB free in $kTmpDir; the slow tests may fail to write" >&2
+fi
 readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
 readonly kBuildDir="${BUILD_DIR:-build}"
 echo "[test] layering check"

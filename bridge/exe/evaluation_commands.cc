@@ -77,6 +77,22 @@ int RunEvaluateModel(int argc, char** argv) {
   return EXIT_SUCCESS;
 }
 
+namespace {
+
+// The console summary of a model evaluation with evaluated points.
+void PrintModelEvaluation(const ModelEvaluation& result) {
+  std::cout << std::fixed << std::setprecision(2) << "evaluate_model: mean " << result.mean * 1000
+            << " mm, median " << result.median * 1000 << " mm, RMSE " << result.rmse * 1000
+            << " mm, p95 " << result.p95 * 1000 << " mm over " << result.num_evaluated
+            << " points; density " << result.density_points_per_cm2 << " points/cm^2" << std::endl;
+  for (const auto& at : result.at_thresholds) {
+    std::cout << "  at " << MillimetreLabel(at.threshold) << ": completeness " << at.completeness
+              << ", precision " << at.precision << ", F " << at.f_score << std::endl;
+  }
+}
+
+}  // namespace
+
 void RunEvaluateModelStep(const std::string& model_path,
                           const std::string& ground_truth_path,
                           const std::string& truth_from_model_path,
@@ -107,13 +123,17 @@ void RunEvaluateModelStep(const std::string& model_path,
   metrics["icp_rotation_deg"] =
       Eigen::AngleAxisd(result.truth_from_model.linear()).angle() * 180 / M_PI;
   metrics["icp_translation_m"] = result.truth_from_model.translation().norm();
-  metrics["mean_m"] = result.mean;
-  metrics["median_m"] = result.median;
-  metrics["rmse_m"] = result.rmse;
-  metrics["p90_m"] = result.p90;
-  metrics["p95_m"] = result.p95;
-  metrics["p99_m"] = result.p99;
-  metrics["max_m"] = result.max;
+  // No evaluated point: the statistics are null, never zeros that read as a perfect model.
+  const bool measured = result.num_evaluated > 0;
+  for (const auto& [key, value] : {std::pair{"mean_m", result.mean},
+                                   {"median_m", result.median},
+                                   {"rmse_m", result.rmse},
+                                   {"p90_m", result.p90},
+                                   {"p95_m", result.p95},
+                                   {"p99_m", result.p99},
+                                   {"max_m", result.max}}) {
+    metrics[key] = measured ? nlohmann::json(value) : nlohmann::json();
+  }
   for (const auto& at : result.at_thresholds) {
     const std::string label = MillimetreLabel(at.threshold);
     metrics["completeness_" + label] = at.completeness;
@@ -139,13 +159,12 @@ void RunEvaluateModelStep(const std::string& model_path,
   }
   WritePointCloud((fs::path(output_path) / "error_colored.ply").string(), coloured);
 
-  std::cout << std::fixed << std::setprecision(2) << "evaluate_model: mean " << result.mean * 1000
-            << " mm, median " << result.median * 1000 << " mm, RMSE " << result.rmse * 1000
-            << " mm, p95 " << result.p95 * 1000 << " mm over " << result.num_evaluated
-            << " points; density " << result.density_points_per_cm2 << " points/cm^2" << std::endl;
-  for (const auto& at : result.at_thresholds) {
-    std::cout << "  at " << MillimetreLabel(at.threshold) << ": completeness " << at.completeness
-              << ", precision " << at.precision << ", F " << at.f_score << std::endl;
+  if (measured) {
+    PrintModelEvaluation(result);
+  } else {
+    std::cout << "evaluate_model: no model point lies within " << options.crop_distance_m
+              << " m of the true surface: nothing to measure (is the model of this structure?)"
+              << std::endl;
   }
   std::cout << "evaluate_model: wrote " << output_path
             << "/{metrics.json, error_histogram.png, error_colored.ply}" << std::endl;

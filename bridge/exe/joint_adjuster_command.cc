@@ -380,9 +380,11 @@ void ResolveAutomaticOptions(const StationDataset& dataset,
   options->adjuster.landmark_lidar_weight =
       degenerate_motion ? kMovingPlatformLandmarkWeight : (dataset.rig.IsStereo() ? 0.0 : 1.0);
   if (degenerate_motion) {
+    std::ostringstream weight;  // std::cout may hold a fixed precision of 1
+    weight << kMovingPlatformLandmarkWeight;
     std::cout << "A moving platform whose stations do not rotate about two axes (" << motion.verdict
               << "): the landmark-to-LiDAR-plane term is on (--landmark_lidar_weight "
-              << kMovingPlatformLandmarkWeight << ")" << std::endl;
+              << weight.str() << ")" << std::endl;
   }
 }
 
