@@ -10,6 +10,7 @@
 #include <limits>
 #include <numeric>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 namespace colmap_lidar {
@@ -146,27 +147,82 @@ void RegisterPairs(const std::vector<const StationCloud*>& stations,
   }
 }
 
-// Edges that break 3-cycles and close none move to the refused list, with the reason.
-void RemoveInconsistentEdges(const CycleConsistencyOptions& options, LidarGraph* graph) {
+std::vector<RelativePose> RelativePoses(const std::vector<LidarEdge>& edges) {
   std::vector<RelativePose> poses;
-  for (const LidarEdge& e : graph->edges) {
+  for (const LidarEdge& e : edges) {
     poses.push_back({e.target, e.source, e.target_from_source, e.Weight()});
   }
-  const CycleCheck check = CheckThreeCycles(poses, options);
-  graph->num_cycles = check.num_cycles;
-  graph->worst_cycle_translation_m = check.worst_translation_m;
-  graph->worst_cycle_rotation_deg = check.worst_rotation_deg;
+  return poses;
+}
+
+// The edges flagged in `removed` move to the refused list with their `reason`.
+void RefuseEdges(const std::vector<bool>& removed,
+                 const std::vector<std::string>& reason,
+                 LidarGraph* graph) {
   std::vector<LidarEdge> kept;
   for (size_t e = 0; e < graph->edges.size(); ++e) {
-    if (!check.removed[e]) {
+    if (!removed[e]) {
       kept.push_back(graph->edges[e]);
       continue;
     }
     graph->edges[e].registration.accepted = false;
-    graph->edges[e].registration.reason = check.reason[e];
+    graph->edges[e].registration.reason = reason[e];
     graph->refused.push_back(graph->edges[e]);
   }
   graph->edges = std::move(kept);
+}
+
+// Edge e of `graph`, refused by `speed`, registered again from the predicted translation: kept (and
+// un-flagged) when ICP from there passes the gates at the neighbours' speed.
+void RegisterAtPredictedSpeed(const std::vector<const StationCloud*>& stations,
+                              const std::vector<double>& frame_indices,
+                              const LidarGraphOptions& options,
+                              size_t e,
+                              SpeedCheck* speed,
+                              LidarGraph* graph) {
+  LidarEdge& edge = graph->edges[e];
+  Eigen::Isometry3d guess = edge.target_from_source;
+  guess.translation() = speed->predicted_translation[e];
+  const PairRegistration again =
+      RegisterFromGuess(*stations[edge.source], *stations[edge.target], guess, options.pair);
+  const double span = std::abs(frame_indices[edge.source] - frame_indices[edge.target]);
+  const double predicted = guess.translation().norm() / span;
+  const double found = again.target_from_source.translation().norm() / span;
+  if (again.accepted && SpeedAgrees(found, predicted, options.speed)) {
+    edge.registration = again;
+    edge.target_from_source = again.target_from_source;
+    speed->removed[e] = false;
+    ++graph->num_speed_reregistered;
+    return;
+  }
+  std::ostringstream reason;
+  reason << "; ICP from the predicted " << predicted << " m per frame: "
+         << (again.accepted ? "slid to " + std::to_string(found) + " m per frame" : again.reason);
+  speed->reason[e] += reason.str();
+}
+
+// Sweeps: each edge whose speed contradicts its neighbours' (CheckSpeedConsistency) is registered
+// again by ICP from the neighbours' velocity (its own rotation kept) and kept if that passes the gates
+// at their speed, else refused. Then edges that break 3-cycles and close none are refused.
+void RemoveInconsistentEdges(const std::vector<const StationCloud*>& stations,
+                             const LidarGraphOptions& options,
+                             const std::vector<double>& frame_indices,
+                             LidarGraph* graph) {
+  if (!frame_indices.empty()) {
+    SpeedCheck speed =
+        CheckSpeedConsistency(RelativePoses(graph->edges), frame_indices, options.speed);
+    for (size_t e = 0; e < graph->edges.size(); ++e) {
+      if (speed.removed[e])
+        RegisterAtPredictedSpeed(stations, frame_indices, options, e, &speed, graph);
+    }
+    RefuseEdges(speed.removed, speed.reason, graph);
+  }
+  if (!options.check_cycles) return;
+  const CycleCheck check = CheckThreeCycles(RelativePoses(graph->edges), options.cycles);
+  graph->num_cycles = check.num_cycles;
+  graph->worst_cycle_translation_m = check.worst_translation_m;
+  graph->worst_cycle_rotation_deg = check.worst_rotation_deg;
+  RefuseEdges(check.removed, check.reason, graph);
 }
 
 // Spanning tree and refinement over the accepted edges (lidar/pose_graph.h).
@@ -198,12 +254,13 @@ double LidarEdge::Weight() const {
 bool LidarGraphOptions::Check() const {
   LIDAR_CHECK_OPTION_GT(robust_loss_sigmas, 0);
   LIDAR_CHECK_OPTION_GE(max_bridge_rounds, 0);
-  return pair.Check() && cycles.Check();
+  return pair.Check() && cycles.Check() && speed.Check();
 }
 
 LidarGraph RegisterAllStations(const std::vector<const StationCloud*>& stations,
                                const LidarGraphOptions& options,
-                               const std::function<void(size_t, size_t)>& progress) {
+                               const std::function<void(size_t, size_t)>& progress,
+                               const std::vector<double>& frame_indices) {
   ThrowUnlessValid(options, "LidarGraphOptions");
   const size_t n = stations.size();
   if (n == 0) throw std::invalid_argument("RegisterAllStations: no stations");
@@ -214,7 +271,7 @@ LidarGraph RegisterAllStations(const std::vector<const StationCloud*>& stations,
       CandidatePairs(histograms, options.max_neighbors, options.sequential);
   std::set<StationPair> tried(pairs.begin(), pairs.end());
   RegisterPairs(stations, pairs, options, progress, 0, &graph);
-  if (options.check_cycles) RemoveInconsistentEdges(options.cycles, &graph);
+  RemoveInconsistentEdges(stations, options, frame_indices, &graph);
   for (int round = 0; round < options.max_bridge_rounds; ++round) {
     const std::vector<StationPair> bridges =
         BridgePairs(histograms, graph.edges, options.bridge_neighbors, tried);
@@ -222,7 +279,7 @@ LidarGraph RegisterAllStations(const std::vector<const StationCloud*>& stations,
     tried.insert(bridges.begin(), bridges.end());
     graph.num_bridge_pairs += bridges.size();
     RegisterPairs(stations, bridges, options, progress, tried.size() - bridges.size(), &graph);
-    if (options.check_cycles) RemoveInconsistentEdges(options.cycles, &graph);
+    RemoveInconsistentEdges(stations, options, frame_indices, &graph);
   }
   SolveLidarPoseGraph(n, options, &graph);
   return graph;

@@ -1,12 +1,14 @@
 // All-pairs LiDAR registration and the LiDAR pose graph (A_l of Zhen et al. 2019): register station
-// pairs, accept edges, remove edges inconsistent around 3-cycles, take a maximum spanning tree for initial poses,
-// refine all poses over all accepted edges with Ceres (information-weighted, robust), and report the
-// connected components. Station poses are world_from_lidar with the first station
-// of each component as its world (identity).
+// pairs, accept edges, for sweeps register edges whose speed contradicts their neighbours' again from
+// the neighbours' velocity (or refuse them), remove edges inconsistent around 3-cycles, take a maximum
+// spanning tree for initial poses, refine all poses over all accepted edges with Ceres
+// (information-weighted, robust), and report the connected components. Station poses are
+// world_from_lidar with the first station of each component as its world (identity).
 #pragma once
 
 #include "lidar/cycle_consistency.h"
 #include "lidar/pair_registration.h"
+#include "lidar/speed_consistency.h"
 #include "lidar/station_cloud.h"
 
 #include <Eigen/Geometry>
@@ -44,6 +46,8 @@ struct LidarGraphOptions {
   // Remove edges inconsistent around 3-cycles before the spanning tree (CheckThreeCycles).
   bool check_cycles = true;
   CycleConsistencyOptions cycles;
+  // Sweeps (frame indices given): first remove edges whose speed contradicts the edges around them.
+  SpeedConsistencyOptions speed;
   // pose-graph refinement over all accepted edges
   bool refine = true;
   // Huber loss of the refinement, on residuals whitened by each edge's information (in sigmas).
@@ -59,6 +63,8 @@ struct LidarGraph {
   std::vector<int> component;  // per station, 0-based; component 0 holds station 0
   int num_components = 0;
   size_t num_bridge_pairs = 0;  // pairs tried to join components (LidarGraphOptions)
+  // Sweeps: edges registered again from the neighbours' velocity (LidarGraphOptions::speed), kept.
+  size_t num_speed_reregistered = 0;
   double refinement_initial_cost = 0, refinement_final_cost = 0;
   // 3-cycles of the registered edges, and the worst loop error among those left after the check.
   size_t num_cycles = 0;
@@ -66,8 +72,11 @@ struct LidarGraph {
 };
 
 // Progress: called after each pair with (pairs done, pairs total).
+// `frame_indices`: for sweeps of a moving platform, each station's frame (time order, in frame
+// periods), which turns on the speed check; empty for stations.
 LidarGraph RegisterAllStations(const std::vector<const StationCloud*>& stations,
                                const LidarGraphOptions& options,
-                               const std::function<void(size_t, size_t)>& progress = nullptr);
+                               const std::function<void(size_t, size_t)>& progress = nullptr,
+                               const std::vector<double>& frame_indices = {});
 
 }  // namespace colmap_lidar

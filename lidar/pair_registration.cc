@@ -171,6 +171,23 @@ std::vector<Hypothesis> BscHypotheses(const StationCloud& source,
   return hypotheses;
 }
 
+// The alignment, fit and constraint analysis of a final ICP.
+void TakeIcpResult(const IcpResult& icp, PairRegistration* result) {
+  result->target_from_source = icp.target_from_source;
+  result->overlap = icp.overlap_ratio;
+  result->rmse = icp.rmse;
+  result->converged = icp.converged;
+  result->hessian = icp.hessian;
+  result->constraints =
+      icp.lever_arm_m > 0 ? AnalyseConstraints(icp.hessian, icp.lever_arm_m) : ConstraintAnalysis();
+}
+
+// The pair's expected ICP RMSE from the clouds' own plane noise [m].
+double PairNoiseRms(const StationCloud& source, const StationCloud& target) {
+  return std::sqrt(0.5 * (source.plane_noise_rms * source.plane_noise_rms +
+                          target.plane_noise_rms * target.plane_noise_rms));
+}
+
 // The gates, in order; the first that fails names the reason.
 void Judge(const PairRegistrationOptions& options, PairRegistration* result) {
   std::ostringstream reason;
@@ -276,15 +293,9 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
         source.cloud, target.cloud, *target.tree, h.target_from_source, options.icp);
     if (have_candidate && fine.overlap_ratio <= result.overlap) continue;
     have_candidate = true;
-    result.target_from_source = fine.target_from_source;
+    TakeIcpResult(fine, &result);
     result.num_inliers = h.inliers.size();
     result.from_identity = h.inliers.empty();
-    result.overlap = fine.overlap_ratio;
-    result.rmse = fine.rmse;
-    result.converged = fine.converged;
-    result.hessian = fine.hessian;
-    result.constraints = fine.lever_arm_m > 0 ? AnalyseConstraints(fine.hessian, fine.lever_arm_m)
-                                              : ConstraintAnalysis();
   }
   if (result.from_identity) {
     // The BSC matches that agree with the alignment ICP found from the identity.
@@ -293,12 +304,26 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
         .Inliers(result.target_from_source, &agreeing);
     result.num_inliers = agreeing.size();
   }
-  result.noise_rms = std::sqrt(0.5 * (source.plane_noise_rms * source.plane_noise_rms +
-                                      target.plane_noise_rms * target.plane_noise_rms));
+  result.noise_rms = PairNoiseRms(source, target);
   Judge(options, &result);
   if (!result.accepted && result.from_identity && !bsc_reason.empty()) {
     result.reason = bsc_reason + "; from the identity: " + result.reason;
   }
+  return result;
+}
+
+PairRegistration RegisterFromGuess(const StationCloud& source,
+                                   const StationCloud& target,
+                                   const Eigen::Isometry3d& target_from_source_guess,
+                                   const PairRegistrationOptions& options) {
+  ThrowUnlessValid(options, "PairRegistrationOptions");
+  PairRegistration result;
+  TakeIcpResult(
+      PointToPlaneIcp(
+          source.cloud, target.cloud, *target.tree, target_from_source_guess, options.icp),
+      &result);
+  result.noise_rms = PairNoiseRms(source, target);
+  Judge(options, &result);
   return result;
 }
 

@@ -85,4 +85,11 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
                                        const StationCloud& target,
                                        const PairRegistrationOptions& options);
 
+// Point-to-plane ICP from `target_from_source_guess` alone (e.g. a constant-velocity prediction for
+// sweeps), judged by the same gates.
+PairRegistration RegisterFromGuess(const StationCloud& source,
+                                   const StationCloud& target,
+                                   const Eigen::Isometry3d& target_from_source_guess,
+                                   const PairRegistrationOptions& options);
+
 }  // namespace colmap_lidar

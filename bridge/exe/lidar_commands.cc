@@ -76,9 +76,9 @@ std::string Summary(const std::vector<std::string>& names,
     }
     summary << "\n";
   }
-  summary << "three_cycles " << graph.num_cycles << "\nworst_cycle_translation_m "
-          << graph.worst_cycle_translation_m << "\nworst_cycle_rotation_deg "
-          << graph.worst_cycle_rotation_deg << "\n";
+  summary << "speed_reregistered " << graph.num_speed_reregistered << "\nthree_cycles "
+          << graph.num_cycles << "\nworst_cycle_translation_m " << graph.worst_cycle_translation_m
+          << "\nworst_cycle_rotation_deg " << graph.worst_cycle_rotation_deg << "\n";
   summary << "pose_graph_cost_initial " << graph.refinement_initial_cost
           << "\npose_graph_cost_final " << graph.refinement_final_cost << "\nseconds " << seconds
           << "\n";
@@ -148,6 +148,10 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("max_cycle_translation_m", &options->graph.cycles.max_translation_m);
   add.Add("max_cycle_rotation_deg", &options->graph.cycles.max_rotation_deg);
   add.Add("robust_loss_sigmas", &options->graph.robust_loss_sigmas);
+  add.Add("max_speed_deviation",
+          &options->graph.speed.max_relative_deviation,
+          "sweeps (deskew_sweeps or sequential): an edge whose speed differs from the edges' "
+          "around it by more than this fraction of theirs is refused");
   add.Add("deskew_sweeps",
           &options->deskew_sweeps,
           "sweeps of a moving platform: de-skew them with the registered motion, register again");
@@ -174,6 +178,7 @@ LidarGraph RegisterClouds(const std::vector<fs::path>& files,
                           const LidarRegistratorStepOptions& options,
                           const std::vector<SweepMotion>* sweep_motions,
                           const std::string& deskewed_path,
+                          const std::vector<double>& frame_indices,
                           const std::chrono::steady_clock::time_point& start) {
   std::vector<std::unique_ptr<StationCloud>> stations;
   for (size_t i = 0; i < files.size(); ++i) {
@@ -195,13 +200,14 @@ LidarGraph RegisterClouds(const std::vector<fs::path>& files,
   }
   std::vector<const StationCloud*> pointers;
   for (const auto& s : stations) pointers.push_back(s.get());
-  return RegisterAllStations(pointers, options.graph, [&](size_t done, size_t total) {
+  const auto progress = [&](size_t done, size_t total) {
     if (done % 10 == 0 || done == total) {
       std::cout << "lidar_registrator: registered " << done << "/" << total << " pairs ["
                 << std::fixed << std::setprecision(1) << SecondsSince(start) << " s]"
                 << std::defaultfloat << std::setprecision(6) << std::endl;
     }
-  });
+  };
+  return RegisterAllStations(pointers, options.graph, progress, frame_indices);
 }
 
 // The frame index of each station: its name when every name is a number (KITTI's %010d, possibly
@@ -284,14 +290,18 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
   fs::remove_all(deskewed_path);
   fs::remove_all(static_path);  // with moving_points.ply: no stale output of an earlier run
   fs::remove(fs::path(output_path) / "moving_points.ply");
-  LidarGraph graph = RegisterClouds(files, options, nullptr, "", start);
+  // Sweeps of a moving platform: their frames in time order turn on the speed check.
+  const std::vector<double> frames = options.deskew_sweeps || options.graph.sequential > 0
+                                         ? FrameIndices(names)
+                                         : std::vector<double>();
+  LidarGraph graph = RegisterClouds(files, options, nullptr, "", frames, start);
   if (options.deskew_sweeps) {
     std::cout << "lidar_registrator: de-skewing every sweep with the registered motion and "
                  "registering again"
               << std::endl;
     const std::vector<SweepMotion> motions = SweepMotions(names, graph);
     fs::create_directories(deskewed_path);
-    graph = RegisterClouds(files, options, &motions, deskewed_path.string(), start);
+    graph = RegisterClouds(files, options, &motions, deskewed_path.string(), frames, start);
   }
 
   fs::create_directories(output_path);
