@@ -399,8 +399,8 @@ std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform
                                ? DescribeAxis(motion.common_axis_in_cam)
                                : std::string("no turn of 2 deg");
   return "not validated for a moving platform turning about one axis (" + axis +
-         "): on simulated 40-frame street drives the errors reached 4-8 of these sigmas (the "
-         "height, the rotation about the driving direction); read them as lower bounds";
+         "): on simulated 40-frame street drives the errors reached 5 of these sigmas (the "
+         "rotation about the driving direction); read them as lower bounds";
 }
 
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(
