@@ -323,6 +323,13 @@ void WriteRigAndLidarFrames(const StationDataset& dataset,
   }
 }
 
+// False for a database file without any table: what an import killed while copying into a new
+// database leaves (SQLite rolls the copy back to the empty file). It holds nothing to keep, so the
+// import treats it as new; any other file must be a COLMAP database.
+bool HoldsTables(const std::string& path) {
+  return SqliteConnection(path, SqliteConnection::Mode::kReadOnly, 1000).HasTables();
+}
+
 // " (... only N KiB free ...)" when the disk of `path` is (nearly) full, else "": COLMAP reports a
 // full disk as "SQL logic error".
 std::string DiskFullHint(const std::string& path) {
@@ -392,7 +399,7 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
     }
   };
   remove_partial();
-  if (fs::exists(database_path)) {
+  if (fs::exists(database_path) && HoldsTables(database_path)) {
     // Rejects a non-COLMAP file before anything is written; the copy is a consistent snapshot.
     { ExtensionDatabase check(database_path, ExtensionDatabase::Mode::kReadOnly); }
     CopySqliteDatabase(database_path, partial);

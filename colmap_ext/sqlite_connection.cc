@@ -65,6 +65,11 @@ bool SqliteConnection::TableExists(const std::string& table) const {
   return stmt.Step();
 }
 
+bool SqliteConnection::HasTables() const {
+  SqliteStatement stmt(*this, "SELECT 1 FROM sqlite_master WHERE type='table' LIMIT 1");
+  return stmt.Step();
+}
+
 SqliteStatement::SqliteStatement(const SqliteConnection& connection, const std::string& sql)
     : connection_(connection) {
   connection_.Check(sqlite3_prepare_v2(connection_.Handle(), sql.c_str(), -1, &stmt_, nullptr),

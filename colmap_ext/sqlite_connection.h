@@ -56,6 +56,8 @@ class SqliteConnection {
 
   void Execute(const std::string& sql) const;
   bool TableExists(const std::string& table) const;
+  // Whether the database holds any table (an empty file holds none).
+  bool HasTables() const;
   // Throws std::runtime_error "<what> failed on <path>: <sqlite message>" when rc is an error.
   void Check(int rc, const std::string& what) const;
 
