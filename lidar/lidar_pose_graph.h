@@ -46,7 +46,8 @@ struct LidarGraphOptions {
   // Remove edges inconsistent around 3-cycles before the spanning tree (CheckThreeCycles).
   bool check_cycles = true;
   CycleConsistencyOptions cycles;
-  // Sweeps (frame indices given): first remove edges whose speed contradicts the edges around them.
+  // Sweeps (frame indices given): first an edge whose speed contradicts the edges around it is
+  // registered again from their velocity, and refused if that fails too.
   SpeedConsistencyOptions speed;
   // pose-graph refinement over all accepted edges
   bool refine = true;

@@ -25,11 +25,12 @@ struct SpeedConsistencyOptions {
   // Edges spanning at most this many frames are judged (a loop closure, revisiting a place much
   // later, is not).
   double max_judged_span_frames = 20;
-  // An edge is refused when its speed differs from its neighbours' median by more than this fraction
-  // of the median and by more than min_deviation_m_per_frame (a walking pace is never judged).
+  // An edge contradicts its neighbours when its speed differs from their median by more than this
+  // fraction of the median and by more than min_deviation_m_per_frame (a walking pace never does).
   double max_relative_deviation = 0.5;
   double min_deviation_m_per_frame = 0.2;
-  // An edge with fewer neighbours (itself included) is not judged.
+  // An edge with fewer neighbours (itself included when it spans at most window_frames) is not
+  // judged.
   int min_neighbours = 4;
 
   bool Check() const;

@@ -151,7 +151,8 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("max_speed_deviation",
           &options->graph.speed.max_relative_deviation,
           "sweeps (deskew_sweeps or sequential): an edge whose speed differs from the edges' "
-          "around it by more than this fraction of theirs is refused");
+          "around it by more than this fraction of theirs is registered again from their "
+          "velocity, and refused if that fails");
   add.Add("deskew_sweeps",
           &options->deskew_sweeps,
           "sweeps of a moving platform: de-skew them with the registered motion, register again");
