@@ -129,6 +129,20 @@ void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
   }
 }
 
+// cam_from_lidar from the chosen start to the stereo-LiDAR alignment's, when that had enough
+// associations.
+void RefineWithStereo(const StationDataset& dataset,
+                      const std::string& depth_path,
+                      const PoseInitializerOptions& options,
+                      PoseInitialization* init) {
+  init->stereo_alignment =
+      AlignStereoWithLidar(dataset, depth_path, init->cam_from_lidar, options.stereo_alignment);
+  std::cout << "Stereo-LiDAR alignment: " << init->stereo_alignment->message << std::endl;
+  if (!init->stereo_alignment->used) return;
+  init->cam_from_lidar = init->stereo_alignment->cam_from_lidar;
+  init->extrinsic_source += " + stereo-LiDAR alignment";
+}
+
 // The camera pose graph A_c v A_l (lidar/pose_graph.h): nodes are the stations in name order, the
 // first one is the world frame; stations outside its component are unreachable.
 void SolveCameraPoseGraph(const std::map<std::string, colmap::image_t>& image_of_station,
@@ -207,6 +221,7 @@ bool PoseInitializerOptions::Check() const {
   CHECK_OPTION(mixed_cycles.Check());
   CHECK_OPTION(similarity_hand_eye.Check());
   CHECK_OPTION_GT(max_lidar_image_angle_deg, 0);
+  CHECK_OPTION(stereo_alignment.Check());
   CHECK_OPTION_GT(sigma_rotation_deg, 0);
   CHECK_OPTION_GT(sigma_translation_m, 0);
   return true;
@@ -215,7 +230,8 @@ bool PoseInitializerOptions::Check() const {
 PoseInitialization InitializePoses(const std::string& database_path,
                                    const StationDataset& dataset,
                                    const std::string& registration_path,
-                                   const PoseInitializerOptions& options) {
+                                   const PoseInitializerOptions& options,
+                                   const std::string& depth_path) {
   THROW_CHECK(options.Check());
   THROW_CHECK(fs::is_regular_file(database_path))
       << "Database file does not exist: " << database_path;
@@ -276,6 +292,8 @@ PoseInitialization InitializePoses(const std::string& database_path,
                    : PairDirectionMotions(database_path, dataset, registration_path);
       },
       &init);
+  if (!depth_path.empty() && options.align_stereo_with_lidar)
+    RefineWithStereo(dataset, depth_path, options, &init);
   for (const auto& [i, j, lidar_i_from_lidar_j, weight] : lidar_edges) {
     init.edges.push_back(
         {i,

@@ -18,12 +18,14 @@
 #include "bridge/hand_eye.h"
 #include "bridge/image_pair_poses.h"
 #include "bridge/lidar_registration_files.h"
+#include "bridge/stereo_lidar_alignment.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cycle_consistency.h"
 
 #include "colmap/scene/reconstruction.h"
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +46,10 @@ struct PoseInitializerOptions {
   }();
   // false: hand-eye even when rig.json has a guess
   bool use_guess = true;
+  // With stereo depth: the start (guess or hand-eye) refined by aligning each station's stereo depth
+  // with its own LiDAR cloud (bridge/stereo_lidar_alignment.h), which needs no motion.
+  bool align_stereo_with_lidar = true;
+  StereoLidarAlignmentOptions stereo_alignment;
   // A LiDAR edge and an image edge of the same station pair measure one motion of the pod, so their
   // rotation angles agree whatever cam_from_lidar is (A = X B X^-1); a LiDAR edge whose angle differs
   // by more than this (degrees) is a wrong registration (sparse clouds: ICP slid along the ground) and
@@ -86,8 +92,10 @@ struct PoseInitialization {
   // Cameras that replace the database's (an existing model's refined intrinsics); empty: none.
   std::map<colmap::camera_t, colmap::Camera> cameras;
   colmap::Rigid3d cam_from_lidar;
-  std::string extrinsic_source;  // "rig.json guess" or "hand-eye"
+  std::string extrinsic_source;  // "rig.json guess" or "hand-eye", "+ stereo-LiDAR alignment"
   HandEyeResult hand_eye;
+  // Ran when stereo depth was given and PoseInitializerOptions::align_stereo_with_lidar.
+  std::optional<StereoLidarAlignment> stereo_alignment;
   std::vector<PoseGraphEdge> edges;
   int num_image_edges = 0;
   int num_lidar_edges = 0;
@@ -108,10 +116,12 @@ struct PoseInitialization {
 std::string DescribeDegenerateEdge(const LidarPairRecord& pair);
 
 // `registration_path`: lidar_registrator's output folder (pairs.txt); may be empty (no LiDAR edges).
+// `depth_path`: stereo_depth's output folder, for the stereo-LiDAR alignment; may be empty.
 PoseInitialization InitializePoses(const std::string& database_path,
                                    const StationDataset& dataset,
                                    const std::string& registration_path,
-                                   const PoseInitializerOptions& options);
+                                   const PoseInitializerOptions& options,
+                                   const std::string& depth_path = "");
 
 // The existing-COLMAP-workflow variant: `models` (colmap mapper's, of the same database; ReadModels in
 // bridge/model_completion.h, the largest first) are rescaled to metres in place (`scales` returns the

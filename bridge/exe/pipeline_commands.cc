@@ -43,11 +43,40 @@ void AddPoseInitializerOptions(const std::string& prefix,
           &options->mixed_cycles.max_translation_m,
           "image and LiDAR edges: an edge breaking every cycle it is on by more is left out");
   add.Add("max_cycle_rotation_deg", &options->mixed_cycles.max_rotation_deg);
+  add.Add("align_stereo_with_lidar",
+          &options->align_stereo_with_lidar,
+          "with stereo depth: refine the start by aligning each station's stereo depth with its "
+          "LiDAR cloud (no motion needed)");
+  add.Add("stereo_alignment_max_depth_m", &options->stereo_alignment.max_depth_m);
+  add.Add("stereo_alignment_pixel_stride", &options->stereo_alignment.pixel_stride);
+  add.Add("stereo_alignment_sigma_disparity_px", &options->stereo_alignment.sigma_disparity_px);
   add.Add("sigma_rotation_deg", &options->sigma_rotation_deg, "pose-graph edge weight");
   add.Add("sigma_translation_m", &options->sigma_translation_m, "pose-graph edge weight");
 }
 
 namespace {
+
+nlohmann::json StereoAlignmentJson(const StereoLidarAlignment& alignment) {
+  const ExtrinsicAlignmentResult& r = alignment.result;
+  const auto list = [](const auto& v) {
+    return std::vector<double>(v.data(), v.data() + v.size());
+  };
+  return {{"used", alignment.used},
+          {"message", alignment.message},
+          {"stations", alignment.num_stations},
+          {"stereo_points", r.num_points},
+          {"associations", r.num_associations},
+          {"rms_mm", 1000 * r.rms_m},
+          {"rms_sigmas", r.rms_sigmas},
+          {"iterations", r.iterations},
+          {"converged", r.converged},
+          {"rotation_change_deg", alignment.rotation_change_deg},
+          {"translation_change_mm", 1000 * alignment.translation_change_m},
+          {"sigma_rotation_deg_in_cam", list(r.sigma_rotation_deg)},
+          {"sigma_translation_mm_in_cam", list(Eigen::Vector3d(1000 * r.sigma_translation_m))},
+          {"constraint_ratios", list(r.constraint_ratios)},
+          {"directions_held_at_start", r.num_weak_directions}};
+}
 
 void WriteInitializationReport(const std::string& path,
                                const PoseInitialization& init,
@@ -74,6 +103,8 @@ void WriteInitializationReport(const std::string& path,
   report["scale_to_metres"] = scales.front();
   if (!input_path.empty()) report["model_scales_to_metres"] = scales;
   report["unreachable_reasons"] = init.unreachable_reason;
+  if (init.stereo_alignment)
+    report["stereo_alignment"] = StereoAlignmentJson(*init.stereo_alignment);
   if (init.hand_eye.unobservable_axis_in_cam.squaredNorm() > 0) {
     const Eigen::Vector3d& axis = init.hand_eye.unobservable_axis_in_cam;
     report["hand_eye"]["unobservable_translation_axis_in_cam"] = {axis.x(), axis.y(), axis.z()};
@@ -98,7 +129,8 @@ void RunPoseInitializerStep(const StationDataset& dataset,
     TriangulateInitialModel(
         paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
   } else if (paths.input_path.empty()) {
-    init = InitializePoses(paths.database_path, dataset, paths.registration_path, options);
+    init = InitializePoses(
+        paths.database_path, dataset, paths.registration_path, options, paths.depth_path);
     std::cout << "Pose graph: " << init.num_image_edges << " image edges (A_c), "
               << init.num_lidar_edges << " LiDAR edges (A_l); " << init.cam_from_world.size()
               << " stations reachable" << std::endl;
@@ -152,6 +184,10 @@ int RunPoseInitializer(int argc, char** argv) {
                            &paths.registration_path,
                            "lidar_registrator's output (pairs.txt); empty: no LiDAR edges");
   options.AddRequiredOption("output_path", &paths.output_path);
+  options.AddDefaultOption("depth_path",
+                           &paths.depth_path,
+                           "stereo_depth's output: cam_from_lidar refined by aligning the stereo "
+                           "depth with the LiDAR; empty: not used");
   options.AddDefaultOption("input_path",
                            &paths.input_path,
                            "existing COLMAP model(s) of the same database: a model folder (.bin "
@@ -259,7 +295,9 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
   std::vector<PipelineStep> back_end = {
       {"pose_initializer",
        [=, &dataset] {
-         RunPoseInitializerStep(dataset, {database, lidar, "", initial}, options.initializer);
+         RunPoseInitializerStep(WithRegistratorClouds(dataset, lidar),
+                                {database, lidar, "", initial, stereo_rig ? stereo : ""},
+                                options.initializer);
        }},
       {"joint_adjuster",
        [=, &dataset] {

@@ -122,6 +122,7 @@ struct PoseInitializerPaths {
   std::string registration_path;  // may be empty: no LiDAR edges
   std::string input_path;         // an existing model to rescale; empty: initialise
   std::string output_path;
+  std::string depth_path;  // stereo_depth's output; empty: no stereo-LiDAR alignment
 };
 void RunPoseInitializerStep(const StationDataset& dataset,
                             const PoseInitializerPaths& paths,

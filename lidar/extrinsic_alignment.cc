@@ -1,0 +1,270 @@
+#include "lidar/extrinsic_alignment.h"
+
+#include "lidar/check_option.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace colmap_lidar {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+struct WeightedNormalEquations {
+  Matrix6d H = Matrix6d::Zero();
+  Vector6d g = Vector6d::Zero();
+  double squared_m = 0;       // sum r^2 of the associations
+  double squared_sigmas = 0;  // sum (r / sigma)^2
+  double robust_squared = 0;  // sum w (r / sigma)^2
+  double squared_lever = 0;   // sum |p'|^2: the lever arm of the rotations
+  size_t count = 0;
+
+  void Add(const WeightedNormalEquations& other) {
+    H += other.H;
+    g += other.g;
+    squared_m += other.squared_m;
+    squared_sigmas += other.squared_sigmas;
+    robust_squared += other.robust_squared;
+    squared_lever += other.squared_lever;
+    count += other.count;
+  }
+};
+
+// One station's contribution, linearised about lidar_from_cam with a left increment [omega, t] in
+// the LiDAR frame: r = n^T (p' - q), d r / d[omega, t] = [p' x n, n] (as in PointToPlaneIcp).
+WeightedNormalEquations StationEquations(const CameraDepthPoints& points,
+                                         const StationCloud& station,
+                                         const Eigen::Isometry3d& lidar_from_cam,
+                                         double gate,
+                                         const ExtrinsicAlignmentOptions& options) {
+  WeightedNormalEquations eq;
+  const Eigen::Vector3d camera_in_lidar = lidar_from_cam.translation();
+  const double lidar_variance = options.sigma_lidar_m * options.sigma_lidar_m;
+  for (size_t k = 0; k < points.point_in_cam.size(); ++k) {
+    const Eigen::Vector3d p = lidar_from_cam * points.point_in_cam[k];
+    size_t index = 0;
+    double squared = 0;
+    if (!station.tree->Nearest(p, &index, &squared) || squared > gate * gate ||
+        station.curvature[index] > options.max_curvature) {
+      continue;
+    }
+    const Eigen::Vector3d& n = station.cloud.normals[index];
+    if (n.squaredNorm() < 0.5) continue;  // no normal estimated there
+    const double r = n.dot(p - station.cloud.points[index]);
+    // The depth error lies along the viewing ray; its share along the normal.
+    const double along_normal =
+        points.sigma_along_ray_m[k] * n.dot((p - camera_in_lidar).normalized());
+    const double sigma = std::sqrt(lidar_variance + along_normal * along_normal);
+    const double z = std::abs(r) / sigma;
+    const double huber = z <= options.huber_sigmas ? 1.0 : options.huber_sigmas / z;
+    const double w = huber / (sigma * sigma);
+    Vector6d J;
+    J << p.cross(n), n;
+    eq.H.noalias() += w * J * J.transpose();
+    eq.g.noalias() += w * J * r;
+    eq.squared_m += r * r;
+    eq.squared_sigmas += z * z;
+    eq.robust_squared += huber * z * z;
+    eq.squared_lever += p.squaredNorm();
+    ++eq.count;
+  }
+  return eq;
+}
+
+WeightedNormalEquations AllEquations(const std::vector<CameraDepthPoints>& points,
+                                     const std::vector<const StationCloud*>& clouds,
+                                     const Eigen::Isometry3d& lidar_from_cam,
+                                     double gate,
+                                     const ExtrinsicAlignmentOptions& options) {
+  std::vector<WeightedNormalEquations> per_station(points.size());
+#pragma omp parallel for schedule(dynamic)
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+    per_station[i] = StationEquations(points[i], *clouds[i], lidar_from_cam, gate, options);
+  }
+  WeightedNormalEquations total;
+  for (const WeightedNormalEquations& eq : per_station) total.Add(eq);
+  return total;
+}
+
+// The weak prior's information and its pull towards the start, in the same increment coordinates.
+Matrix6d PriorInformation(const ExtrinsicAlignmentOptions& options) {
+  Vector6d diagonal;
+  const double rotation = options.prior_rotation_deg * kDegToRad;
+  diagonal << Eigen::Vector3d::Constant(1 / (rotation * rotation)),
+      Eigen::Vector3d::Constant(1 / (options.prior_translation_m * options.prior_translation_m));
+  return diagonal.asDiagonal();
+}
+
+Vector6d DeviationFromStart(const Eigen::Isometry3d& lidar_from_cam,
+                            const Eigen::Isometry3d& start_lidar_from_cam) {
+  const Eigen::Matrix3d rotation =
+      lidar_from_cam.linear() * start_lidar_from_cam.linear().transpose();
+  const Eigen::AngleAxisd angle_axis(rotation);
+  Vector6d deviation;
+  deviation << angle_axis.angle() * angle_axis.axis(),
+      lidar_from_cam.translation() - rotation * start_lidar_from_cam.translation();
+  return deviation;
+}
+
+Eigen::Isometry3d Increment(const Vector6d& x) {
+  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+  const double angle = x.head<3>().norm();
+  if (angle > 0) step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
+  step.translation() = x.tail<3>();
+  return step;
+}
+
+// The data's directions in [omega * lever, t] (metres both), weakest first, and their information
+// relative to the strongest: a direction below `min_ratio` is one the scenes do not constrain (noise
+// in the LiDAR normals gives a plane's tangent directions a small ratio of their own; see the
+// option)
+struct DataDirections {
+  Matrix6d scale = Matrix6d::Identity();  // x = scale * y
+  Eigen::Matrix<double, 6, 6> vectors;    // columns, in y
+  Vector6d ratios;
+  int num_weak = 0;
+};
+
+DataDirections AnalyseDirections(const WeightedNormalEquations& eq, double min_ratio) {
+  DataDirections directions;
+  const double lever = std::max(1.0, std::sqrt(eq.squared_lever / std::max<size_t>(eq.count, 1)));
+  directions.scale.topLeftCorner<3, 3>() /= lever;
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(directions.scale * eq.H * directions.scale);
+  directions.vectors = solver.eigenvectors();
+  const double strongest = std::max(solver.eigenvalues()(5), 1e-300);
+  directions.ratios = solver.eigenvalues() / strongest;
+  while (directions.num_weak < 6 && directions.ratios(directions.num_weak) < min_ratio) {
+    ++directions.num_weak;
+  }
+  return directions;
+}
+
+// The step without its components along the weak directions (Zhang et al. 2016, "solution
+// remapping"): what the data do not determine stays where it was.
+Vector6d WithoutWeakDirections(const Vector6d& x, const DataDirections& directions) {
+  if (directions.num_weak == 0) return x;
+  const Matrix6d inverse_scale = directions.scale.inverse();
+  Vector6d y = inverse_scale * x;
+  for (int k = 0; k < directions.num_weak; ++k) {
+    y -= directions.vectors.col(k) * directions.vectors.col(k).dot(y);
+  }
+  return directions.scale * y;
+}
+
+// Covariance of the increment [omega, t] in the LiDAR frame: the data's (scaled by the residual
+// variance) along the directions they determine, the prior's translation variance along the weak
+// ones (unknown; held at the start).
+Matrix6d Covariance(const WeightedNormalEquations& eq,
+                    const DataDirections& directions,
+                    double variance,
+                    const ExtrinsicAlignmentOptions& options) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(directions.scale * eq.H * directions.scale);
+  Matrix6d covariance_y = Matrix6d::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const double v = k < directions.num_weak
+                         ? options.prior_translation_m * options.prior_translation_m
+                         : variance / solver.eigenvalues()(k);
+    covariance_y += v * directions.vectors.col(k) * directions.vectors.col(k).transpose();
+  }
+  return directions.scale * covariance_y * directions.scale;
+}
+
+// Sigmas of cam_from_lidar about / along the camera's axes: lidar_from_cam <- exp(d) lidar_from_cam
+// is cam_from_lidar <- cam_from_lidar exp(-d), a change R (-omega) of its rotation and -R t of its
+// translation in the camera frame, R = cam_from_lidar's rotation.
+void SetSigmas(const Matrix6d& covariance_in_lidar,
+               const Eigen::Isometry3d& cam_from_lidar,
+               ExtrinsicAlignmentResult* result) {
+  Matrix6d to_cam = Matrix6d::Zero();
+  to_cam.topLeftCorner<3, 3>() = cam_from_lidar.linear();
+  to_cam.bottomRightCorner<3, 3>() = cam_from_lidar.linear();
+  const Matrix6d covariance = to_cam * covariance_in_lidar * to_cam.transpose();
+  for (int axis = 0; axis < 3; ++axis) {
+    result->sigma_rotation_deg[axis] = std::sqrt(covariance(axis, axis)) / kDegToRad;
+    result->sigma_translation_m[axis] = std::sqrt(covariance(3 + axis, 3 + axis));
+  }
+}
+
+}  // namespace
+
+bool ExtrinsicAlignmentOptions::Check() const {
+  LIDAR_CHECK_OPTION_GT(min_correspondence_distance_m, 0);
+  LIDAR_CHECK_OPTION_GE(max_correspondence_distance_m, min_correspondence_distance_m);
+  LIDAR_CHECK_OPTION_GE(max_iterations, 1);
+  LIDAR_CHECK_OPTION_GT(max_curvature, 0);
+  LIDAR_CHECK_OPTION_GT(sigma_lidar_m, 0);
+  LIDAR_CHECK_OPTION_GT(huber_sigmas, 0);
+  LIDAR_CHECK_OPTION_GE(min_constraint_ratio, 0);
+  LIDAR_CHECK_OPTION_LT(min_constraint_ratio, 1);
+  LIDAR_CHECK_OPTION_GT(prior_rotation_deg, 0);
+  LIDAR_CHECK_OPTION_GT(prior_translation_m, 0);
+  LIDAR_CHECK_OPTION_GT(convergence_rotation_deg, 0);
+  LIDAR_CHECK_OPTION_GT(convergence_translation_m, 0);
+  return true;
+}
+
+ExtrinsicAlignmentResult AlignCameraPointsWithLidar(const std::vector<CameraDepthPoints>& points,
+                                                    const std::vector<const StationCloud*>& clouds,
+                                                    const Eigen::Isometry3d& initial_cam_from_lidar,
+                                                    const ExtrinsicAlignmentOptions& options) {
+  ThrowUnlessValid(options, "ExtrinsicAlignmentOptions");
+  if (points.size() != clouds.size()) {
+    throw std::invalid_argument("AlignCameraPointsWithLidar: " + std::to_string(points.size()) +
+                                " point sets for " + std::to_string(clouds.size()) + " clouds");
+  }
+  ExtrinsicAlignmentResult result;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (points[i].point_in_cam.size() != points[i].sigma_along_ray_m.size() || !clouds[i] ||
+        !clouds[i]->tree || clouds[i]->curvature.size() != clouds[i]->cloud.Size()) {
+      throw std::invalid_argument("AlignCameraPointsWithLidar: station " + std::to_string(i) +
+                                  " has mismatched points, sigmas or an unprepared cloud");
+    }
+    result.num_points += points[i].point_in_cam.size();
+  }
+  const Eigen::Isometry3d start = initial_cam_from_lidar.inverse();
+  const Matrix6d prior = PriorInformation(options);
+  Eigen::Isometry3d lidar_from_cam = start;
+  double gate = options.max_correspondence_distance_m;
+  WeightedNormalEquations eq;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    eq = AllEquations(points, clouds, lidar_from_cam, gate, options);
+    result.iterations = it + 1;
+    if (eq.count < 6) break;
+    const DataDirections directions = AnalyseDirections(eq, options.min_constraint_ratio);
+    const Vector6d x = WithoutWeakDirections(
+        (eq.H + prior).ldlt().solve(-(eq.g + prior * DeviationFromStart(lidar_from_cam, start))),
+        directions);
+    if (!x.allFinite()) break;
+    lidar_from_cam = Increment(x) * lidar_from_cam;
+    const bool small_step = x.head<3>().norm() < options.convergence_rotation_deg * kDegToRad &&
+                            x.tail<3>().norm() < options.convergence_translation_m;
+    const double rms = std::sqrt(eq.squared_m / eq.count);
+    const double next_gate = std::max(options.min_correspondence_distance_m,
+                                      std::min(gate, std::max(0.7 * gate, 6 * rms)));
+    if (small_step && next_gate > 0.98 * gate) {
+      result.converged = true;
+      break;
+    }
+    gate = next_gate;
+  }
+  eq = AllEquations(points, clouds, lidar_from_cam, gate, options);
+  result.cam_from_lidar = lidar_from_cam.inverse();
+  result.num_associations = eq.count;
+  if (eq.count < 6) return result;
+  result.rms_m = std::sqrt(eq.squared_m / eq.count);
+  result.rms_sigmas = std::sqrt(eq.squared_sigmas / eq.count);
+  const DataDirections directions = AnalyseDirections(eq, options.min_constraint_ratio);
+  result.constraint_ratios = directions.ratios;
+  result.num_weak_directions = directions.num_weak;
+  const double variance = std::max(1.0, eq.robust_squared / std::max<double>(eq.count - 6, 1));
+  SetSigmas(Covariance(eq, directions, variance, options), result.cam_from_lidar, &result);
+  return result;
+}
+
+}  // namespace colmap_lidar
