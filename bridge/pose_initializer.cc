@@ -459,7 +459,8 @@ PoseInitialization InitializeFromModels(const std::string& database_path,
                                         const std::string& registration_path,
                                         const PoseInitializerOptions& options,
                                         std::vector<colmap::Reconstruction>* models,
-                                        std::vector<double>* scales) {
+                                        std::vector<double>* scales,
+                                        const std::string& depth_path) {
   THROW_CHECK(options.Check());
   THROW_CHECK(models != nullptr && scales != nullptr);
   THROW_CHECK(!models->empty()) << "no COLMAP model given";
@@ -472,6 +473,9 @@ PoseInitialization InitializeFromModels(const std::string& database_path,
   PoseInitialization init;
   ChooseModelScalesAndExtrinsic(
       database_path, dataset, lidar_pairs, options, models, scales, &init);
+  if (!depth_path.empty() && options.align_stereo_with_lidar) {
+    RefineWithStereo(dataset, depth_path, options, &init);
+  }
   std::vector<const colmap::Reconstruction*> metric;
   for (const colmap::Reconstruction& model : *models) metric.push_back(&model);
   ModelCompletionOptions completion;

@@ -133,13 +133,15 @@ PoseInitialization InitializePoses(const std::string& database_path,
 //   other models are scaled to the LiDAR motions.
 // Then the stations the models did not register, and the other models, are placed through the LiDAR
 // pose graph (CompleteThroughLidar) in the first model's frame; stations no edge reaches are listed
-// with the kind of edge missing. `cameras` holds the models' cameras.
+// with the kind of edge missing. `cameras` holds the models' cameras. With `depth_path` (stereo_depth's
+// output) cam_from_lidar is then refined by the stereo-LiDAR alignment, as in InitializePoses.
 PoseInitialization InitializeFromModels(const std::string& database_path,
                                         const StationDataset& dataset,
                                         const std::string& registration_path,
                                         const PoseInitializerOptions& options,
                                         std::vector<colmap::Reconstruction>* models,
-                                        std::vector<double>* scales);
+                                        std::vector<double>* scales,
+                                        const std::string& depth_path = "");
 
 // The monocular initialisation: cam_from_lidar from rig.json's guess (if allowed and present), else
 // from the similarity hand-eye (one scale per motion) between COLMAP's two-view geometry of the

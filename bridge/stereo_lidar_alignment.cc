@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -38,8 +39,12 @@ CameraDepthPoints BackProjectDepthMap(const cv::Mat& depth,
                                       double focal_times_baseline,
                                       const StereoLidarAlignmentOptions& options) {
   CameraDepthPoints points;
-  for (int row = 0; row < depth.rows; row += options.pixel_stride) {
-    for (int col = 0; col < depth.cols; col += options.pixel_stride) {
+  const int stride = std::max(
+      options.pixel_stride,
+      static_cast<int>(
+          std::ceil(std::sqrt(double(depth.rows) * depth.cols / options.max_pixels_per_station))));
+  for (int row = 0; row < depth.rows; row += stride) {
+    for (int col = 0; col < depth.cols; col += stride) {
       const double d = depth.at<float>(row, col);
       if (!(d >= options.min_depth_m && d <= options.max_depth_m) ||
           !AwayFromDepthEdge(depth, row, col, options.max_neighbour_depth_change)) {
@@ -78,6 +83,7 @@ std::string Describe(const StereoLidarAlignment& alignment) {
 
 bool StereoLidarAlignmentOptions::Check() const {
   CHECK_OPTION_GE(pixel_stride, 1);
+  CHECK_OPTION_GE(max_pixels_per_station, 100);
   CHECK_OPTION_GT(min_depth_m, 0);
   CHECK_OPTION_GT(max_depth_m, min_depth_m);
   CHECK_OPTION_GT(sigma_disparity_px, 0);

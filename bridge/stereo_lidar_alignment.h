@@ -15,8 +15,10 @@
 namespace colmap_lidar {
 
 struct StereoLidarAlignmentOptions {
-  // every `pixel_stride`-th pixel of a depth map, in both directions
+  // every `pixel_stride`-th pixel of a depth map, in both directions, or a wider stride that keeps
+  // at most `max_pixels_per_station` (a 12 MP map: every 25th)
   int pixel_stride = 4;
+  int max_pixels_per_station = 50000;
   // stereo depths used [m]: beyond `max_depth_m` a disparity step is decimetres
   double min_depth_m = 1.0;
   double max_depth_m = 20.0;

@@ -7,6 +7,8 @@
 #   SCENES="street_drive": the simulated street drive instead (one camera, DRIVE_FRAMES frames,
 #                  default 40, 120000 rays per sweep, no guess; the whole `pipeline` with sequential
 #                  matching), e.g. SEEDS=4 SCENES=street_drive DOC=docs/benchmarks/drive_uncertainty.md
+#   SCENES="street_drive_stereo": the same drive with the second camera (stereo depth, depth priors,
+#                  the stereo-LiDAR alignment of the pose initialiser)
 #   LIDAR_POINTS per station (default 300000), BUILD_DIR (default build),
 #   WORK_DIR       keep the runs there (default: a temporary folder, removed); steps already done in
 #                  WORK_DIR are not run again, so that a changed joint adjuster can be re-evaluated on the
@@ -46,9 +48,11 @@ run_stations() {
   step "$joint" $cli joint_adjuster --database_path "$ws/db.db" --input_path "$ws/initial" \
     --dataset_path "$run/dataset" --output_path "$joint"
 }
-# One seed of the mono street drive: the whole pipeline.
+# One seed of the street drive (mono unless the scene is street_drive_stereo): the whole pipeline.
 run_drive() {
-  step "$run/dataset" $cli simulate_dataset --scene street --motion drive --mono 1 \
+  local mono=1
+  [ "$scene" = street_drive_stereo ] && mono=0
+  step "$run/dataset" $cli simulate_dataset --scene street --motion drive --mono "$mono" \
     --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 \
     --write_guess 0 --output_path "$run/dataset" &&
   step "$joint" $cli pipeline --dataset_path "$run/dataset" --workspace_path "$ws" \
@@ -65,7 +69,7 @@ for scene in ${SCENES:-t_specimen bridge_pier}; do
       shift
       [ -e "$output" ] || "$@" >> "$run/log.txt" 2>&1
     }
-    if [ "$scene" = street_drive ]; then
+    if [ "$scene" = street_drive ] || [ "$scene" = street_drive_stereo ]; then
       joint="$ws/sparse/joint"
       front_and_back_end=run_drive
     else

@@ -6,7 +6,7 @@ path, stations, points = sys.argv[1:]
 axes = ['rx', 'ry', 'rz', 'tx', 'ty', 'tz']
 rows = [line.rstrip('\n').split('\t') for line in open(path) if line.strip()]
 print('# Coverage of the reported cam_from_lidar uncertainty, end to end\n')
-drive_only = all(r[0] == 'street_drive' for r in rows)
+drive_only = all(r[0].startswith('street_drive') for r in rows)
 print('Written by `scripts/benchmark_uncertainty.sh` on %s (%d cores)' %
       (datetime.date.today().isoformat(), os.cpu_count()) + ('.' if drive_only else ':'))
 if not drive_only:
@@ -21,6 +21,10 @@ if any(r[0] == 'street_drive' for r in rows):
           '(`DRIVE_FRAMES`), 120000 rays per sweep, no guess, the whole `pipeline` with sequential '
           'matching (de-skewed sweeps, moving cars left out, similarity hand-eye, E_m at the moving '
           "platform's weight); `report.json` marks these sigmas as not validated by coverage.\n")
+if any(r[0] == 'street_drive_stereo' for r in rows):
+    print('`street_drive_stereo`: the same drive with the second camera: stereo depth and depth priors, '
+          'the planar hand-eye refined by the stereo-LiDAR alignment (`initialization.json` '
+          '`stereo_alignment`), E_m at the moving platform\'s weight.\n')
 print('| scene | seed | ' + ' | '.join('z ' + a for a in axes) + ' | ' +
       ' | '.join('sigma ' + a for a in axes) + ' |')
 print('|---|---|' + '---|' * 12)

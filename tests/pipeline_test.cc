@@ -58,7 +58,9 @@ TEST(PipelineTest, DefaultSceneWithoutAGuessEndToEndAndRestartable) {
   EXPECT_TRUE(fs::is_regular_file(f.File("sparse/joint/images.txt")));
   EXPECT_FALSE(fs::exists(f.File("sparse/initial/images.txt")));
   const nlohmann::json init = ReadJson(f.File("sparse/initial/initialization.json"));
-  EXPECT_EQ(init["extrinsic_source"], "hand-eye");
+  // The hand-eye's start, refined by the stereo-LiDAR alignment.
+  EXPECT_EQ(init["extrinsic_source"], "hand-eye + stereo-LiDAR alignment");
+  EXPECT_TRUE(init["stereo_alignment"]["used"].get<bool>());
   EXPECT_TRUE(init["hand_eye"]["unique"].get<bool>());
   const nlohmann::json metrics = ReadJson(f.File("evaluation/metrics.json"));
   std::cout << "pipeline without a guess: cam_from_lidar error "
