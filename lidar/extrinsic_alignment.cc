@@ -1,6 +1,7 @@
 #include "lidar/extrinsic_alignment.h"
 
 #include "lidar/check_option.h"
+#include "lidar/point_to_plane_icp.h"
 
 #include <Eigen/Dense>
 
@@ -110,14 +111,6 @@ Vector6d DeviationFromStart(const Eigen::Isometry3d& lidar_from_cam,
   deviation << angle_axis.angle() * angle_axis.axis(),
       lidar_from_cam.translation() - rotation * start_lidar_from_cam.translation();
   return deviation;
-}
-
-Eigen::Isometry3d Increment(const Vector6d& x) {
-  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-  const double angle = x.head<3>().norm();
-  if (angle > 0) step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
-  step.translation() = x.tail<3>();
-  return step;
 }
 
 // The data's directions in [omega * lever, t] (metres both), weakest first, and their information
@@ -241,7 +234,7 @@ ExtrinsicAlignmentResult AlignCameraPointsWithLidar(const std::vector<CameraDept
         (eq.H + prior).ldlt().solve(-(eq.g + prior * DeviationFromStart(lidar_from_cam, start))),
         directions);
     if (!x.allFinite()) break;
-    lidar_from_cam = Increment(x) * lidar_from_cam;
+    lidar_from_cam = IsometryFromIncrement(x) * lidar_from_cam;
     const bool small_step = x.head<3>().norm() < options.convergence_rotation_deg * kDegToRad &&
                             x.tail<3>().norm() < options.convergence_translation_m;
     const double rms = std::sqrt(eq.squared_m / eq.count);

@@ -63,6 +63,14 @@ NormalEquations BuildNormalEquations(const PointCloud& source,
 
 }  // namespace
 
+Eigen::Isometry3d IsometryFromIncrement(const Eigen::Matrix<double, 6, 1>& x) {
+  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+  const double angle = x.head<3>().norm();
+  if (angle > 0) step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
+  step.translation() = x.tail<3>();
+  return step;
+}
+
 bool IcpOptions::Check() const {
   LIDAR_CHECK_OPTION_GE(max_iterations, 1);
   LIDAR_CHECK_OPTION_GT(min_correspondence_distance, 0);
@@ -95,11 +103,8 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
     if (eq.count < 6) break;
     const Eigen::Matrix<double, 6, 1> x = eq.H.ldlt().solve(-eq.g);
     if (!x.allFinite()) break;
-    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    result.target_from_source = IsometryFromIncrement(x) * result.target_from_source;
     const double angle = x.head<3>().norm();
-    if (angle > 0) step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
-    step.translation() = x.tail<3>();
-    result.target_from_source = step * result.target_from_source;
     const bool small_step = angle < options.convergence_rotation_rad &&
                             x.tail<3>().norm() < options.convergence_translation_m;
     // Shrink the gate towards a few times the residual, never below the minimum.

@@ -39,6 +39,10 @@ struct IcpResult {
   double lever_arm_m = 0;
 };
 
+// The Gauss-Newton step of a point-to-plane problem as a transform: rotation by the rotation vector
+// x[0..2] [rad], then translation x[3..5] [m] (a left increment, applied as step * pose).
+Eigen::Isometry3d IsometryFromIncrement(const Eigen::Matrix<double, 6, 1>& x);
+
 // `target` must have normals and `target_tree` must be built over target.points.
 IcpResult PointToPlaneIcp(const PointCloud& source,
                           const PointCloud& target,
