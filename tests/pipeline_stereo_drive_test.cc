@@ -31,7 +31,7 @@ std::pair<double, double> ExtrinsicError(const std::string& estimate_path,
 // 319 mm off, the alignment 0.057 deg / 8.5 mm both times, the joint 0.014 deg / 6.1 mm and
 // 0.055 deg / 11.4 mm (before the alignment the joint ended at 0.062-0.24 deg / 3.3-9.2 mm). The
 // issue's goal, 0.05 deg / 1 cm, met in one of two; the bounds are about 2-3x the worse run.
-TEST(PipelineStereoDriveTest, FortyFrameStereoDriveMeetsTheGoalWithoutAGuess) {
+TEST(PipelineStereoDriveTest, FortyFrameStereoDriveCalibratesFromItsStereoDepthWithoutAGuess) {
   testing::ScopedTempDir dir;
   sim::SimulationOptions drive;
   drive.scene = "street";
