@@ -120,6 +120,7 @@ Vector6d DeviationFromStart(const Eigen::Isometry3d& lidar_from_cam,
 struct DataDirections {
   Matrix6d scale = Matrix6d::Identity();  // x = scale * y
   Eigen::Matrix<double, 6, 6> vectors;    // columns, in y
+  Vector6d eigenvalues;                   // of scale H scale, ascending
   Vector6d ratios;
   int num_weak = 0;
 };
@@ -130,8 +131,8 @@ DataDirections AnalyseDirections(const WeightedNormalEquations& eq, double min_r
   directions.scale.topLeftCorner<3, 3>() /= lever;
   const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(directions.scale * eq.H * directions.scale);
   directions.vectors = solver.eigenvectors();
-  const double strongest = std::max(solver.eigenvalues()(5), 1e-300);
-  directions.ratios = solver.eigenvalues() / strongest;
+  directions.eigenvalues = solver.eigenvalues();
+  directions.ratios = directions.eigenvalues / std::max(directions.eigenvalues(5), 1e-300);
   while (directions.num_weak < 6 && directions.ratios(directions.num_weak) < min_ratio) {
     ++directions.num_weak;
   }
@@ -153,16 +154,14 @@ Vector6d WithoutWeakDirections(const Vector6d& x, const DataDirections& directio
 // Covariance of the increment [omega, t] in the LiDAR frame: the data's (scaled by the residual
 // variance) along the directions they determine, the prior's translation variance along the weak
 // ones (unknown; held at the start).
-Matrix6d Covariance(const WeightedNormalEquations& eq,
-                    const DataDirections& directions,
+Matrix6d Covariance(const DataDirections& directions,
                     double variance,
                     const ExtrinsicAlignmentOptions& options) {
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(directions.scale * eq.H * directions.scale);
   Matrix6d covariance_y = Matrix6d::Zero();
   for (int k = 0; k < 6; ++k) {
     const double v = k < directions.num_weak
                          ? options.prior_translation_m * options.prior_translation_m
-                         : variance / solver.eigenvalues()(k);
+                         : variance / directions.eigenvalues(k);
     covariance_y += v * directions.vectors.col(k) * directions.vectors.col(k).transpose();
   }
   return directions.scale * covariance_y * directions.scale;
@@ -237,9 +236,8 @@ ExtrinsicAlignmentResult AlignCameraPointsWithLidar(const std::vector<CameraDept
     lidar_from_cam = IsometryFromIncrement(x) * lidar_from_cam;
     const bool small_step = x.head<3>().norm() < options.convergence_rotation_deg * kDegToRad &&
                             x.tail<3>().norm() < options.convergence_translation_m;
-    const double rms = std::sqrt(eq.squared_m / eq.count);
-    const double next_gate = std::max(options.min_correspondence_distance_m,
-                                      std::min(gate, std::max(0.7 * gate, 6 * rms)));
+    const double next_gate = NextIcpGate(
+        gate, std::sqrt(eq.squared_m / eq.count), options.min_correspondence_distance_m);
     if (small_step && next_gate > 0.98 * gate) {
       result.converged = true;
       break;
@@ -256,7 +254,7 @@ ExtrinsicAlignmentResult AlignCameraPointsWithLidar(const std::vector<CameraDept
   result.constraint_ratios = directions.ratios;
   result.num_weak_directions = directions.num_weak;
   const double variance = std::max(1.0, eq.robust_squared / std::max<double>(eq.count - 6, 1));
-  SetSigmas(Covariance(eq, directions, variance, options), result.cam_from_lidar, &result);
+  SetSigmas(Covariance(directions, variance, options), result.cam_from_lidar, &result);
   return result;
 }
 

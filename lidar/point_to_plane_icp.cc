@@ -71,6 +71,10 @@ Eigen::Isometry3d IsometryFromIncrement(const Eigen::Matrix<double, 6, 1>& x) {
   return step;
 }
 
+double NextIcpGate(double gate, double residual_rms, double min_gate) {
+  return std::max(min_gate, std::min(gate, std::max(0.7 * gate, 6 * residual_rms)));
+}
+
 bool IcpOptions::Check() const {
   LIDAR_CHECK_OPTION_GE(max_iterations, 1);
   LIDAR_CHECK_OPTION_GT(min_correspondence_distance, 0);
@@ -107,10 +111,8 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
     const double angle = x.head<3>().norm();
     const bool small_step = angle < options.convergence_rotation_rad &&
                             x.tail<3>().norm() < options.convergence_translation_m;
-    // Shrink the gate towards a few times the residual, never below the minimum.
-    const double rms = std::sqrt(eq.squared_error / eq.count);
-    const double next_gate = std::max(options.min_correspondence_distance,
-                                      std::min(gate, std::max(0.7 * gate, 6 * rms)));
+    const double next_gate = NextIcpGate(
+        gate, std::sqrt(eq.squared_error / eq.count), options.min_correspondence_distance);
     // Converged: a small step with the gate settled (at its floor or at a few times the noise).
     if (small_step && next_gate > 0.98 * gate) {
       result.converged = true;

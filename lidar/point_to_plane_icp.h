@@ -43,6 +43,11 @@ struct IcpResult {
 // x[0..2] [rad], then translation x[3..5] [m] (a left increment, applied as step * pose).
 Eigen::Isometry3d IsometryFromIncrement(const Eigen::Matrix<double, 6, 1>& x);
 
+// The next iteration's association gate: shrunk towards six times the residual RMS, by at most 30 %
+// per iteration, never below `min_gate`. An ICP has converged when its step is small and this gate
+// has settled (above 0.98 of the current one).
+double NextIcpGate(double gate, double residual_rms, double min_gate);
+
 // `target` must have normals and `target_tree` must be built over target.points.
 IcpResult PointToPlaneIcp(const PointCloud& source,
                           const PointCloud& target,

@@ -138,9 +138,13 @@ void RunPoseInitializerStep(const StationDataset& dataset,
         paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
   } else {
     std::vector<colmap::Reconstruction> models = ReadModels(paths.input_path);
-    init = InitializeFromModels(
-        paths.database_path, dataset, paths.registration_path, options, &models, &scales,
-        paths.depth_path);
+    init = InitializeFromModels(paths.database_path,
+                                dataset,
+                                paths.registration_path,
+                                options,
+                                &models,
+                                &scales,
+                                paths.depth_path);
     for (size_t k = 0; k < models.size(); ++k) {
       std::cout << "Model " << k << " (" << models[k].NumRegImages()
                 << " registered images) rescaled to metres by " << scales[k] << std::endl;
