@@ -16,7 +16,7 @@ namespace colmap_lidar {
 
 struct StereoLidarAlignmentOptions {
   // every `pixel_stride`-th pixel of a depth map, in both directions, or a wider stride that keeps
-  // at most `max_pixels_per_station` (a 12 MP map: every 25th)
+  // at most `max_pixels_per_station` (a 12 MP map: every 16th)
   int pixel_stride = 4;
   int max_pixels_per_station = 50000;
   // stereo depths used [m]: beyond `max_depth_m` a disparity step is decimetres
