@@ -186,10 +186,13 @@ ColumnLayout MakeColumnLayout(ceres::Problem* problem,
 }
 
 // The Jacobian of the data residuals (cluster order) and of the regularisers (last rows).
+constexpr int kRegularizerRow = -1;
+constexpr int kMeasurementRow = -2;
+
 struct JacobianRows {
   Eigen::SparseMatrix<double> jacobian;
   std::vector<double> residuals;
-  // Per row: its cluster (-1 for a regulariser) and d(residual)/d(stereo scale).
+  // Per row: its cluster (kRegularizerRow, kMeasurementRow or >= 0) and d(residual)/d(stereo scale).
   std::vector<int> cluster;
   std::vector<double> scale_derivative;
   int num_data_rows = 0;
@@ -200,6 +203,7 @@ JacobianRows EvaluateRows(
     const ColumnLayout& layout,
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
     const std::vector<ceres::ResidualBlockId>& regularizers,
+    const std::vector<ceres::ResidualBlockId>& measurements,
     const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative) {
   JacobianRows rows;
   std::vector<ceres::ResidualBlockId> residual_blocks;
@@ -216,8 +220,9 @@ JacobianRows EvaluateRows(
   for (size_t c = 0; c < clusters.size(); ++c) {
     for (const ceres::ResidualBlockId id : clusters[c]) add(id, static_cast<int>(c));
   }
+  for (const ceres::ResidualBlockId id : measurements) add(id, kMeasurementRow);
   rows.num_data_rows = static_cast<int>(rows.cluster.size());
-  for (const ceres::ResidualBlockId id : regularizers) add(id, -1);
+  for (const ceres::ResidualBlockId id : regularizers) add(id, kRegularizerRow);
   ceres::Problem::EvaluateOptions evaluate_options;
   evaluate_options.parameter_blocks = layout.blocks;
   evaluate_options.residual_blocks = residual_blocks;
@@ -338,7 +343,12 @@ bool ClusterRobust(const JacobianRows& rows,
   const Eigen::MatrixXd y = rows.jacobian * full.solve(selector);
   std::vector<Eigen::VectorXd> scores(num_clusters, Eigen::VectorXd::Zero(num_extrinsic));
   *scale_sensitivity = Eigen::VectorXd::Zero(num_extrinsic);
+  Eigen::MatrixXd known = Eigen::MatrixXd::Zero(num_extrinsic, num_extrinsic);
   for (int row = 0; row < rows.num_data_rows; ++row) {
+    if (rows.cluster[row] == kMeasurementRow) {
+      known += y.row(row).transpose() * y.row(row);
+      continue;
+    }
     scores[rows.cluster[row]] += y.row(row).transpose() * rows.residuals[row];
     *scale_sensitivity -= y.row(row).transpose() * rows.scale_derivative[row];
   }
@@ -355,6 +365,7 @@ bool ClusterRobust(const JacobianRows& rows,
     *sandwich = eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
                 eigen.eigenvectors().transpose();
   }
+  *sandwich += known;
   return sandwich->allFinite();
 }
 
@@ -411,6 +422,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
     const std::vector<std::array<int, 2>>& cluster_groups,
     const std::vector<ceres::ResidualBlockId>& regularizers,
+    const std::vector<ceres::ResidualBlockId>& measurements,
     size_t hidden_residuals,
     const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
     const MotionAnalysis& motion,
@@ -431,7 +443,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
                                                translation_free,
                                                held_translation);
   const JacobianRows rows =
-      EvaluateRows(problem, layout, clusters, regularizers, depth_scale_derivative);
+      EvaluateRows(problem, layout, clusters, regularizers, measurements, depth_scale_derivative);
   const Eigen::SparseMatrix<double> data_jacobian = rows.jacobian.topRows(rows.num_data_rows);
   const Eigen::SparseMatrix<double> data_information =
       (data_jacobian.transpose() * data_jacobian).pruned();

@@ -103,6 +103,9 @@ std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform
 // variance factor's redundancy).
 // `regularizers`: residual blocks that are not data (the weak extrinsic prior): they keep the
 // information invertible for the sandwich but never decide what is observable.
+// `measurements`: whitened residual blocks of measurements with a known covariance (the stereo-LiDAR
+// alignment's E_x): data, whose share of the sandwich is their information J^T J, not a score (one
+// draw of a measurement says nothing about its spread).
 // `held_translation`: translation components held constant by a subset manifold (known exactly).
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     ceres::Problem* problem,
@@ -112,6 +115,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
     const std::vector<std::array<int, 2>>& cluster_groups,
     const std::vector<ceres::ResidualBlockId>& regularizers,
+    const std::vector<ceres::ResidualBlockId>& measurements,
     size_t hidden_residuals,
     const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
     const MotionAnalysis& motion,

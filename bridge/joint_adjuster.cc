@@ -1,6 +1,6 @@
 #include "bridge/joint_adjuster.h"
 
-#include "bridge/extrinsic_hold_cost.h"
+#include "bridge/extrinsic_deviation_cost.h"
 #include "bridge/extrinsic_prior_cost.h"
 #include "bridge/landmark_lidar_plane_cost.h"
 #include "bridge/landmark_lidar_term.h"
@@ -106,6 +106,8 @@ struct JointProblem {
   // Residuals that compressed LiDAR blocks stand for beyond the rows they have.
   size_t num_hidden_residuals = 0;
   std::vector<ceres::ResidualBlockId> landmark_ids;
+  // E_x of the extrinsic measurement (data, known covariance), if any.
+  std::vector<ceres::ResidualBlockId> measurement_ids;
   std::vector<ceres::ResidualBlockId> prior_ids;
 };
 
@@ -249,15 +251,24 @@ void AddExtrinsicBlocks(const RunState& state, JointProblem* joint) {
   if (state.refine_extrinsic &&
       (state.held_rotation.squaredNorm() > 0 || state.held_translation.squaredNorm() > 0)) {
     constexpr double kHoldSigma = 1e-7;  // [rad], [m]: effectively constant
-    joint->prior_ids.push_back(
-        problem->AddResidualBlock(ExtrinsicHoldCostFunctor::Create(state.initial_rotation,
-                                                                   state.initial_translation,
-                                                                   state.held_rotation,
-                                                                   state.held_translation,
-                                                                   kHoldSigma),
-                                  nullptr,
-                                  rotation,
-                                  translation));
+    joint->prior_ids.push_back(problem->AddResidualBlock(
+        ExtrinsicDeviationCostFunctor::Create(
+            state.initial_rotation,
+            state.initial_translation,
+            WhiteningOfHeldDirections(state.held_rotation, state.held_translation, kHoldSigma)),
+        nullptr,
+        rotation,
+        translation));
+  }
+  const std::optional<ExtrinsicMeasurement>& measurement = state.data.extrinsic_measurement;
+  if (state.refine_extrinsic && measurement) {
+    joint->measurement_ids.push_back(problem->AddResidualBlock(
+        ExtrinsicDeviationCostFunctor::Create(measurement->cam_from_lidar.rotation,
+                                              measurement->cam_from_lidar.translation,
+                                              WhiteningOfCovariance(measurement->covariance)),
+        nullptr,
+        rotation,
+        translation));
   }
   if (state.refine_extrinsic && held.size() < 3 && state.options.extrinsic_prior_sigma_m > 0) {
     joint->prior_ids.push_back(problem->AddResidualBlock(
@@ -686,6 +697,7 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
       state.options.observability.two_way_lidar_clusters ? clusters.groups
                                                          : std::vector<std::array<int, 2>>(),
       joint.prior_ids,
+      joint.measurement_ids,
       joint.num_hidden_residuals,
       depth_scale_derivative,
       motion,
@@ -700,7 +712,7 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
   return uncertainty;
 }
 
-// The paper's perturbation curves: only E_l (and E_m) depend on T_e, so the total is the rest
+// The paper's perturbation curves: only E_l (and E_m, E_x) depend on T_e, so the total is the rest
 // (constant) plus those terms at the perturbed T_e. Offsets are true rotation angles about the camera axes.
 std::vector<PerturbationCurve> PerturbationCurves(const RunState& state, JointProblem* joint) {
   ceres::Problem* problem = joint->problem.get();
@@ -725,7 +737,8 @@ std::vector<PerturbationCurve> PerturbationCurves(const RunState& state, JointPr
       }
       curve.offsets.push_back(offset);
       curve.costs.push_back(rest + TermCost(problem, joint->lidar_ids) +
-                            TermCost(problem, joint->landmark_ids));
+                            TermCost(problem, joint->landmark_ids) +
+                            TermCost(problem, joint->measurement_ids));
     }
     curves.push_back(curve);
   }

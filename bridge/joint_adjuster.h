@@ -36,6 +36,7 @@
 
 #include <array>
 #include <map>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -121,7 +122,7 @@ struct JointAdjusterOptions {
   double extrinsic_prior_sigma_m = 1.0;
   // Never drift: when the solve finds directions of T_e unobservable (their standard deviation above
   // hold_rotation_deg / hold_translation_mm), the adjustment runs again from the initial state with
-  // those directions held at their initial value (bridge/extrinsic_hold_cost.h); the report names them.
+  // those directions held at their initial value (bridge/extrinsic_deviation_cost.h); the report names them.
   bool hold_unobservable = true;
   // Above the reporting thresholds of `observability` (5 mm / 0.2 deg: "not calibrated to that"): a
   // direction the data know to 6 mm (a car's height from landmarks on the road, E_m) beats an initial
@@ -135,6 +136,15 @@ struct JointAdjusterOptions {
   bool Check() const;
 };
 
+// A measurement of T_e made outside the joint problem (the pose initialiser's stereo-LiDAR alignment):
+// cam_from_lidar and its 6x6 covariance, rotation [rad] about the camera axes (left of the rotation)
+// then translation [m].
+struct ExtrinsicMeasurement {
+  colmap::Rigid3d cam_from_lidar;
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();
+  std::string source;  // for reports, e.g. "stereo-LiDAR alignment"
+};
+
 // What the joint problem needs besides COLMAP's reconstruction. Borrowed by JointAdjuster::Run for the
 // duration of the call only.
 struct JointProblemData {
@@ -145,6 +155,8 @@ struct JointProblemData {
   std::map<colmap::image_t, const StationCloud*> clouds;
   // The pose graph A_c v A_l as unordered image pairs; LiDAR observations are drawn in both directions.
   std::vector<std::pair<colmap::image_t, colmap::image_t>> pairs;
+  // Joins the cost as E_x (bridge/extrinsic_deviation_cost.h) in joint mode; absent: not used.
+  std::optional<ExtrinsicMeasurement> extrinsic_measurement;
 };
 
 struct TermStats {

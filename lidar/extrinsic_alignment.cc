@@ -20,6 +20,8 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 struct WeightedNormalEquations {
   Matrix6d H = Matrix6d::Zero();
   Vector6d g = Vector6d::Zero();
+  // sum w J dr/ds, s a relative scale of every depth (p_cam -> (1 + s) p_cam)
+  Vector6d scale_gradient = Vector6d::Zero();
   double squared_m = 0;       // sum r^2 of the associations
   double squared_sigmas = 0;  // sum (r / sigma)^2
   double robust_squared = 0;  // sum w (r / sigma)^2
@@ -29,6 +31,7 @@ struct WeightedNormalEquations {
   void Add(const WeightedNormalEquations& other) {
     H += other.H;
     g += other.g;
+    scale_gradient += other.scale_gradient;
     squared_m += other.squared_m;
     squared_sigmas += other.squared_sigmas;
     robust_squared += other.robust_squared;
@@ -69,6 +72,7 @@ WeightedNormalEquations StationEquations(const CameraDepthPoints& points,
     J << p.cross(n), n;
     eq.H.noalias() += w * J * J.transpose();
     eq.g.noalias() += w * J * r;
+    eq.scale_gradient.noalias() += w * J * n.dot(p - camera_in_lidar);
     eq.squared_m += r * r;
     eq.squared_sigmas += z * z;
     eq.robust_squared += huber * z * z;
@@ -78,19 +82,31 @@ WeightedNormalEquations StationEquations(const CameraDepthPoints& points,
   return eq;
 }
 
-WeightedNormalEquations AllEquations(const std::vector<CameraDepthPoints>& points,
-                                     const std::vector<const StationCloud*>& clouds,
-                                     const Eigen::Isometry3d& lidar_from_cam,
-                                     double gate,
-                                     const ExtrinsicAlignmentOptions& options) {
+std::vector<WeightedNormalEquations> StationEquationsOfAll(
+    const std::vector<CameraDepthPoints>& points,
+    const std::vector<const StationCloud*>& clouds,
+    const Eigen::Isometry3d& lidar_from_cam,
+    double gate,
+    const ExtrinsicAlignmentOptions& options) {
   std::vector<WeightedNormalEquations> per_station(points.size());
 #pragma omp parallel for schedule(dynamic)
   for (int i = 0; i < static_cast<int>(points.size()); ++i) {
     per_station[i] = StationEquations(points[i], *clouds[i], lidar_from_cam, gate, options);
   }
+  return per_station;
+}
+
+WeightedNormalEquations Sum(const std::vector<WeightedNormalEquations>& per_station) {
   WeightedNormalEquations total;
   for (const WeightedNormalEquations& eq : per_station) total.Add(eq);
   return total;
+}
+
+int NumStationsWithAssociations(const std::vector<WeightedNormalEquations>& per_station) {
+  return static_cast<int>(
+      std::count_if(per_station.begin(), per_station.end(), [](const WeightedNormalEquations& eq) {
+        return eq.count > 0;
+      }));
 }
 
 // The weak prior's information and its pull towards the start, in the same increment coordinates.
@@ -167,19 +183,63 @@ Matrix6d Covariance(const DataDirections& directions,
   return directions.scale * covariance_y * directions.scale;
 }
 
-// Sigmas of cam_from_lidar about / along the camera's axes: lidar_from_cam <- exp(d) lidar_from_cam
-// is cam_from_lidar <- cam_from_lidar exp(-d), a change R (-omega) of its rotation and -R t of its
-// translation in the camera frame, R = cam_from_lidar's rotation.
-void SetSigmas(const Matrix6d& covariance_in_lidar,
-               const Eigen::Isometry3d& cam_from_lidar,
-               ExtrinsicAlignmentResult* result) {
+// Covariance of the increment [omega, t] in the LiDAR frame from the scatter of the stations' own
+// scores g_s = sum w J r (cluster-robust, a sandwich H^-1 (G / (G - 1)) sum_s g_s g_s^T H^-1): errors
+// shared within a station (a stereo bias over a surface, the cloud's normals) count once per station,
+// not once per point. The weak directions keep the prior's translation variance.
+Matrix6d StationClusteredCovariance(const std::vector<WeightedNormalEquations>& per_station,
+                                    const DataDirections& directions,
+                                    const ExtrinsicAlignmentOptions& options) {
+  Matrix6d inverse_y = Matrix6d::Zero();  // (scale H scale)^+ over the determined directions
+  Matrix6d weak_y = Matrix6d::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const Matrix6d outer = directions.vectors.col(k) * directions.vectors.col(k).transpose();
+    if (k < directions.num_weak) {
+      weak_y += options.prior_translation_m * options.prior_translation_m * outer;
+    } else {
+      inverse_y += outer / directions.eigenvalues(k);
+    }
+  }
+  Matrix6d meat_y = Matrix6d::Zero();
+  const double num_stations = NumStationsWithAssociations(per_station);
+  for (const WeightedNormalEquations& eq : per_station) {
+    if (eq.count == 0) continue;
+    const Vector6d score_y = directions.scale * eq.g;
+    meat_y += score_y * score_y.transpose();
+  }
+  if (num_stations > 1) meat_y *= num_stations / (num_stations - 1);
+  return directions.scale * (inverse_y * meat_y * inverse_y + weak_y) * directions.scale;
+}
+
+// A depth scale error s common to every station (a stereo baseline or focal length off, a sub-pixel
+// bias) moves the solution by dx/ds = -H^+ sum w J dr/ds; no scatter of residuals reveals it, so it
+// enters as a consider parameter, sigma_s^2 (dx/ds)(dx/ds)^T.
+Matrix6d DepthScaleCovariance(const WeightedNormalEquations& eq,
+                              const DataDirections& directions,
+                              const ExtrinsicAlignmentOptions& options) {
+  Vector6d response_y = Vector6d::Zero();
+  const Vector6d gradient_y = directions.scale * eq.scale_gradient;
+  for (int k = directions.num_weak; k < 6; ++k) {
+    response_y -= directions.vectors.col(k) * directions.vectors.col(k).dot(gradient_y) /
+                  directions.eigenvalues(k);
+  }
+  const Vector6d response = directions.scale * response_y;
+  return options.depth_scale_sigma * options.depth_scale_sigma * response * response.transpose();
+}
+
+// cam_from_lidar's covariance about / along the camera's axes: lidar_from_cam <- exp(d)
+// lidar_from_cam is cam_from_lidar <- cam_from_lidar exp(-d), a change R (-omega) of its rotation
+// (left of it) and -R t of its translation in the camera frame, R = cam_from_lidar's rotation.
+void SetCovariance(const Matrix6d& covariance_in_lidar,
+                   const Eigen::Isometry3d& cam_from_lidar,
+                   ExtrinsicAlignmentResult* result) {
   Matrix6d to_cam = Matrix6d::Zero();
   to_cam.topLeftCorner<3, 3>() = cam_from_lidar.linear();
   to_cam.bottomRightCorner<3, 3>() = cam_from_lidar.linear();
-  const Matrix6d covariance = to_cam * covariance_in_lidar * to_cam.transpose();
+  result->covariance_in_cam = to_cam * covariance_in_lidar * to_cam.transpose();
   for (int axis = 0; axis < 3; ++axis) {
-    result->sigma_rotation_deg[axis] = std::sqrt(covariance(axis, axis)) / kDegToRad;
-    result->sigma_translation_m[axis] = std::sqrt(covariance(3 + axis, 3 + axis));
+    result->sigma_rotation_deg[axis] = std::sqrt(result->covariance_in_cam(axis, axis)) / kDegToRad;
+    result->sigma_translation_m[axis] = std::sqrt(result->covariance_in_cam(3 + axis, 3 + axis));
   }
 }
 
@@ -198,6 +258,8 @@ bool ExtrinsicAlignmentOptions::Check() const {
   LIDAR_CHECK_OPTION_GT(prior_translation_m, 0);
   LIDAR_CHECK_OPTION_GT(convergence_rotation_deg, 0);
   LIDAR_CHECK_OPTION_GT(convergence_translation_m, 0);
+  LIDAR_CHECK_OPTION_GE(min_station_clusters, 2);
+  LIDAR_CHECK_OPTION_GE(depth_scale_sigma, 0);
   return true;
 }
 
@@ -225,7 +287,7 @@ ExtrinsicAlignmentResult AlignCameraPointsWithLidar(const std::vector<CameraDept
   double gate = options.max_correspondence_distance_m;
   WeightedNormalEquations eq;
   for (int it = 0; it < options.max_iterations; ++it) {
-    eq = AllEquations(points, clouds, lidar_from_cam, gate, options);
+    eq = Sum(StationEquationsOfAll(points, clouds, lidar_from_cam, gate, options));
     result.iterations = it + 1;
     if (eq.count < 6) break;
     const DataDirections directions = AnalyseDirections(eq, options.min_constraint_ratio);
@@ -244,7 +306,9 @@ ExtrinsicAlignmentResult AlignCameraPointsWithLidar(const std::vector<CameraDept
     }
     gate = next_gate;
   }
-  eq = AllEquations(points, clouds, lidar_from_cam, gate, options);
+  const std::vector<WeightedNormalEquations> per_station =
+      StationEquationsOfAll(points, clouds, lidar_from_cam, gate, options);
+  eq = Sum(per_station);
   result.cam_from_lidar = lidar_from_cam.inverse();
   result.num_associations = eq.count;
   if (eq.count < 6) return result;
@@ -254,7 +318,13 @@ ExtrinsicAlignmentResult AlignCameraPointsWithLidar(const std::vector<CameraDept
   result.constraint_ratios = directions.ratios;
   result.num_weak_directions = directions.num_weak;
   const double variance = std::max(1.0, eq.robust_squared / std::max<double>(eq.count - 6, 1));
-  SetSigmas(Covariance(directions, variance, options), result.cam_from_lidar, &result);
+  Matrix6d covariance = Covariance(directions, variance, options);
+  const Matrix6d station_covariance = StationClusteredCovariance(per_station, directions, options);
+  result.num_station_clusters = NumStationsWithAssociations(per_station);
+  result.station_clustered = result.num_station_clusters >= options.min_station_clusters;
+  if (result.station_clustered) covariance = station_covariance;
+  covariance += DepthScaleCovariance(eq, directions, options);
+  SetCovariance(covariance, result.cam_from_lidar, &result);
   return result;
 }
 

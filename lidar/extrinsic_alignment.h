@@ -42,6 +42,13 @@ struct ExtrinsicAlignmentOptions {
   // converged when a step is below both and the gate has settled
   double convergence_rotation_deg = 1e-4;
   double convergence_translation_m = 1e-5;
+  // With at least this many stations with associations, the covariance is clustered by station (a
+  // sandwich over the stations' scores); with fewer, the formal one (independent residuals).
+  int min_station_clusters = 10;
+  // Relative error of every depth's scale, common to all stations (a stereo baseline or focal length
+  // off, a sub-pixel bias): a consider parameter added to the covariance (as the joint's
+  // ObservabilityOptions::stereo_scale_sigma); 0: none.
+  double depth_scale_sigma = 0.001;
 
   bool Check() const;
 };
@@ -61,9 +68,17 @@ struct ExtrinsicAlignmentResult {
   size_t num_associations = 0;  // within the final gate on a planar LiDAR sample
   double rms_m = 0;             // point-to-plane RMS of the associations [m]
   double rms_sigmas = 0;        // the same in units of each residual's sigma
-  // 1-sigma of cam_from_lidar from the Gauss-Newton Hessian scaled by the residual variance, rotation
-  // about and translation along the camera's axes. Residuals of one surface share errors, so these
-  // are lower bounds; a value near the prior's says the scenes do not constrain that direction.
+  // Covariance of cam_from_lidar: rotation [rad] about the camera's axes (a rotation vector left of
+  // the rotation, R = exp(w) R_0), then translation [m] along them. Clustered by station when
+  // `station_clustered` (residuals of one station share errors: its stereo biases and its cloud's
+  // normals); else the formal one from the Gauss-Newton Hessian scaled by the residual variance,
+  // which treats every residual as independent (a lower bound). A direction the scenes do not
+  // constrain gets the prior's variance. Both include a depth scale error common to every station
+  // (options.depth_scale_sigma).
+  Eigen::Matrix<double, 6, 6> covariance_in_cam = Eigen::Matrix<double, 6, 6>::Zero();
+  bool station_clustered = false;
+  int num_station_clusters = 0;  // stations with associations
+  // Its square roots on the diagonal, in degrees and metres.
   Eigen::Vector3d sigma_rotation_deg = Eigen::Vector3d::Zero();
   Eigen::Vector3d sigma_translation_m = Eigen::Vector3d::Zero();
   // Eigenvalues of the data's information in [rotation * lever arm, translation], weakest first,

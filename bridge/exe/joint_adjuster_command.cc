@@ -1,6 +1,7 @@
 // colmap-lidar joint_adjuster: the joint problem on a COLMAP sparse model (bridge/joint_adjuster.h).
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
+#include "bridge/exe/stereo_alignment_report.h"
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
 #include "bridge/lidar_registration_files.h"
@@ -14,10 +15,12 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace colmap_lidar {
@@ -322,6 +325,10 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("two_way_lidar_clusters", &adjuster.observability.two_way_lidar_clusters);
   add.Add("unobservable_translation_mm", &adjuster.observability.unobservable_translation_mm);
   add.Add("unobservable_rotation_deg", &adjuster.observability.unobservable_rotation_deg);
+  add.Add("use_stereo_alignment",
+          &options->use_stereo_alignment,
+          "take INPUT/initialization.json's stereo-LiDAR alignment as a measurement of "
+          "cam_from_lidar");
   add.Add("write_text", &options->write_text, "also write cameras.txt, images.txt, points3D.txt");
 }
 
@@ -330,6 +337,8 @@ namespace {
 // What pose_initializer wrote about its start (INPUT/initialization.json), if anything.
 struct InitialisationFacts {
   bool one_axis = false;  // every rotation about one axis (a driving platform)
+  // The stereo-LiDAR alignment, if it was used.
+  std::optional<ExtrinsicMeasurement> stereo_alignment;
 };
 
 // A model without one (e.g. the user's own) has no facts; an unreadable one is an error naming it.
@@ -344,7 +353,16 @@ InitialisationFacts ReadInitialisationFacts(const std::string& input_path) {
   }
   facts.one_axis = init.contains("hand_eye") &&
                    init["hand_eye"].contains("unobservable_translation_axis_in_cam");
+  facts.stereo_alignment = ReadStereoAlignmentMeasurement(init, path.string());
   return facts;
+}
+
+void PrintMeasurement(const ExtrinsicMeasurement& measurement) {
+  const Eigen::Matrix<double, 6, 1> sigmas = measurement.covariance.diagonal().cwiseSqrt();
+  std::cout << "cam_from_lidar measured by the " << measurement.source
+            << " joins the cost: sigma about the camera axes "
+            << sigmas.head<3>().transpose() * 180 / M_PI << " deg, along them "
+            << 1000 * sigmas.tail<3>().transpose() << " mm" << std::endl;
 }
 
 // A moving platform: rig.json's clouds are sweeps, or initialization.json reports a one-axis
@@ -420,6 +438,11 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                            options.data);
   std::cout << "Loaded depth priors, clouds and the pose graph (" << SecondsSince(start) << " s)"
             << std::endl;
+  if (options.use_stereo_alignment && facts.stereo_alignment &&
+      options.adjuster.mode == JointMode::kJoint) {
+    loaded->data.extrinsic_measurement = facts.stereo_alignment;
+    PrintMeasurement(*facts.stereo_alignment);
+  }
   const JointAdjustmentSummary summary =
       JointAdjuster(options.adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);
 

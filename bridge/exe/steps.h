@@ -150,6 +150,10 @@ struct JointAdjusterStepOptions {
   double landmark_lidar_weight = -1;
   // LiDAR samples per pair (int for the OptionManager); into `adjuster.association` by Check().
   int num_samples_per_pair = static_cast<int>(JointAdjusterOptions().association.num_samples);
+  // Take the pose initialiser's stereo-LiDAR alignment (INPUT/initialization.json) as a measurement
+  // of cam_from_lidar in joint mode, when it was used and its covariance is clustered by station
+  // (StereoLidarAlignment's min_station_clusters stations with associations).
+  bool use_stereo_alignment = true;
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
   bool write_text = false;
 

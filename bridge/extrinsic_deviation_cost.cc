@@ -1,0 +1,30 @@
+#include "bridge/extrinsic_deviation_cost.h"
+
+#include <Eigen/Cholesky>
+
+#include <stdexcept>
+
+namespace colmap_lidar {
+
+Matrix6d WhiteningOfCovariance(const Matrix6d& covariance) {
+  if (!covariance.allFinite() || !covariance.isApprox(covariance.transpose(), 1e-9)) {
+    throw std::invalid_argument("an extrinsic covariance must be finite and symmetric");
+  }
+  const Eigen::LLT<Matrix6d> information(covariance.inverse());
+  if (information.info() != Eigen::Success || !covariance.inverse().allFinite()) {
+    throw std::invalid_argument("an extrinsic covariance must be positive definite");
+  }
+  // information = L L^T, so W = L^T gives W^T W = information.
+  return information.matrixL().transpose();
+}
+
+Matrix6d WhiteningOfHeldDirections(const Eigen::Matrix3d& rotation_projection,
+                                   const Eigen::Matrix3d& translation_projection,
+                                   double sigma) {
+  Matrix6d whitening = Matrix6d::Zero();
+  whitening.topLeftCorner<3, 3>() = rotation_projection / sigma;
+  whitening.bottomRightCorner<3, 3>() = translation_projection / sigma;
+  return whitening;
+}
+
+}  // namespace colmap_lidar
