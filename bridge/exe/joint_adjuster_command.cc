@@ -65,6 +65,25 @@ nlohmann::json PoseJson(const colmap::Rigid3d& pose) {
           {"tz", pose.translation.z()}};
 }
 
+// The measurement of T_e that joined the cost, and how far the result lies from it in its own
+// sigmas (the Mahalanobis distance of the rotation vector and translation difference).
+nlohmann::json MeasurementJson(const ExtrinsicMeasurement& measurement,
+                               const colmap::Rigid3d& refined) {
+  const Eigen::AngleAxisd rotation(refined.rotation *
+                                   measurement.cam_from_lidar.rotation.inverse());
+  Eigen::Matrix<double, 6, 1> difference;
+  difference << rotation.angle() * rotation.axis(),
+      refined.translation - measurement.cam_from_lidar.translation;
+  const Eigen::Matrix<double, 6, 1> sigmas = measurement.covariance.diagonal().cwiseSqrt();
+  return {{"source", measurement.source},
+          {"cam_from_lidar", PoseJson(measurement.cam_from_lidar)},
+          {"sigma_rotation_deg_in_cam",
+           {sigmas(0) * 180 / M_PI, sigmas(1) * 180 / M_PI, sigmas(2) * 180 / M_PI}},
+          {"sigma_translation_mm_in_cam", {1000 * sigmas(3), 1000 * sigmas(4), 1000 * sigmas(5)}},
+          {"result_mahalanobis_distance",
+           std::sqrt(difference.dot(measurement.covariance.ldlt().solve(difference)))}};
+}
+
 nlohmann::json MatrixJson(const Eigen::MatrixXd& matrix) {
   nlohmann::json rows = nlohmann::json::array();
   for (int r = 0; r < matrix.rows(); ++r) {
@@ -146,6 +165,9 @@ void WriteReport(const std::string& directory,
                              {"lidar_residuals", summary.final_lidar_residuals},
                              {"landmark_lidar_residuals", summary.final_landmark_lidar_residuals}};
   report["landmark_lidar_weight"] = options.landmark_lidar_weight;
+  if (loaded.data.extrinsic_measurement) {
+    report["extrinsic_measurement"] = MeasurementJson(*loaded.data.extrinsic_measurement, refined);
+  }
   const ExtrinsicUncertainty& u = summary.uncertainty;
   report["uncertainty"] = UncertaintyJson(u, options.observability, caveat);
   report["unobservable"] = u.unobservable;

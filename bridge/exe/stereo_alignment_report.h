@@ -20,7 +20,8 @@ nlohmann::json StereoAlignmentJson(const StereoLidarAlignment& alignment);
 
 // The measurement of `initialization` (the parsed initialization.json at `path`), if its alignment
 // was used and its covariance is clustered by station (enough stations to measure the spread of
-// their errors); nullopt otherwise. Throws naming `path` when the block is malformed.
+// their errors), with the covariance's diagonal only (see the .cc); nullopt otherwise. Throws naming
+// `path` when the block is malformed.
 std::optional<ExtrinsicMeasurement> ReadStereoAlignmentMeasurement(
     const nlohmann::json& initialization, const std::string& path);
 
