@@ -14,6 +14,9 @@
 //   (bridge/lidar_point_to_plane_cost.h).
 // - Optional (not in the paper; on by default for a monocular rig): the landmark-to-LiDAR-plane
 //   residual E_m = n^T (lidar_i_from_world X - q) / sigma_m with w_m (bridge/landmark_lidar_plane_cost.h).
+// - Optional (not in the paper): a measurement of T_e made outside the problem (the pose initialiser's
+//   stereo-LiDAR alignment), E_x = W [rotvec(R_e R_x^-1); t_e - t_x] with W^T W its inverse covariance
+//   (bridge/extrinsic_deviation_cost.h; JointProblemData::extrinsic_measurement).
 // - E_f = COLMAP's reprojection residual in pixels (sigma_p = 1 px); E_d = the depth-prior residual
 //   (colmap_ext/depth_prior_cost.h), z-depth with sigma_d = d^2/(b f) sigma_p.
 // - Gauge: the first station's (smallest image_id's) pose is constant. Metric scale comes from the depth
