@@ -158,6 +158,22 @@ TEST(SimilarityHandEye, LeavesOutMotionsThatContradictTheFit) {
       << inconsistent.message;
 }
 
+// The only turn of a drive contradicts the fit (its translation flipped) and is left out: no turn is
+// left to give the axis, and that is said, not fitted with a zero axis.
+TEST(SimilarityHandEye, NoTurnLeftAfterContradictionsIsDegenerate) {
+  std::vector<HandEyeMotion> motions = Conjugate({Motion(7, {0, 1, 0}, {0.6, 0, 3.8}),
+                                                  Motion(0, {0, 1, 0}, {0.02, 0, 5.0}),
+                                                  Motion(0.5, {0, 1, 0}, {0.1, 0, 4.5}),
+                                                  Motion(-1, {0, 1, 0}, {0.4, 0, 2.5})});
+  for (HandEyeMotion& motion : motions) motion.cam_i_from_cam_j.translation.normalize();
+  motions[0].cam_i_from_cam_j.translation *= -1;
+  const HandEyeResult result =
+      SolveSimilarityHandEye(motions, HandEyeOptions(), Eigen::Vector3d::Zero(), true);
+  EXPECT_FALSE(result.rotation_unique);
+  EXPECT_NE(result.message.find("the turns contradict the fit"), std::string::npos)
+      << result.message;
+}
+
 TEST(SimilarityHandEye, StraightDrivingIsDegenerate) {
   const HandEyeResult result = SolveSimilarityHandEye(
       UpToScale(Conjugate({Motion(0, {0, 1, 0}, {0, 0, 4.0}), Motion(0, {0, 1, 0}, {0, 0, 5.0})}),

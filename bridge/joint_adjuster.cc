@@ -10,6 +10,7 @@
 #include "colmap_ext/elapsed.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
+#include "lidar/statistics.h"
 
 #include "colmap/estimators/bundle_adjustment.h"
 #include "colmap/estimators/cost_functions.h"
@@ -427,9 +428,7 @@ size_t RemoveReprojectionOutliers(RunState* state) {
 double RobustScale(std::vector<double> normalised) {
   constexpr double kMinScale = 0.1;
   if (normalised.empty()) return 1.0;
-  const auto middle = normalised.begin() + normalised.size() / 2;
-  std::nth_element(normalised.begin(), middle, normalised.end());
-  return std::clamp(1.4826 * *middle, kMinScale, 1.0);
+  return std::clamp(1.4826 * Median(std::move(normalised)), kMinScale, 1.0);
 }
 
 // Depth priors: the outlier set recomputed from the current state (a prior that fits again comes

@@ -7,6 +7,7 @@
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "lidar/pose_graph.h"
+#include "lidar/statistics.h"
 
 #include "colmap/controllers/incremental_mapper.h"
 #include "colmap/estimators/cost_functions.h"
@@ -335,8 +336,7 @@ double DepthPriorScale(const std::string& database_path, const colmap::Reconstru
                              " landmark observations carry a depth prior (run "
                              "depth_prior_extractor on the model's database)");
   }
-  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
-  return ratios[ratios.size() / 2];
+  return Median(std::move(ratios));
 }
 
 // The model's relative motions paired with the LiDAR's over lidar_registrator's pairs (by station:

@@ -2,6 +2,7 @@
 
 #include "lidar/atomic_file.h"
 #include "lidar/pcd_header.h"
+#include "lidar/statistics.h"
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
@@ -608,8 +609,7 @@ PointCloud ReadStationCloud(const std::string& path, CloudReadStats* stats) {
   std::vector<double> ranges;
   const size_t stride = std::max<size_t>(1, cloud.Size() / 10000);
   for (size_t i = 0; i < cloud.Size(); i += stride) ranges.push_back(cloud.points[i].norm());
-  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
-  const double median = ranges[ranges.size() / 2];
+  const double median = Median(std::move(ranges));
   if (median > kMaxMedianRangeM) {
     std::ostringstream problem;
     problem << "the median range from the sensor is " << std::fixed << std::setprecision(0)

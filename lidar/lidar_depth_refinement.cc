@@ -1,6 +1,7 @@
 #include "lidar/lidar_depth_refinement.h"
 
 #include "lidar/check_option.h"
+#include "lidar/statistics.h"
 
 #include <algorithm>
 #include <cmath>
@@ -106,9 +107,7 @@ int AutomaticWindowRadius(const LidarSurface& surface,
     }
   }
   if (spacing_px.empty()) return 3;
-  std::nth_element(
-      spacing_px.begin(), spacing_px.begin() + spacing_px.size() / 2, spacing_px.end());
-  return std::clamp(static_cast<int>(std::lround(1.5 * spacing_px[spacing_px.size() / 2])), 3, 30);
+  return std::clamp(static_cast<int>(std::lround(1.5 * Median(std::move(spacing_px)))), 3, 30);
 }
 
 // The visible samples (those owning a pixel of the z-buffer), bucketed in square cells of the window

@@ -3,6 +3,7 @@
 #include "lidar/check_option.h"
 #include "lidar/kd_tree.h"
 #include "lidar/point_to_plane_icp.h"
+#include "lidar/statistics.h"
 #include "lidar/voxel_accumulator.h"
 
 #include <Eigen/Dense>
@@ -39,10 +40,7 @@ double DistanceToSampledSurface(const PointCloud& truth,
 namespace {
 
 double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0;
-  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
+  return values.empty() ? 0 : Quantile(std::move(values), q);
 }
 
 // The sampling spacing of the truth: median nearest-neighbour distance over a subset.

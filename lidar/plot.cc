@@ -1,6 +1,7 @@
 #include "lidar/plot.h"
 
 #include "lidar/atomic_file.h"
+#include "lidar/statistics.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -127,10 +128,7 @@ void WriteHistogramPng(const std::string& path,
   cv::Mat canvas(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
   double max_value = options.max_value;
   if (max_value <= 0 && !values.empty()) {
-    std::vector<double> sorted = values;
-    const size_t k = static_cast<size_t>(0.99 * (sorted.size() - 1));
-    std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-    max_value = sorted[k];
+    max_value = Quantile(values, 0.99);
   }
   if (max_value <= 0) max_value = 1.0 / options.value_scale;  // one unit on the axis
   const int bins = std::max(1, options.num_bins);

@@ -1,6 +1,7 @@
 #include "lidar/speed_consistency.h"
 
 #include "lidar/check_option.h"
+#include "lidar/statistics.h"
 
 #include <algorithm>
 #include <array>
@@ -28,13 +29,6 @@ struct EdgeSpeed {
   double m_per_frame = 0;
   Eigen::Vector3d velocity;  // target_from_source translation per frame, source after target
 };
-
-double Median(std::vector<double> values) {
-  const size_t half = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + half, values.end());
-  if (values.size() % 2 == 1) return values[half];
-  return 0.5 * (values[half] + *std::max_element(values.begin(), values.begin() + half));
-}
 
 }  // namespace
 

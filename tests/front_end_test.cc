@@ -4,6 +4,7 @@
 #include "bridge/lidar_registration_files.h"
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/station_dataset.h"
+#include "lidar/statistics.h"
 #include "tests/simulator/scene.h"
 #include "tests/simulator/simulate_dataset.h"
 #include "tests/testing/run_command.h"
@@ -33,13 +34,6 @@ using testing::RunCommand;
 const std::string kCli = COLMAP_LIDAR_CLI_EXE;
 const std::string kColmap = COLMAP_LIDAR_COLMAP_EXE;
 const std::string kSift = " --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2";
-
-double Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
-}
 
 std::string FileBytes(const std::string& path) {
   std::ifstream file(path, std::ios::binary);

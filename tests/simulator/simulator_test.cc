@@ -4,6 +4,7 @@
 #include "lidar/cloud_io.h"
 #include "lidar/kd_tree.h"
 #include "lidar/model_evaluation.h"
+#include "lidar/statistics.h"
 #include "tests/simulator/renderer.h"
 #include "tests/simulator/scene.h"
 #include "tests/simulator/simulate_dataset.h"
@@ -21,12 +22,6 @@
 
 namespace colmap_lidar {
 namespace {
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return std::nan("");
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
 
 double Bilinear(const cv::Mat& image, double x, double y) {
   // (x, y) in COLMAP's convention: pixel centres at +0.5.

@@ -2,6 +2,7 @@
 
 #include "lidar/kd_tree.h"
 #include "lidar/spherical_range_image.h"
+#include "lidar/statistics.h"
 #include "lidar/voxel_accumulator.h"
 
 #include <algorithm>
@@ -132,8 +133,7 @@ double MedianPointSpacing(const PointCloud& cloud) {
     if (squared.size() == 2) distances.push_back(std::sqrt(squared[1]));
   }
   if (distances.empty()) return 0;
-  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-  return distances[distances.size() / 2];
+  return Median(std::move(distances));
 }
 
 SyntheticWorld WorldOfSurface(std::shared_ptr<const PointCloud> surface, double ground_z) {
