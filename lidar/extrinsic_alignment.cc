@@ -167,48 +167,52 @@ Vector6d WithoutWeakDirections(const Vector6d& x, const DataDirections& directio
   return directions.scale * y;
 }
 
+// (scale H scale)^+ over the directions the data determine, in y; and the prior's translation
+// variance along the weak ones (unknown; held at the start).
+Matrix6d DeterminedInverseY(const DataDirections& directions) {
+  Matrix6d inverse_y = Matrix6d::Zero();
+  for (int k = directions.num_weak; k < 6; ++k) {
+    inverse_y += directions.vectors.col(k) * directions.vectors.col(k).transpose() /
+                 directions.eigenvalues(k);
+  }
+  return inverse_y;
+}
+
+Matrix6d WeakCovarianceY(const DataDirections& directions,
+                         const ExtrinsicAlignmentOptions& options) {
+  Matrix6d weak_y = Matrix6d::Zero();
+  for (int k = 0; k < directions.num_weak; ++k) {
+    weak_y += directions.vectors.col(k) * directions.vectors.col(k).transpose();
+  }
+  return options.prior_translation_m * options.prior_translation_m * weak_y;
+}
+
 // Covariance of the increment [omega, t] in the LiDAR frame: the data's (scaled by the residual
-// variance) along the directions they determine, the prior's translation variance along the weak
-// ones (unknown; held at the start).
+// variance) along the directions they determine, the prior's along the weak ones.
 Matrix6d Covariance(const DataDirections& directions,
                     double variance,
                     const ExtrinsicAlignmentOptions& options) {
-  Matrix6d covariance_y = Matrix6d::Zero();
-  for (int k = 0; k < 6; ++k) {
-    const double v = k < directions.num_weak
-                         ? options.prior_translation_m * options.prior_translation_m
-                         : variance / directions.eigenvalues(k);
-    covariance_y += v * directions.vectors.col(k) * directions.vectors.col(k).transpose();
-  }
-  return directions.scale * covariance_y * directions.scale;
+  return directions.scale *
+         (variance * DeterminedInverseY(directions) + WeakCovarianceY(directions, options)) *
+         directions.scale;
 }
 
-// Covariance of the increment [omega, t] in the LiDAR frame from the scatter of the stations' own
-// scores g_s = sum w J r (cluster-robust, a sandwich H^-1 (G / (G - 1)) sum_s g_s g_s^T H^-1): errors
-// shared within a station (a stereo bias over a surface, the cloud's normals) count once per station,
-// not once per point. The weak directions keep the prior's translation variance.
+// The same from the scatter of the stations' own scores g_s = sum w J r (cluster-robust, a sandwich
+// H^-1 (G / (G - 1)) sum_s g_s g_s^T H^-1): errors shared within a station (a stereo bias over a
+// surface, the cloud's normals) count once per station, not once per point.
 Matrix6d StationClusteredCovariance(const std::vector<WeightedNormalEquations>& per_station,
                                     const DataDirections& directions,
                                     const ExtrinsicAlignmentOptions& options) {
-  Matrix6d inverse_y = Matrix6d::Zero();  // (scale H scale)^+ over the determined directions
-  Matrix6d weak_y = Matrix6d::Zero();
-  for (int k = 0; k < 6; ++k) {
-    const Matrix6d outer = directions.vectors.col(k) * directions.vectors.col(k).transpose();
-    if (k < directions.num_weak) {
-      weak_y += options.prior_translation_m * options.prior_translation_m * outer;
-    } else {
-      inverse_y += outer / directions.eigenvalues(k);
-    }
-  }
   Matrix6d meat_y = Matrix6d::Zero();
-  const double num_stations = NumStationsWithAssociations(per_station);
   for (const WeightedNormalEquations& eq : per_station) {
-    if (eq.count == 0) continue;
-    const Vector6d score_y = directions.scale * eq.g;
+    const Vector6d score_y = directions.scale * eq.g;  // zero for a station without associations
     meat_y += score_y * score_y.transpose();
   }
+  const double num_stations = NumStationsWithAssociations(per_station);
   if (num_stations > 1) meat_y *= num_stations / (num_stations - 1);
-  return directions.scale * (inverse_y * meat_y * inverse_y + weak_y) * directions.scale;
+  const Matrix6d inverse_y = DeterminedInverseY(directions);
+  return directions.scale *
+         (inverse_y * meat_y * inverse_y + WeakCovarianceY(directions, options)) * directions.scale;
 }
 
 // A depth scale error s common to every station (a stereo baseline or focal length off, a sub-pixel
@@ -217,13 +221,8 @@ Matrix6d StationClusteredCovariance(const std::vector<WeightedNormalEquations>& 
 Matrix6d DepthScaleCovariance(const WeightedNormalEquations& eq,
                               const DataDirections& directions,
                               const ExtrinsicAlignmentOptions& options) {
-  Vector6d response_y = Vector6d::Zero();
-  const Vector6d gradient_y = directions.scale * eq.scale_gradient;
-  for (int k = directions.num_weak; k < 6; ++k) {
-    response_y -= directions.vectors.col(k) * directions.vectors.col(k).dot(gradient_y) /
-                  directions.eigenvalues(k);
-  }
-  const Vector6d response = directions.scale * response_y;
+  const Vector6d response =
+      -directions.scale * DeterminedInverseY(directions) * directions.scale * eq.scale_gradient;
   return options.depth_scale_sigma * options.depth_scale_sigma * response * response.transpose();
 }
 
@@ -318,11 +317,11 @@ ExtrinsicAlignmentResult AlignCameraPointsWithLidar(const std::vector<CameraDept
   result.constraint_ratios = directions.ratios;
   result.num_weak_directions = directions.num_weak;
   const double variance = std::max(1.0, eq.robust_squared / std::max<double>(eq.count - 6, 1));
-  Matrix6d covariance = Covariance(directions, variance, options);
-  const Matrix6d station_covariance = StationClusteredCovariance(per_station, directions, options);
   result.num_station_clusters = NumStationsWithAssociations(per_station);
   result.station_clustered = result.num_station_clusters >= options.min_station_clusters;
-  if (result.station_clustered) covariance = station_covariance;
+  Matrix6d covariance = result.station_clustered
+                            ? StationClusteredCovariance(per_station, directions, options)
+                            : Covariance(directions, variance, options);
   covariance += DepthScaleCovariance(eq, directions, options);
   SetCovariance(covariance, result.cam_from_lidar, &result);
   return result;

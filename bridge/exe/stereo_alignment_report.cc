@@ -97,6 +97,10 @@ std::optional<ExtrinsicMeasurement> ReadStereoAlignmentMeasurement(
   // correlations, seeds 0/1/2/4 ended at 0.016/0.046/0.022/0.056 deg (correlated:
   // 0.074/0.060/0.068/0.034).
   const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> full(covariance.data());
+  if (!(full.diagonal().minCoeff() > 0)) {
+    throw std::runtime_error(path + ": " + kBlock + "." + kCovariance +
+                             " has a variance that is not positive on its diagonal");
+  }
   measurement.covariance = full.diagonal().asDiagonal();
   measurement.source = "stereo-LiDAR alignment";
   return measurement;
