@@ -78,6 +78,26 @@ double LargestRotationOffMainAxisDeg(const std::vector<Eigen::Vector3d>& rotatio
 
 }  // namespace
 
+namespace {
+
+// The principal direction of b's camera centre seen from camera a, over all registered pairs.
+Eigen::Vector3d TravelDirectionInCam(const colmap::Reconstruction& reconstruction) {
+  const std::vector<colmap::image_t>& ids = reconstruction.RegImageIds();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const colmap::image_t a : ids) {
+    for (const colmap::image_t b : ids) {
+      const Eigen::Vector3d b_in_a =
+          reconstruction.Image(a).CamFromWorld() * reconstruction.Image(b).ProjectionCenter();
+      if (a != b && b_in_a.norm() > 0)
+        scatter += b_in_a.normalized() * b_in_a.normalized().transpose();
+    }
+  }
+  if (scatter.isZero()) return Eigen::Vector3d::Zero();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2);
+}
+
+}  // namespace
+
 MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
                              const ObservabilityOptions& options) {
   MotionAnalysis analysis;
@@ -102,6 +122,7 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
     }
   }
   analysis.num_rotating_pairs = static_cast<int>(axes.size());
+  analysis.travel_direction_in_cam = TravelDirectionInCam(reconstruction);
   for (size_t a = 0; a < axes.size(); ++a) {
     for (size_t b = a + 1; b < axes.size(); ++b) {
       const double cosine = std::min(1.0, std::abs(axes[a].dot(axes[b])));

@@ -73,6 +73,9 @@ struct MotionAnalysis {
   // largest relative rotation about an axis perpendicular to the main rotation axis
   double second_axis_rotation_deg = 0;
   Eigen::Vector3d common_axis_in_cam = Eigen::Vector3d::Zero();  // if all axes are parallel
+  // Unit direction of travel between the stations in each camera's own frame (the principal direction
+  // of the camera centres seen from each other, sign free); zero if the stations do not move.
+  Eigen::Vector3d travel_direction_in_cam = Eigen::Vector3d::Zero();
   // The test of Zhen et al. 2019: >= 3 stations, axes not all parallel (more than
   // max_parallel_axes_deg apart, and some pair turning min_rotation_deg about a second axis).
   bool unique = false;

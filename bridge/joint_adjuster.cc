@@ -2,6 +2,7 @@
 
 #include "bridge/extrinsic_deviation_cost.h"
 #include "bridge/extrinsic_prior_cost.h"
+#include "bridge/free_axis_extrinsic_cost.h"
 #include "bridge/landmark_lidar_plane_cost.h"
 #include "bridge/landmark_lidar_term.h"
 #include "bridge/lidar_pair_cost.h"
@@ -154,11 +155,24 @@ struct RunState {
   double round_gate_m = 0;
   // Whether this round's problem has E_d (see JointAdjusterOptions::first_depth_prior_round).
   bool depth_priors_in_force = true;
+  // JointAdjusterOptions::free_lidar_drive_roll: the axis (zero: off) and E_l's own angle about it,
+  // a parameter block that lives across rounds.
+  Eigen::Vector3d lidar_free_axis = Eigen::Vector3d::Zero();
+  std::unique_ptr<double> lidar_free_angle = std::make_unique<double>(0.0);
 
   bool UsesExtrinsic() const { return use_lidar || use_landmark_lidar; }
 
   double* ExtrinsicRotation() const { return cam_from_lidar->rotation.coeffs().data(); }
   double* ExtrinsicTranslation() const { return cam_from_lidar->translation.data(); }
+  bool LidarHasFreeAxis() const { return use_lidar && !lidar_free_axis.isZero(); }
+  // T_e as E_l sees it: exp(angle u) T_e with a free axis, else T_e.
+  colmap::Rigid3d LidarTermExtrinsic() const {
+    if (!LidarHasFreeAxis()) return *cam_from_lidar;
+    return colmap::Rigid3d(
+               Eigen::Quaterniond(Eigen::AngleAxisd(*lidar_free_angle, lidar_free_axis)),
+               Eigen::Vector3d::Zero()) *
+           *cam_from_lidar;
+  }
 };
 
 colmap::BundleAdjustmentOptions JointBundleAdjustmentOptions(const JointAdjusterOptions& options) {
@@ -309,17 +323,20 @@ void AddLidarBlocks(const RunState& state,
     const colmap::Rigid3d reference =
         LidarIFromLidarJ(state.reconstruction->Image(observation.target).CamFromWorld(),
                          state.reconstruction->Image(observation.source).CamFromWorld(),
-                         *state.cam_from_lidar);
-    joint->lidar_ids.push_back(problem->AddResidualBlock(
-        LidarPairPointToPlaneCost::Create(
-            std::move(group), sigma, state.options.compress_lidar_blocks, reference),
-        state.loss.get(),
-        {target_rotation,
-         target_translation,
-         source_rotation,
-         source_translation,
-         state.ExtrinsicRotation(),
-         state.ExtrinsicTranslation()}));
+                         state.LidarTermExtrinsic());
+    ceres::CostFunction* cost = LidarPairPointToPlaneCost::Create(
+        std::move(group), sigma, state.options.compress_lidar_blocks, reference);
+    std::vector<double*> blocks = {target_rotation,
+                                   target_translation,
+                                   source_rotation,
+                                   source_translation,
+                                   state.ExtrinsicRotation(),
+                                   state.ExtrinsicTranslation()};
+    if (state.LidarHasFreeAxis()) {
+      cost = FreeAxisExtrinsicCost::Create(cost, state.lidar_free_axis);
+      blocks.push_back(state.lidar_free_angle.get());
+    }
+    joint->lidar_ids.push_back(problem->AddResidualBlock(cost, state.loss.get(), blocks));
     group.clear();
   }
 }
@@ -483,7 +500,7 @@ size_t FlagLidarOutliers(RunState* state, std::vector<LidarObservation>* observa
     const colmap::Rigid3d target_from_source =
         LidarIFromLidarJ(state->reconstruction->Image(observation.target).CamFromWorld(),
                          state->reconstruction->Image(observation.source).CamFromWorld(),
-                         *state->cam_from_lidar);
+                         state->LidarTermExtrinsic());
     const double distance = observation.data.normal_in_target.dot(
         target_from_source * observation.data.point_in_source - observation.data.point_in_target);
     if (std::abs(distance) > state->options.max_point_to_plane_m) {
@@ -529,6 +546,7 @@ std::vector<LidarObservation> Associate(const RunState& state, double max_distan
     directed.emplace_back(b, a);
   }
   std::vector<std::vector<LidarObservation>> per_pair(directed.size());
+  const colmap::Rigid3d cam_from_lidar = state.LidarTermExtrinsic();
 #pragma omp parallel for schedule(dynamic)
   for (int k = 0; k < static_cast<int>(directed.size()); ++k) {
     const auto [target, source] = directed[k];
@@ -539,7 +557,7 @@ std::vector<LidarObservation> Associate(const RunState& state, double max_distan
     const colmap::Rigid3d target_from_source =
         LidarIFromLidarJ(reconstruction.Image(target).CamFromWorld(),
                          reconstruction.Image(source).CamFromWorld(),
-                         *state.cam_from_lidar);
+                         cam_from_lidar);
     for (const PointToPlaneObservation& observation :
          AssociatePointToPlane(state.data.clouds.at(source)->cloud,
                                target_cloud.cloud,
@@ -753,6 +771,24 @@ struct HeldDirections {
   std::vector<std::string> names;
 };
 
+// JointAdjusterOptions::free_lidar_drive_roll: the direction of travel in the camera frame without
+// its component along the common turn axis; zero if off, without E_l, or the stations do not move.
+Eigen::Vector3d LidarFreeAxis(const JointAdjusterOptions& options,
+                              const colmap::Reconstruction& reconstruction) {
+  if (!options.free_lidar_drive_roll || options.mode != JointMode::kJoint ||
+      options.lidar_weight <= 0) {
+    return Eigen::Vector3d::Zero();
+  }
+  const MotionAnalysis motion = AnalyseMotion(reconstruction, options.observability);
+  const Eigen::Vector3d& turn = motion.common_axis_in_cam;
+  const Eigen::Vector3d axis =
+      motion.travel_direction_in_cam - turn.dot(motion.travel_direction_in_cam) * turn;
+  if (axis.norm() < 0.5) return Eigen::Vector3d::Zero();
+  std::cout << "E_l leaves the rotation about the driving direction (camera "
+            << axis.normalized().transpose() << ") to the other terms" << std::endl;
+  return axis.normalized();
+}
+
 // How far a round moved T_e: rotation (deg), translation (mm).
 std::array<double, 2> ExtrinsicChange(const colmap::Rigid3d& before, const colmap::Rigid3d& after) {
   return {before.rotation.angularDistance(after.rotation) * 180 / M_PI,
@@ -856,6 +892,7 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
   RunState state(options_, data, reconstruction, cam_from_lidar);
   state.held_rotation = held_rotation;
   state.held_translation = held_translation;
+  state.lidar_free_axis = LidarFreeAxis(options_, *reconstruction);
   for (const colmap::image_t image_id : image_ids) state.config.AddImage(image_id);
   state.config.SetConstantCamPose(image_ids.front());  // the gauge
 
@@ -886,6 +923,12 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
   // state: the last solve's problem may hold residuals of observations (even landmarks) removed after
   // it.
   summary.motion = AnalyseMotion(*reconstruction, options_.observability);
+  if (state.LidarHasFreeAxis()) {
+    summary.lidar_free_axis_in_cam = state.lidar_free_axis;
+    summary.lidar_free_angle_deg = *state.lidar_free_angle * 180 / M_PI;
+    std::cout << "E_l's own rotation about the driving direction: " << summary.lidar_free_angle_deg
+              << " deg from cam_from_lidar" << std::endl;
+  }
   const std::unique_ptr<JointProblem> final_problem = BuildProblem(state, associations);
   summary.final_reprojection_residuals = final_problem->reprojection_ids.size();
   summary.final_depth_residuals = final_problem->depth_ids.size();

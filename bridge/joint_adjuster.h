@@ -71,6 +71,12 @@ struct JointAdjusterOptions {
   int first_depth_prior_round = 2;
   // w_l of E_l.
   double lidar_weight = 1.0;
+  // E_l leaves T_e's rotation about the driving direction to the other terms (an angle of its own,
+  // bridge/free_axis_extrinsic_cost.h): on a moving platform that turns about one axis, E_l knows that
+  // rotation only from how the turns' axis maps between camera and LiDAR, which a drift of 0.001 deg
+  // per frame moves by tenths of a degree. The axis is the direction of travel in the camera frame,
+  // perpendicular to the common turn axis.
+  bool free_lidar_drive_roll = false;
   // w_m of E_m, the landmark-to-LiDAR-plane term; 0 = off (the paper's cost). The pipeline turns it on
   // for a monocular rig, where it gives the landmarks their metric depth.
   double landmark_lidar_weight = 0.0;
@@ -220,6 +226,10 @@ struct JointAdjustmentSummary {
   // Directions of T_e held at their initial value after a first solve found them unobservable (empty:
   // none); the solves of that first pass are in `solves` too, before those of the held pass.
   std::vector<std::string> held_at_initial;
+  // With free_lidar_drive_roll: the axis in the camera frame (zero: E_l saw all of T_e) and E_l's own
+  // angle about it at the end (how far the LiDAR motions alone would roll T_e) [deg].
+  Eigen::Vector3d lidar_free_axis_in_cam = Eigen::Vector3d::Zero();
+  double lidar_free_angle_deg = 0;
   // Per association round of the (last) pass: how far it moved T_e, {deg, mm}.
   std::vector<std::array<double, 2>> extrinsic_change_per_round;
 };

@@ -165,6 +165,13 @@ void WriteReport(const std::string& directory,
                              {"lidar_residuals", summary.final_lidar_residuals},
                              {"landmark_lidar_residuals", summary.final_landmark_lidar_residuals}};
   report["landmark_lidar_weight"] = options.landmark_lidar_weight;
+  if (!summary.lidar_free_axis_in_cam.isZero()) {
+    report["lidar_free_rotation"] = {
+        {"axis_in_cam",
+         std::vector<double>(summary.lidar_free_axis_in_cam.data(),
+                             summary.lidar_free_axis_in_cam.data() + 3)},
+        {"lidar_term_angle_deg", summary.lidar_free_angle_deg}};
+  }
   if (loaded.data.extrinsic_measurement) {
     report["extrinsic_measurement"] = MeasurementJson(*loaded.data.extrinsic_measurement, refined);
   }
@@ -315,6 +322,11 @@ void AddJointAdjusterOptions(const std::string& prefix,
           "w_m of the landmark-to-LiDAR-plane term; -1: 0.25 for a moving platform (sweeps) "
           "whose stations do not rotate about two axes, else 1 for a monocular rig and 0 for a "
           "stereo rig");
+  add.Add(
+      "free_lidar_drive_roll",
+      &adjuster.free_lidar_drive_roll,
+      "the LiDAR term leaves cam_from_lidar's rotation about the driving direction to the other "
+      "terms (an angle of its own)");
   add.Add("sigma_landmark_lidar_m", &adjuster.sigma_landmark_lidar_m);
   add.Add("max_landmark_plane_m", &adjuster.max_landmark_plane_m);
   add.Add("max_landmark_plane_sigmas", &adjuster.max_landmark_plane_sigmas);
