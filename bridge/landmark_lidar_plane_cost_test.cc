@@ -1,6 +1,7 @@
 #include "bridge/landmark_lidar_plane_cost.h"
 
 #include "tests/testing/generic_poses.h"
+#include "tests/testing/gradient_check.h"
 
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
@@ -51,11 +52,9 @@ TEST(LandmarkLidarPlaneCost, AutodiffJacobianMatchesNumericDifferences) {
       Eigen::Vector3d(2.1, 0.4, -0.3), setup.normal_in_lidar_i, 0.02));
   // Ambient quaternion coordinates: checks the derivative of the whole function.
   const std::vector<const ceres::Manifold*> manifolds(5, nullptr);
-  ceres::NumericDiffOptions numeric_options;
-  ceres::GradientChecker checker(cost.get(), &manifolds, numeric_options);
   ceres::GradientChecker::ProbeResults results;
-  std::vector<double*> blocks = setup.Blocks();
-  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-7, &results)) << results.error_log;
+  EXPECT_TRUE(
+      testing::GradientMatchesNumericDifferences(*cost, setup.Blocks(), manifolds, &results));
   // And it is not trivially zero: the landmark's Jacobian is (R_cam^T R_e n)^T / sigma.
   EXPECT_GT(results.jacobians[2].norm(), 10.0);
 }

@@ -1,6 +1,7 @@
 #include "bridge/lidar_point_to_plane_cost.h"
 
 #include "tests/testing/generic_poses.h"
+#include "tests/testing/gradient_check.h"
 
 #include "colmap/geometry/rigid3.h"
 
@@ -51,11 +52,7 @@ TEST(LidarPointToPlaneCost,
                                            0.02));
   // Ambient quaternion coordinates: checks the autodiff derivative of the whole function.
   const std::vector<const ceres::Manifold*> manifolds(6, nullptr);
-  ceres::NumericDiffOptions numeric_options;
-  ceres::GradientChecker checker(cost.get(), &manifolds, numeric_options);
-  ceres::GradientChecker::ProbeResults results;
-  std::vector<double*> blocks = setup.Blocks();
-  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-7, &results)) << results.error_log;
+  EXPECT_TRUE(testing::GradientMatchesNumericDifferences(*cost, setup.Blocks(), manifolds));
 }
 
 }  // namespace

@@ -124,6 +124,15 @@ nlohmann::json UncertaintyJson(const ExtrinsicUncertainty& u,
   return uncertainty;
 }
 
+nlohmann::json MotionJson(const MotionAnalysis& motion) {
+  return {{"stations", motion.num_stations},
+          {"rotating_pairs", motion.num_rotating_pairs},
+          {"max_axis_angle_deg", motion.max_axis_angle_deg},
+          {"second_axis_rotation_deg", motion.second_axis_rotation_deg},
+          {"unique", motion.unique},
+          {"verdict", motion.verdict}};
+}
+
 void WriteReport(const std::string& directory,
                  const JointAdjusterOptions& options,
                  const LoadedJointData& loaded,
@@ -166,11 +175,9 @@ void WriteReport(const std::string& directory,
                              {"landmark_lidar_residuals", summary.final_landmark_lidar_residuals}};
   report["landmark_lidar_weight"] = options.landmark_lidar_weight;
   if (!summary.lidar_free_axis_in_cam.isZero()) {
-    report["lidar_free_rotation"] = {
-        {"axis_in_cam",
-         std::vector<double>(summary.lidar_free_axis_in_cam.data(),
-                             summary.lidar_free_axis_in_cam.data() + 3)},
-        {"lidar_term_angle_deg", summary.lidar_free_angle_deg}};
+    const Eigen::Vector3d& axis = summary.lidar_free_axis_in_cam;
+    report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
+                                     {"lidar_term_angle_deg", summary.lidar_free_angle_deg}};
   }
   if (loaded.data.extrinsic_measurement) {
     report["extrinsic_measurement"] = MeasurementJson(*loaded.data.extrinsic_measurement, refined);
@@ -182,12 +189,7 @@ void WriteReport(const std::string& directory,
   report["hold_thresholds"] = {{"enabled", options.hold_unobservable},
                                {"rotation_deg", options.hold_rotation_deg},
                                {"translation_mm", options.hold_translation_mm}};
-  report["motion"] = {{"stations", summary.motion.num_stations},
-                      {"rotating_pairs", summary.motion.num_rotating_pairs},
-                      {"max_axis_angle_deg", summary.motion.max_axis_angle_deg},
-                      {"second_axis_rotation_deg", summary.motion.second_axis_rotation_deg},
-                      {"unique", summary.motion.unique},
-                      {"verdict", summary.motion.verdict}};
+  report["motion"] = MotionJson(summary.motion);
   std::string verdict;
   if (options.mode != JointMode::kJoint) {
     verdict = "cam_from_lidar held constant (" + JointModeName(options.mode) + ")";
