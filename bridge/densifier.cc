@@ -217,7 +217,11 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
 
   RefinedDepth refined;
   if (options.refine_with_lidar) {
-    const LidarSurface surface = BuildLidarSurface(in_view, options.surface);
+    LidarSurfaceOptions surface_options = options.surface;
+    // No image depth (a monocular rig): the LiDAR is the only depth, so the samples of a sparse sweep
+    // grow their neighbourhoods instead of being dropped.
+    surface_options.grow_sparse_neighbourhoods |= depth_path.empty();
+    const LidarSurface surface = BuildLidarSurface(in_view, surface_options);
     refined = RefineDepthWithLidar(stereo_depth, surface, intrinsics, options.refinement);
   } else {
     refined.depth = stereo_depth;

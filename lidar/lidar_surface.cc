@@ -46,33 +46,81 @@ double Curvature(const Pca& pca) {
   return sum > 0 ? std::max(0.0, pca.eigenvalues(0)) / sum : 0.0;
 }
 
-// Each sample's own neighbourhood plane (`valid` false with fewer than min_neighbors samples in the
-// radius) and the mean distance to its 4 nearest other samples (a count in the radius would double
-// the spacing at a border, where half the disc is empty, and fatten the border's splats).
-void OwnNeighbourhoods(const std::vector<Eigen::Vector3d>& samples,
-                       const KdTree3& tree,
-                       const LidarSurfaceOptions& options,
-                       std::vector<Pca>* pcas,
-                       std::vector<char>* valid,
-                       std::vector<float>* spacing) {
-  pcas->assign(samples.size(), Pca());
-  valid->assign(samples.size(), 0);
-  spacing->assign(samples.size(), 0.f);
+// A sparse sample's neighbourhood: 1.5x the distance to its min_neighbors-th nearest sample
+// (`kth_distance`), doubled while it is a line (one scan line: it must span the next one), up to
+// max_radius_m. Returns the radius; `valid` says whether a plane was found.
+double GrownNeighbourhood(const std::vector<Eigen::Vector3d>& samples,
+                          const KdTree3& tree,
+                          size_t i,
+                          double kth_distance,
+                          const LidarSurfaceOptions& options,
+                          std::vector<size_t>* indices,
+                          Pca* pca,
+                          char* valid) {
+  double r = std::min(options.max_radius_m, std::max(options.radius_m, 1.5 * kth_distance));
+  for (;;) {
+    tree.RadiusSearch(samples[i], r, indices);
+    if (static_cast<int>(indices->size()) >= options.min_neighbors) {
+      *pca = NeighbourhoodPca(samples, *indices, options.max_neighbors);
+      *valid = pca->eigenvalues(1) >= options.min_planarity * pca->eigenvalues(2);
+    }
+    if (*valid || r >= options.max_radius_m) return r;
+    r = std::min(options.max_radius_m, 2 * r);
+  }
+}
+
+// Each sample's mean distance to its 4 nearest other samples (a count in the radius would double
+// the spacing at a border, where half the disc is empty, and fatten the border's splats) and to its
+// min_neighbors-th nearest.
+void NeighbourDistances(const std::vector<Eigen::Vector3d>& samples,
+                        const KdTree3& tree,
+                        const LidarSurfaceOptions& options,
+                        std::vector<float>* spacing,
+                        std::vector<double>* kth_distance) {
+  spacing->assign(samples.size(), float(options.sample_spacing_m));
+  kth_distance->assign(samples.size(), 0.0);
 #pragma omp parallel
   {
-    std::vector<size_t> indices, nearest;
+    std::vector<size_t> nearest;
     std::vector<double> squared;
 #pragma omp for schedule(dynamic, 256)
     for (size_t i = 0; i < samples.size(); ++i) {
-      tree.RadiusSearch(samples[i], options.radius_m, &indices);
-      if (static_cast<int>(indices.size()) < options.min_neighbors) continue;
-      (*pcas)[i] = NeighbourhoodPca(samples, indices, options.max_neighbors);
-      (*valid)[i] = 1;
-      tree.KNearest(samples[i], 5, &nearest, &squared);
+      tree.KNearest(samples[i], std::max(5, options.min_neighbors + 1), &nearest, &squared);
+      const size_t four = std::min<size_t>(5, nearest.size());
       double sum = 0;
-      for (size_t k = 1; k < nearest.size(); ++k) sum += std::sqrt(squared[k]);
-      (*spacing)[i] =
-          float(nearest.size() > 1 ? sum / (nearest.size() - 1) : options.sample_spacing_m);
+      for (size_t k = 1; k < four; ++k) sum += std::sqrt(squared[k]);
+      if (four > 1) (*spacing)[i] = float(sum / (four - 1));
+      (*kth_distance)[i] = std::sqrt(squared.back());
+    }
+  }
+}
+
+// Each sample's PCA radius and its neighbourhood plane (`valid` false with fewer than min_neighbors
+// samples in the radius, or a line): radius_m, or with grow_sparse_neighbourhoods a sample with too
+// few grows its own (GrownNeighbourhood).
+void OwnNeighbourhoods(const std::vector<Eigen::Vector3d>& samples,
+                       const KdTree3& tree,
+                       const LidarSurfaceOptions& options,
+                       const std::vector<double>& kth_distance,
+                       std::vector<Pca>* pcas,
+                       std::vector<char>* valid,
+                       std::vector<float>* radius) {
+  pcas->assign(samples.size(), Pca());
+  valid->assign(samples.size(), 0);
+  radius->assign(samples.size(), float(options.radius_m));
+#pragma omp parallel
+  {
+    std::vector<size_t> indices;
+#pragma omp for schedule(dynamic, 256)
+    for (size_t i = 0; i < samples.size(); ++i) {
+      tree.RadiusSearch(samples[i], options.radius_m, &indices);
+      if (static_cast<int>(indices.size()) >= options.min_neighbors) {
+        (*pcas)[i] = NeighbourhoodPca(samples, indices, options.max_neighbors);
+        (*valid)[i] = 1;
+      } else if (options.grow_sparse_neighbourhoods) {
+        (*radius)[i] = float(GrownNeighbourhood(
+            samples, tree, i, kth_distance[i], options, &indices, &(*pcas)[i], &(*valid)[i]));
+      }
     }
   }
 }
@@ -82,6 +130,9 @@ void OwnNeighbourhoods(const std::vector<Eigen::Vector3d>& samples,
 bool LidarSurfaceOptions::Check() const {
   LIDAR_CHECK_OPTION_GT(sample_spacing_m, 0);
   LIDAR_CHECK_OPTION_GT(radius_m, sample_spacing_m);
+  LIDAR_CHECK_OPTION_GE(max_radius_m, radius_m);
+  LIDAR_CHECK_OPTION_GE(min_planarity, 0);
+  LIDAR_CHECK_OPTION_LT(min_planarity, 1);
   LIDAR_CHECK_OPTION_GT(curvature_radius_m, 0);
   LIDAR_CHECK_OPTION_GE(min_neighbors, 3);
   LIDAR_CHECK_OPTION_GE(max_neighbors, min_neighbors);
@@ -101,8 +152,10 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
   // Every neighbourhood once: a shifted neighbourhood centred on sample j is sample j's own.
   std::vector<Pca> own;
   std::vector<char> valid;
-  std::vector<float> spacing;
-  OwnNeighbourhoods(samples, tree, options, &own, &valid, &spacing);
+  std::vector<float> spacing, radius;
+  std::vector<double> kth_distance;
+  NeighbourDistances(samples, tree, options, &spacing, &kth_distance);
+  OwnNeighbourhoods(samples, tree, options, kth_distance, &own, &valid, &radius);
 
   std::vector<Eigen::Vector3d> points(samples.size());
   std::vector<Eigen::Vector3d> normals(samples.size());
@@ -118,11 +171,11 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
         // Neighbourhood shifting: also take the neighbourhoods centred on samples half a radius
         // away and keep the flattest. Near a corner that is a neighbourhood on the sample's own face,
         // so the corner stays sharp instead of being rounded off by a radius.
-        tree.RadiusSearch(samples[i], options.radius_m, &indices);
+        tree.RadiusSearch(samples[i], radius[i], &indices);
         candidates.clear();
         for (size_t j : indices) {
           const double d = (samples[j] - samples[i]).norm();
-          if (d > 0.35 * options.radius_m && d < 0.65 * options.radius_m) {
+          if (d > 0.35 * radius[i] && d < 0.65 * radius[i]) {
             candidates.push_back(j);
           }
         }
@@ -141,7 +194,8 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
       normals[i] = normal;
       double c = Curvature(*pca);
       if (options.curvature_radius_m != options.radius_m) {
-        tree.RadiusSearch(samples[i], options.curvature_radius_m, &indices);
+        tree.RadiusSearch(
+            samples[i], options.curvature_radius_m * radius[i] / options.radius_m, &indices);
         c = Curvature(NeighbourhoodPca(samples, indices, options.max_neighbors));
       }
       curvature[i] = float(c);

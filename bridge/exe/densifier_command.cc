@@ -20,6 +20,11 @@ void AddDensifierOptions(const std::string& prefix,
           "0: fuse the stereo depth maps as they are");
   add.Add("lidar_sample_spacing_m", &options->surface.sample_spacing_m);
   add.Add("lidar_normal_radius_m", &options->surface.radius_m);
+  add.Add(
+      "lidar_grow_sparse_neighbourhoods",
+      &options->surface.grow_sparse_neighbourhoods,
+      "a LiDAR sample with too few neighbours within the normal radius grows its own instead of "
+      "being dropped (always on without stereo depth)");
   add.Add("window_radius_px", &refinement.window_radius_px);
   add.Add("remove_inconsistent", &refinement.remove_inconsistent);
   add.Add("max_abs_diff_m", &refinement.max_abs_diff_m);
