@@ -66,6 +66,14 @@ TEST(PipelineStereoDriveTest, FortyFrameStereoDriveCalibratesFromItsStereoDepthW
   EXPECT_LT(joint_mm, 12.0);
   // The alignment joined the joint cost with a covariance clustered over the 40 stations.
   EXPECT_TRUE(init["stereo_alignment"]["covariance_clustered_by_station"].get<bool>());
+  // The dense depth maps against the true ones: the LiDAR surface of the sweeps grows its
+  // neighbourhoods on a moving platform and corrects the stereo, decimetres off at 10-30 m. Measured
+  // on seed 1: median 11 mm, 70 % within 5 cm (without the growth 52 mm, 49 %).
+  const nlohmann::json depth = ReadJson(ws + "/evaluation/dense_depth/metrics.json")["all"];
+  std::cout << "stereo drive: dense depth median error " << depth["median_abs_error_m"]
+            << " m, within 5 cm " << depth["within_5cm"] << std::endl;
+  EXPECT_LT(depth["median_abs_error_m"].get<double>(), 0.033);
+  EXPECT_GT(depth["within_5cm"].get<double>(), 0.6);
   const nlohmann::json report = ReadJson(ws + "/sparse/joint/report.json");
   ASSERT_TRUE(report.contains("extrinsic_measurement")) << report.dump(2).substr(0, 2000);
   EXPECT_EQ(report["extrinsic_measurement"]["source"], "stereo-LiDAR alignment");

@@ -57,6 +57,10 @@ int RunEvaluateCalibration(int argc, char** argv);
 // from depth edges (colmap_ext/depth_prior_evaluation.h).
 int RunEvaluateDepthPriors(int argc, char** argv);
 
+// A dense workspace's depth maps against ground_truth/depth/: coverage and error
+// (colmap_ext/dense_depth_evaluation.h).
+int RunEvaluateDenseDepth(int argc, char** argv);
+
 // cam_from_lidar from image edges and LiDAR depth discontinuities (Levinson & Thrun 2013), the
 // baseline of the paper's comparison (bridge/edge_calibration.h).
 int RunCalibrateEdges(int argc, char** argv);

@@ -316,6 +316,13 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
                                                   DepthPriorEvaluationOptions());
                      }});
   }
+  // ... and how far the dense depth maps are from them, wherever the model is (a drive too).
+  if (fs::is_directory(dataset.GroundTruthPath("depth"))) {
+    steps.push_back({"evaluate_dense_depth", [=, &dataset] {
+                       RunEvaluateDenseDepthStep(
+                           dense, dataset.root, (fs::path(evaluation) / "dense_depth").string());
+                     }});
+  }
   if (!dataset.HasGroundTruth() || !fs::is_regular_file(dataset.GroundTruthPath("surface.ply"))) {
     return steps;
   }

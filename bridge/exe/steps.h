@@ -211,6 +211,12 @@ void RunEvaluateDepthPriorsStep(const std::string& database_path,
                                 const std::string& output_path,
                                 const DepthPriorEvaluationOptions& options);
 
+// evaluate_dense_depth: DENSE's depth maps against DATASET/ground_truth/depth/, metrics.json and a
+// histogram into `output_path`.
+void RunEvaluateDenseDepthStep(const std::string& dense_path,
+                               const std::string& dataset_path,
+                               const std::string& output_path);
+
 // evaluate_model's options but the thresholds (a list, parsed by the command).
 void AddModelEvaluationOptions(const std::string& prefix,
                                colmap::OptionManager* manager,
