@@ -248,6 +248,51 @@ struct PipelineStep {
   std::function<void()> run;
 };
 
+// The evaluation steps: what the dataset's ground truth holds.
+std::vector<PipelineStep> EvaluationSteps(const StationDataset& dataset,
+                                          const PipelineOptions& options,
+                                          bool stereo_rig) {
+  const fs::path ws(options.workspace_path);
+  const std::string database = (ws / "database.db").string();
+  const std::string joint = (ws / "sparse" / "joint").string();
+  const std::string dense = (ws / "dense").string();
+  const std::string evaluation = (ws / "evaluation").string();
+  std::vector<PipelineStep> steps;
+  // A KITTI drive: the reference extrinsic only.
+  if (dataset.HasReferenceExtrinsic()) {
+    steps.push_back({"evaluate_calibration", [=, &dataset] {
+                       RunEvaluateCalibrationStep(dataset.root, joint, "", evaluation, "rigid");
+                     }});
+  }
+  // The simulator's true depth maps: how far the stereo depth priors are from the truth.
+  if (stereo_rig && fs::is_directory(dataset.GroundTruthPath("depth"))) {
+    steps.push_back({"evaluate_depth_priors", [=, &dataset] {
+                       RunEvaluateDepthPriorsStep(database,
+                                                  dataset.root,
+                                                  (fs::path(evaluation) / "depth_priors").string(),
+                                                  DepthPriorEvaluationOptions());
+                     }});
+  }
+  // ... and how far the dense depth maps are from them, wherever the model is (a drive too).
+  if (fs::is_directory(dataset.GroundTruthPath("depth"))) {
+    steps.push_back({"evaluate_dense_depth", [=, &dataset] {
+                       RunEvaluateDenseDepthStep(
+                           dense, dataset.root, (fs::path(evaluation) / "dense_depth").string());
+                     }});
+  }
+  if (!dataset.HasGroundTruth() || !fs::is_regular_file(dataset.GroundTruthPath("surface.ply"))) {
+    return steps;
+  }
+  steps.push_back({"evaluate_model", [=, &dataset] {
+                     RunEvaluateModelStep((fs::path(dense) / "fused.ply").string(),
+                                          dataset.GroundTruthPath("surface.ply"),
+                                          (fs::path(evaluation) / "truth_from_model.txt").string(),
+                                          (fs::path(evaluation) / "model").string(),
+                                          options.evaluation);
+                   }});
+  return steps;
+}
+
 // The steps in order, on the workspace layout WS/{database.db, stereo, lidar, sparse/initial,
 // sparse/joint, dense, evaluation}; the evaluation steps only when the dataset has ground truth.
 std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
@@ -259,7 +304,6 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
   const std::string initial = (ws / "sparse" / "initial").string();
   const std::string joint = (ws / "sparse" / "joint").string();
   const std::string dense = (ws / "dense").string();
-  const std::string evaluation = (ws / "evaluation").string();
   // A monocular rig has no stereo steps and no stereo depth for the densifier.
   const bool stereo_rig = dataset.rig.IsStereo();
   const PipelineStep registrator = {
@@ -301,38 +345,8 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
        }},
   };
   steps.insert(steps.end(), back_end.begin(), back_end.end());
-  // Evaluated: what the dataset's ground truth holds (a KITTI drive: the reference extrinsic only).
-  if (dataset.HasReferenceExtrinsic()) {
-    steps.push_back({"evaluate_calibration", [=, &dataset] {
-                       RunEvaluateCalibrationStep(dataset.root, joint, "", evaluation, "rigid");
-                     }});
-  }
-  // The simulator's true depth maps: how far the stereo depth priors are from the truth.
-  if (stereo_rig && fs::is_directory(dataset.GroundTruthPath("depth"))) {
-    steps.push_back({"evaluate_depth_priors", [=, &dataset] {
-                       RunEvaluateDepthPriorsStep(database,
-                                                  dataset.root,
-                                                  (fs::path(evaluation) / "depth_priors").string(),
-                                                  DepthPriorEvaluationOptions());
-                     }});
-  }
-  // ... and how far the dense depth maps are from them, wherever the model is (a drive too).
-  if (fs::is_directory(dataset.GroundTruthPath("depth"))) {
-    steps.push_back({"evaluate_dense_depth", [=, &dataset] {
-                       RunEvaluateDenseDepthStep(
-                           dense, dataset.root, (fs::path(evaluation) / "dense_depth").string());
-                     }});
-  }
-  if (!dataset.HasGroundTruth() || !fs::is_regular_file(dataset.GroundTruthPath("surface.ply"))) {
-    return steps;
-  }
-  steps.push_back({"evaluate_model", [=, &dataset] {
-                     RunEvaluateModelStep((fs::path(dense) / "fused.ply").string(),
-                                          dataset.GroundTruthPath("surface.ply"),
-                                          (fs::path(evaluation) / "truth_from_model.txt").string(),
-                                          (fs::path(evaluation) / "model").string(),
-                                          options.evaluation);
-                   }});
+  const std::vector<PipelineStep> evaluation_steps = EvaluationSteps(dataset, options, stereo_rig);
+  steps.insert(steps.end(), evaluation_steps.begin(), evaluation_steps.end());
   return steps;
 }
 
