@@ -98,9 +98,13 @@ void RunCalibrateEdgesStep(const std::string& dataset_path,
                            const std::string& input_path,
                            const std::string& cam_from_lidar_path,
                            const std::string& output_path,
-                           const EdgeCalibrationOptions& options) {
+                           const EdgeCalibrationOptions& options,
+                           const std::string& registration_path) {
   THROW_CHECK(options.Check());
-  const StationDataset dataset = ReadStationDataset(dataset_path);
+  const StationDataset dataset =
+      registration_path.empty()
+          ? ReadStationDataset(dataset_path)
+          : WithRegistratorClouds(ReadStationDataset(dataset_path), registration_path);
   const colmap::Rigid3d initial = InitialEstimate(dataset, cam_from_lidar_path);
   const std::vector<size_t> selected = SelectedStations(dataset, input_path);
   std::cout << "calibrate_edges: " << selected.size() << " stations: image edges and LiDAR depth "
@@ -131,7 +135,7 @@ void RunCalibrateEdgesStep(const std::string& dataset_path,
 }
 
 int RunCalibrateEdges(int argc, char** argv) {
-  std::string dataset_path, input_path, cam_from_lidar_path, output_path;
+  std::string dataset_path, input_path, cam_from_lidar_path, output_path, registration_path;
   std::string rotation_steps = "1,0.5,0.2,0.1", translation_steps = "0.05,0.03,0.02,0.01";
   EdgeCalibrationOptions options;
   DepthDiscontinuityOptions& lidar = options.discontinuities;
@@ -143,6 +147,10 @@ int RunCalibrateEdges(int argc, char** argv) {
   manager.AddDefaultOption("cam_from_lidar",
                            &cam_from_lidar_path,
                            "start (qw qx qy qz tx ty tz); default rig.json's guess");
+  manager.AddDefaultOption("registration_path",
+                           &registration_path,
+                           "lidar_registrator's output: its static (de-skewed) clouds instead of "
+                           "the dataset's (a moving platform's sweeps)");
   manager.AddDefaultOption("rotation_steps_deg", &rotation_steps, "grid steps, coarse to fine");
   manager.AddDefaultOption("translation_steps_m", &translation_steps, "one per rotation step");
   manager.AddDefaultOption("max_moves_per_level", &options.max_moves_per_level);
@@ -157,7 +165,8 @@ int RunCalibrateEdges(int argc, char** argv) {
   options.translation_steps_m = colmap::CSVToVector<double>(translation_steps);
   THROW_CHECK_GE(max_points, 0);
   lidar.max_points = static_cast<size_t>(max_points);
-  RunCalibrateEdgesStep(dataset_path, input_path, cam_from_lidar_path, output_path, options);
+  RunCalibrateEdgesStep(
+      dataset_path, input_path, cam_from_lidar_path, output_path, options, registration_path);
   return EXIT_SUCCESS;
 }
 

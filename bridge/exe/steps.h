@@ -190,11 +190,14 @@ void RunDensifierStep(const StationDataset& dataset,
 
 // calibrate_edges: cam_from_lidar by Levinson & Thrun's edge alignment from a start (the file, or
 // rig.json's guess), over all stations or those registered in `input_path`.
+// `registration_path`: lidar_registrator's output, whose static (de-skewed) clouds replace the
+// dataset's; empty: the dataset's clouds.
 void RunCalibrateEdgesStep(const std::string& dataset_path,
                            const std::string& input_path,
                            const std::string& cam_from_lidar_path,
                            const std::string& output_path,
-                           const EdgeCalibrationOptions& options);
+                           const EdgeCalibrationOptions& options,
+                           const std::string& registration_path = "");
 
 // evaluate_calibration: cam_from_lidar and station poses against ground_truth/. `output_path` empty:
 // print the metrics only. `alignment`: rigid | similarity.
