@@ -76,10 +76,6 @@ double LargestRotationOffMainAxisDeg(const std::vector<Eigen::Vector3d>& rotatio
   return largest;
 }
 
-}  // namespace
-
-namespace {
-
 // The principal direction of b's camera centre seen from camera a, over all registered pairs.
 Eigen::Vector3d TravelDirectionInCam(const colmap::Reconstruction& reconstruction) {
   const std::vector<colmap::image_t>& ids = reconstruction.RegImageIds();

@@ -1,7 +1,8 @@
 #include "bridge/free_axis_extrinsic_cost.h"
 
-#include <Eigen/Geometry>
 #include "colmap_ext/logging.h"
+
+#include <Eigen/Geometry>
 
 #include <vector>
 

@@ -2,6 +2,7 @@
 
 #include "colmap_ext/dense_workspace.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -19,8 +20,8 @@ class QuantileHistogram {
       : bin_width_(bin_width), counts_(static_cast<size_t>(max_value / bin_width) + 1, 0) {}
 
   void Add(double value) {
-    const size_t bin = static_cast<size_t>(std::max(0.0, value) / bin_width_);
-    ++counts_[std::min(bin, counts_.size() - 1)];
+    const double last = static_cast<double>(counts_.size() - 1);
+    ++counts_[static_cast<size_t>(std::min(std::max(0.0, value) / bin_width_, last))];
     ++total_;
   }
   void Merge(const QuantileHistogram& other) {
@@ -101,10 +102,11 @@ void CompareImage(const cv::Mat& dense,
   image->statistics.num_pixels += dense.total();
   for (int row = 0; row < dense.rows; ++row) {
     for (int col = 0; col < dense.cols; ++col) {
+      // No depth: 0, negative or not finite (NaN, inf), in either map.
       const float d = dense.at<float>(row, col), t = truth.at<float>(row, col);
-      if (!(d > 0)) continue;
+      if (!(d > 0) || !std::isfinite(d)) continue;
       ++image->statistics.num_with_depth;
-      if (!(t > 0)) continue;
+      if (!(t > 0) || !std::isfinite(t)) continue;
       const double error = static_cast<double>(d) - t;
       image->absolute.Add(std::abs(error));
       image->relative.Add(std::abs(error) / t);

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 namespace colmap_lidar {
@@ -16,7 +17,7 @@ constexpr int kWidth = 80, kHeight = 60;
 
 // Truth: a plane at 4 m with a sky strip (depth 0) in the top 10 rows. Dense: the left half with the
 // truth plus Gaussian noise of `sigma_m` and 2 % of its pixels 0.5 m off (edge fattening); the right
-// half without depth.
+// half without depth but for an infinite and a NaN pixel.
 class DenseDepthEvaluationTest : public ::testing::Test {
  protected:
   void Write(double sigma_m) {
@@ -33,6 +34,9 @@ class DenseDepthEvaluationTest : public ::testing::Test {
         }
       }
     }
+    // Not finite: no depth (counted nowhere).
+    dense.at<float>(0, kWidth - 1) = std::numeric_limits<float>::infinity();
+    dense.at<float>(1, kWidth - 1) = std::numeric_limits<float>::quiet_NaN();
     std::filesystem::create_directories(dir_.File("truth"));
     truth.Write(dir_.File("truth/000.bin"));
     const DenseWorkspace workspace(dir_.File("dense"));

@@ -79,13 +79,15 @@ void NeighbourDistances(const std::vector<Eigen::Vector3d>& samples,
                         std::vector<double>* kth_distance) {
   spacing->assign(samples.size(), float(options.sample_spacing_m));
   kth_distance->assign(samples.size(), 0.0);
+  const size_t k = options.grow_sparse_neighbourhoods ? std::max(5, options.min_neighbors + 1) : 5;
 #pragma omp parallel
   {
     std::vector<size_t> nearest;
     std::vector<double> squared;
 #pragma omp for schedule(dynamic, 256)
     for (size_t i = 0; i < samples.size(); ++i) {
-      tree.KNearest(samples[i], std::max(5, options.min_neighbors + 1), &nearest, &squared);
+      // The min_neighbors-th nearest only when a sparse sample may grow its neighbourhood.
+      tree.KNearest(samples[i], k, &nearest, &squared);
       const size_t four = std::min<size_t>(5, nearest.size());
       double sum = 0;
       for (size_t k = 1; k < four; ++k) sum += std::sqrt(squared[k]);
@@ -104,10 +106,10 @@ void OwnNeighbourhoods(const std::vector<Eigen::Vector3d>& samples,
                        const std::vector<double>& kth_distance,
                        std::vector<Pca>* pcas,
                        std::vector<char>* valid,
-                       std::vector<float>* radius) {
+                       std::vector<double>* radius) {
   pcas->assign(samples.size(), Pca());
   valid->assign(samples.size(), 0);
-  radius->assign(samples.size(), float(options.radius_m));
+  radius->assign(samples.size(), options.radius_m);
 #pragma omp parallel
   {
     std::vector<size_t> indices;
@@ -118,8 +120,8 @@ void OwnNeighbourhoods(const std::vector<Eigen::Vector3d>& samples,
         (*pcas)[i] = NeighbourhoodPca(samples, indices, options.max_neighbors);
         (*valid)[i] = 1;
       } else if (options.grow_sparse_neighbourhoods) {
-        (*radius)[i] = float(GrownNeighbourhood(
-            samples, tree, i, kth_distance[i], options, &indices, &(*pcas)[i], &(*valid)[i]));
+        (*radius)[i] = GrownNeighbourhood(
+            samples, tree, i, kth_distance[i], options, &indices, &(*pcas)[i], &(*valid)[i]);
       }
     }
   }
@@ -152,8 +154,8 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
   // Every neighbourhood once: a shifted neighbourhood centred on sample j is sample j's own.
   std::vector<Pca> own;
   std::vector<char> valid;
-  std::vector<float> spacing, radius;
-  std::vector<double> kth_distance;
+  std::vector<float> spacing;
+  std::vector<double> kth_distance, radius;
   NeighbourDistances(samples, tree, options, &spacing, &kth_distance);
   OwnNeighbourhoods(samples, tree, options, kth_distance, &own, &valid, &radius);
 

@@ -248,15 +248,27 @@ struct PipelineStep {
   std::function<void()> run;
 };
 
+// The workspace layout WS/{database.db, stereo, lidar, sparse/initial, sparse/joint, dense,
+// evaluation}.
+struct WorkspacePaths {
+  explicit WorkspacePaths(const fs::path& ws)
+      : database((ws / "database.db").string()),
+        stereo((ws / "stereo").string()),
+        lidar((ws / "lidar").string()),
+        initial((ws / "sparse" / "initial").string()),
+        joint((ws / "sparse" / "joint").string()),
+        dense((ws / "dense").string()),
+        evaluation((ws / "evaluation").string()) {}
+  std::string database, stereo, lidar, initial, joint, dense, evaluation;
+};
+
 // The evaluation steps: what the dataset's ground truth holds.
 std::vector<PipelineStep> EvaluationSteps(const StationDataset& dataset,
-                                          const PipelineOptions& options,
-                                          bool stereo_rig) {
-  const fs::path ws(options.workspace_path);
-  const std::string database = (ws / "database.db").string();
-  const std::string joint = (ws / "sparse" / "joint").string();
-  const std::string dense = (ws / "dense").string();
-  const std::string evaluation = (ws / "evaluation").string();
+                                          const PipelineOptions& options) {
+  const WorkspacePaths paths(options.workspace_path);
+  const std::string &database = paths.database, &joint = paths.joint, &dense = paths.dense,
+                    &evaluation = paths.evaluation;
+  const bool stereo_rig = dataset.rig.IsStereo();
   std::vector<PipelineStep> steps;
   // A KITTI drive: the reference extrinsic only.
   if (dataset.HasReferenceExtrinsic()) {
@@ -293,17 +305,13 @@ std::vector<PipelineStep> EvaluationSteps(const StationDataset& dataset,
   return steps;
 }
 
-// The steps in order, on the workspace layout WS/{database.db, stereo, lidar, sparse/initial,
-// sparse/joint, dense, evaluation}; the evaluation steps only when the dataset has ground truth.
+// The steps in order, on the workspace layout (WorkspacePaths); the evaluation steps only when the
+// dataset has ground truth.
 std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
                                         const PipelineOptions& options) {
-  const fs::path ws(options.workspace_path);
-  const std::string database = (ws / "database.db").string();
-  const std::string stereo = (ws / "stereo").string();
-  const std::string lidar = (ws / "lidar").string();
-  const std::string initial = (ws / "sparse" / "initial").string();
-  const std::string joint = (ws / "sparse" / "joint").string();
-  const std::string dense = (ws / "dense").string();
+  const WorkspacePaths paths(options.workspace_path);
+  const std::string &database = paths.database, &stereo = paths.stereo, &lidar = paths.lidar,
+                    &initial = paths.initial, &joint = paths.joint, &dense = paths.dense;
   // A monocular rig has no stereo steps and no stereo depth for the densifier.
   const bool stereo_rig = dataset.rig.IsStereo();
   const PipelineStep registrator = {
@@ -345,7 +353,7 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
        }},
   };
   steps.insert(steps.end(), back_end.begin(), back_end.end());
-  const std::vector<PipelineStep> evaluation_steps = EvaluationSteps(dataset, options, stereo_rig);
+  const std::vector<PipelineStep> evaluation_steps = EvaluationSteps(dataset, options);
   steps.insert(steps.end(), evaluation_steps.begin(), evaluation_steps.end());
   return steps;
 }
