@@ -279,15 +279,22 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 // and the rotated LiDAR axis (if it rotates enough), and between the camera's translation direction
 // and the one the LiDAR motion predicts, s a = R_X t_B - (R_A - I) t_X (if it translates enough); the
 // larger of the two, 0 when it says neither.
+// The angle [deg] between the camera's rotation axis of `motion` and the rotated LiDAR axis; 0 if it
+// rotates too little to have an axis.
+double AxisResidualDeg(const HandEyeMotion& motion,
+                       const HandEyeOptions& options,
+                       const colmap::Rigid3d& cam_from_lidar) {
+  const Eigen::AngleAxisd a(motion.cam_i_from_cam_j.rotation);
+  if (a.angle() < options.min_rotation_deg * kDegToRad) return 0;
+  const Eigen::AngleAxisd b(motion.lidar_i_from_lidar_j.rotation);
+  return AngleDeg(a.axis(), cam_from_lidar.rotation * b.axis());
+}
+
 double MotionResidualDeg(const HandEyeMotion& motion,
                          const HandEyeOptions& options,
                          const colmap::Rigid3d& cam_from_lidar) {
   const Eigen::AngleAxisd a(motion.cam_i_from_cam_j.rotation);
-  const Eigen::AngleAxisd b(motion.lidar_i_from_lidar_j.rotation);
-  double residual = 0;
-  if (a.angle() >= options.min_rotation_deg * kDegToRad) {
-    residual = AngleDeg(a.axis(), cam_from_lidar.rotation * b.axis());
-  }
+  double residual = AxisResidualDeg(motion, options, cam_from_lidar);
   const Eigen::Vector3d& t_a = motion.cam_i_from_cam_j.translation;
   const Eigen::Vector3d& t_b = motion.lidar_i_from_lidar_j.translation;
   if (t_b.norm() >= kMinTranslationM && t_a.norm() > 0) {
@@ -299,33 +306,70 @@ double MotionResidualDeg(const HandEyeMotion& motion,
   return residual;
 }
 
-// SimilarityHandEye, leaving out the motion that contradicts the fit most (MotionResidualDeg above
-// options.max_motion_residual_deg) and fitting again, until none does. A wrong two-view geometry (a
-// flipped translation direction of forward motion) otherwise gives a negative scale or a wrong axis.
-// Fails (rotation_unique false) when more than half of the motions would be left out.
+// The motion that contradicts a fit most: `index` -1 if none.
+struct Contradiction {
+  int index = -1;
+  // Left out for its axis alone (the general fit's axes do not fit one rotation).
+  bool by_axis = false;
+};
+
+// The largest MotionResidualDeg if above options.max_motion_residual_deg; else, if `by_axis_allowed`
+// and a general fit's axes do not fit one rotation (rotation_rms_deg above
+// options.max_axis_residual_deg), the largest AxisResidualDeg.
+Contradiction MostContradictingMotion(const std::vector<HandEyeMotion>& motions,
+                                      const HandEyeOptions& options,
+                                      const HandEyeResult& result,
+                                      bool planar,
+                                      bool by_axis_allowed) {
+  Contradiction worst, worst_axis{-1, true};
+  double worst_deg = options.max_motion_residual_deg, worst_axis_deg = 0;
+  for (size_t k = 0; k < motions.size(); ++k) {
+    const double residual = MotionResidualDeg(motions[k], options, result.cam_from_lidar);
+    if (residual > worst_deg) std::tie(worst.index, worst_deg) = std::make_pair(int(k), residual);
+    const double axis = AxisResidualDeg(motions[k], options, result.cam_from_lidar);
+    if (axis > worst_axis_deg)
+      std::tie(worst_axis.index, worst_axis_deg) = std::make_pair(int(k), axis);
+  }
+  const bool axes_fit = planar || result.rotation_rms_deg <= options.max_axis_residual_deg;
+  return worst.index >= 0 || axes_fit || !by_axis_allowed ? worst : worst_axis;
+}
+
+// SimilarityHandEye, leaving out the motion that contradicts the fit most (MostContradictingMotion)
+// and fitting again, until none does. A wrong two-view geometry (a flipped translation direction of
+// forward motion) otherwise gives a negative scale or a wrong axis; one poorly estimated axis among
+// tripod stations that rotate about axes 58 deg apart (0.54 deg rms with it) otherwise sent the fit to
+// the planar variant, whose translation is 0. Only one motion is left out for its axis alone: the
+// noisy axes of a car's small turns must not be thinned until a few happen to fit. Fails
+// (rotation_unique false) when more than half of the motions would be left out, or when a general
+// fit's remaining axes are parallel.
 HandEyeResult FitWithoutContradictingMotions(std::vector<HandEyeMotion> motions,
                                              const HandEyeOptions& options,
                                              const Eigen::Vector3d& axis_translation_fallback,
                                              bool per_motion_scale,
                                              bool planar) {
   const size_t num_given = motions.size();
+  bool left_out_by_axis = false;
   for (int left_out = 0;; ++left_out) {
     HandEyeResult result =
         SimilarityHandEye(motions, options, axis_translation_fallback, per_motion_scale, planar);
     result.num_contradicting = left_out;
+    result.axis_misfit_left_out = left_out_by_axis;
     if (!result.message.empty()) return result;  // degenerate
-    size_t worst = 0;
-    double worst_deg = 0;
-    for (size_t k = 0; k < motions.size(); ++k) {
-      const double residual = MotionResidualDeg(motions[k], options, result.cam_from_lidar);
-      if (residual > worst_deg) std::tie(worst, worst_deg) = std::make_pair(k, residual);
-    }
-    if (worst_deg <= options.max_motion_residual_deg) return result;
+    const Contradiction worst =
+        MostContradictingMotion(motions, options, result, planar, !left_out_by_axis);
+    if (worst.index < 0) return result;
     if (2 * static_cast<size_t>(left_out + 1) > num_given) {
       result.rotation_unique = result.unique = false;
       return result;
     }
-    motions.erase(motions.begin() + worst);
+    left_out_by_axis = left_out_by_axis || worst.by_axis;
+    motions.erase(motions.begin() + worst.index);
+    const RotationAxes axes = RotatingMotions(motions, options);
+    if (!planar && (axes.motions.size() < 2 ||
+                    MaxAngleBetweenLinesDeg(axes.in_cam) < options.min_axis_angle_deg)) {
+      result.rotation_unique = result.unique = false;
+      return result;
+    }
   }
 }
 
@@ -338,9 +382,14 @@ std::string SimilarityMessage(const HandEyeResult& result,
   std::ostringstream message;
   message << std::fixed << std::setprecision(1) << "similarity hand-eye from "
           << num_used - result.num_contradicting << " of " << num_given << " motion pairs (";
-  if (result.num_contradicting > 0) {
-    message << result.num_contradicting << " contradicting the fit by more than "
-            << options.max_motion_residual_deg << " deg left out, ";
+  const int num_far = result.num_contradicting - (result.axis_misfit_left_out ? 1 : 0);
+  if (num_far > 0) {
+    message << num_far << " contradicting the fit by more than " << options.max_motion_residual_deg
+            << " deg left out, ";
+  }
+  if (result.axis_misfit_left_out) {
+    message << "1 whose axis kept the fit above " << options.max_axis_residual_deg
+            << " deg rms left out, ";
   }
   message << result.num_motions << " rotating, axes span " << result.max_axis_angle_deg
           << " deg): scale " << std::setprecision(4) << result.scale << ", axis fit "

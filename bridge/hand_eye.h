@@ -46,8 +46,11 @@ struct HandEyeResult {
   double scale = 1;
   std::string message;  // why not unique, or a summary
   colmap::Rigid3d cam_from_lidar;
-  int num_motions = 0;            // used
-  int num_contradicting = 0;      // similarity variant: left out as contradicting the fit
+  int num_motions = 0;        // used
+  int num_contradicting = 0;  // similarity variant: left out as contradicting the fit
+  // Similarity variant: one of those left out only because its axis kept a general fit above
+  // max_axis_residual_deg rms.
+  bool axis_misfit_left_out = false;
   double max_axis_angle_deg = 0;  // spread of the rotation axes
   double rotation_rms_deg = 0;    // residual of the axis fit
   double translation_rms_m = 0;   // residual of the linear system
