@@ -84,22 +84,30 @@ EdgeStation PrepareEdgeStation(const std::string& name,
   return station;
 }
 
+double StationEdgeObjective(const EdgeStation& station,
+                            const colmap::Rigid3d& cam_from_lidar,
+                            double min_depth_m) {
+  const Eigen::Matrix3x4d cam_from_lidar_matrix = cam_from_lidar.ToMatrix();
+  const cv::Mat& transform = station.transform;
+  double objective = 0;
+  for (const DepthDiscontinuity& d : station.discontinuities) {
+    const Eigen::Vector3d point_in_cam = cam_from_lidar_matrix * d.point_in_lidar.homogeneous();
+    if (point_in_cam.z() < min_depth_m) continue;
+    const Eigen::Vector2d xy = station.camera.ImgFromCam(point_in_cam.hnormalized());
+    const int col = static_cast<int>(std::floor(xy.x()));
+    const int row = static_cast<int>(std::floor(xy.y()));
+    if (col < 0 || row < 0 || col >= transform.cols || row >= transform.rows) continue;
+    objective += d.score * transform.at<float>(row, col);
+  }
+  return objective;
+}
+
 double EdgeObjective(const std::vector<EdgeStation>& stations,
                      const colmap::Rigid3d& cam_from_lidar,
                      double min_depth_m) {
-  const Eigen::Matrix3x4d cam_from_lidar_matrix = cam_from_lidar.ToMatrix();
   double objective = 0;
   for (const EdgeStation& station : stations) {
-    const cv::Mat& transform = station.transform;
-    for (const DepthDiscontinuity& d : station.discontinuities) {
-      const Eigen::Vector3d point_in_cam = cam_from_lidar_matrix * d.point_in_lidar.homogeneous();
-      if (point_in_cam.z() < min_depth_m) continue;
-      const Eigen::Vector2d xy = station.camera.ImgFromCam(point_in_cam.hnormalized());
-      const int col = static_cast<int>(std::floor(xy.x()));
-      const int row = static_cast<int>(std::floor(xy.y()));
-      if (col < 0 || row < 0 || col >= transform.cols || row >= transform.rows) continue;
-      objective += d.score * transform.at<float>(row, col);
-    }
+    objective += StationEdgeObjective(station, cam_from_lidar, min_depth_m);
   }
   return objective;
 }

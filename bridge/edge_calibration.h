@@ -56,6 +56,11 @@ EdgeStation PrepareEdgeStation(const std::string& name,
                                const std::vector<Eigen::Vector3d>& points_in_lidar,
                                const EdgeCalibrationOptions& options);
 
+// One station's share of J(T_e).
+double StationEdgeObjective(const EdgeStation& station,
+                            const colmap::Rigid3d& cam_from_lidar,
+                            double min_depth_m);
+
 // J(T_e): the X-weighted sum of D at the projected discontinuity points.
 double EdgeObjective(const std::vector<EdgeStation>& stations,
                      const colmap::Rigid3d& cam_from_lidar,

@@ -44,6 +44,27 @@ TEST_F(EdgeCalibrationTest, WritesTheExtrinsicAReportAndAPlot) {
   EXPECT_TRUE(fs::exists(dir_.File("edges/edges_001.png")));
 }
 
+// --profile_axis: J along one camera axis instead of the grid, with its plot; a bad axis is refused.
+TEST_F(EdgeCalibrationTest, ProfilesOneAxisAndRefusesABadOne) {
+  const auto result = RunCommand(kCli + " calibrate_edges --dataset_path " + dir_.File("dataset") +
+                                 " --output_path " + dir_.File("profile") +
+                                 " --profile_axis 0,0,1 --profile_half_range_deg 0.3");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::ifstream file(dir_.File("profile/report.json"));
+  const nlohmann::json report = nlohmann::json::parse(file);
+  EXPECT_EQ(report["angles_deg"].size(), 61u);
+  EXPECT_EQ(report["objective"].size(), 61u);
+  EXPECT_LE(std::abs(report["peak_deg"].get<double>()), 0.3);
+  EXPECT_GE(report["sigma_deg"].get<double>(), 0);
+  EXPECT_TRUE(fs::exists(dir_.File("profile/profile.png")));
+  EXPECT_NO_THROW(ReadPoseFile(dir_.File("profile/cam_from_lidar.txt")));
+  const auto bad = RunCommand(kCli + " calibrate_edges --dataset_path " + dir_.File("dataset") +
+                              " --output_path " + dir_.File("none") + " --profile_axis 0,0");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--profile_axis needs x,y,z"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir_.File("none")));
+}
+
 TEST_F(EdgeCalibrationTest, BadInputIsOneErrorNamingItAndNoOutput) {
   const auto missing = RunCommand(kCli + " calibrate_edges --dataset_path " + dir_.File("dataset") +
                                   " --cam_from_lidar " + dir_.File("missing.txt") +

@@ -3,7 +3,10 @@
 //   OUTPUT/cam_from_lidar.txt   qw qx qy qz tx ty tz (quaternion w first)
 //   OUTPUT/report.json          J at the start and end, F_c, moves per level, time, the options
 //   OUTPUT/edges_<station>.png  one station's edge transform, discontinuities before (red), after (green)
+// With --profile_axis, no grid search: J along the rotation about that camera axis through the start
+// (bridge/edge_axis_profile.h), the result turned to its peak, and OUTPUT/profile.png.
 #include "bridge/calibration_evaluation.h"
+#include "bridge/edge_axis_profile.h"
 #include "bridge/edge_calibration.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
@@ -12,6 +15,7 @@
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
 #include "lidar/parallel_for_each.h"
+#include "lidar/plot.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/scene/reconstruction.h"
@@ -94,12 +98,70 @@ nlohmann::json EdgeReport(const EdgeCalibrationResult& result,
 
 }  // namespace
 
+namespace {
+
+void PrintAgainstReference(const StationDataset& dataset, const colmap::Rigid3d& cam_from_lidar) {
+  if (!dataset.HasReferenceExtrinsic()) return;
+  const colmap::Rigid3d truth = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  std::cout << "calibrate_edges: against ground_truth/cam_from_lidar.txt: rotation "
+            << RotationErrorDeg(cam_from_lidar, truth) << " deg, translation "
+            << (cam_from_lidar.translation - truth.translation).norm() * 1000 << " mm" << std::endl;
+}
+
+// The profile about `axis_in_cam` through `initial`: its report and plot into `partial`, the start
+// turned to the peak returned.
+colmap::Rigid3d ProfileStep(const std::vector<EdgeStation>& stations,
+                            const colmap::Rigid3d& initial,
+                            const Eigen::Vector3d& axis_in_cam,
+                            const EdgeAxisProfileOptions& options,
+                            PartialOutputFolder* partial) {
+  const EdgeAxisProfile profile = ProfileEdgeObjective(stations, initial, axis_in_cam, options);
+  std::cout << std::setprecision(4) << "calibrate_edges: J about camera axis ("
+            << profile.axis_in_cam.transpose() << ") peaks at " << profile.peak_deg
+            << " deg, bootstrap sigma " << profile.sigma_deg << " deg"
+            << (profile.at_range_end ? " (at the end of the range: widen --profile_half_range_deg)"
+                                     : "")
+            << std::endl;
+  const nlohmann::json report = {{"axis_in_cam", profile.axis_in_cam},
+                                 {"angles_deg", profile.angles_deg},
+                                 {"objective", profile.objective},
+                                 {"peak_deg", profile.peak_deg},
+                                 {"sigma_deg", profile.sigma_deg},
+                                 {"at_range_end", profile.at_range_end},
+                                 {"num_stations", stations.size()}};
+  WriteFileAtomically(partial->File("report.json"), report.dump(2) + "\n");
+  LinePlotOptions plot;
+  plot.title = "Edge objective about one camera axis";
+  plot.x_label = "angle from the start [deg]";
+  plot.y_label = "J";
+  WriteLinePlotPng(
+      partial->File("profile.png"), {{"J", profile.angles_deg, profile.objective}}, plot);
+  return TurnAboutCameraAxis(initial, profile.axis_in_cam, profile.peak_deg);
+}
+
+colmap::Rigid3d GridStep(const std::vector<EdgeStation>& stations,
+                         const colmap::Rigid3d& initial,
+                         const EdgeCalibrationOptions& options,
+                         PartialOutputFolder* partial) {
+  const EdgeCalibrationResult result = CalibrateFromEdges(stations, initial, options);
+  std::cout << std::setprecision(4) << "calibrate_edges: J " << result.initial_objective << " -> "
+            << result.final_objective << ", F_c " << result.fraction_lower << ", "
+            << result.objective_history.size() - 1 << " moves, " << result.seconds << " s"
+            << (result.converged ? "" : " (a level stopped at max_moves_per_level)") << std::endl;
+  WriteFileAtomically(partial->File("report.json"),
+                      EdgeReport(result, stations, options).dump(2) + "\n");
+  return result.cam_from_lidar;
+}
+
+}  // namespace
+
 void RunCalibrateEdgesStep(const std::string& dataset_path,
                            const std::string& input_path,
                            const std::string& cam_from_lidar_path,
                            const std::string& output_path,
                            const EdgeCalibrationOptions& options,
-                           const std::string& registration_path) {
+                           const std::string& registration_path,
+                           const std::optional<EdgeAxisProfileRequest>& profile) {
   THROW_CHECK(options.Check());
   const StationDataset dataset =
       registration_path.empty()
@@ -110,27 +172,17 @@ void RunCalibrateEdgesStep(const std::string& dataset_path,
   std::cout << "calibrate_edges: " << selected.size() << " stations: image edges and LiDAR depth "
             << "discontinuities" << std::endl;
   const std::vector<EdgeStation> stations = PrepareStations(dataset, selected, options);
-  const EdgeCalibrationResult result = CalibrateFromEdges(stations, initial, options);
-  std::cout << std::setprecision(4) << "calibrate_edges: J " << result.initial_objective << " -> "
-            << result.final_objective << ", F_c " << result.fraction_lower << ", "
-            << result.objective_history.size() - 1 << " moves, " << result.seconds << " s"
-            << (result.converged ? "" : " (a level stopped at max_moves_per_level)") << std::endl;
-  if (dataset.HasReferenceExtrinsic()) {
-    const colmap::Rigid3d truth = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
-    std::cout << "calibrate_edges: against ground_truth/cam_from_lidar.txt: rotation "
-              << RotationErrorDeg(result.cam_from_lidar, truth) << " deg, translation "
-              << (result.cam_from_lidar.translation - truth.translation).norm() * 1000 << " mm"
-              << std::endl;
-  }
   PartialOutputFolder partial(output_path);
+  const colmap::Rigid3d result =
+      profile ? ProfileStep(stations, initial, profile->axis_in_cam, profile->options, &partial)
+              : GridStep(stations, initial, options, &partial);
+  PrintAgainstReference(dataset, result);
   WritePoseFile(partial.File("cam_from_lidar.txt"),
                 "cam_from_lidar by calibrate_edges (Levinson & Thrun 2013)",
-                result.cam_from_lidar);
-  WriteFileAtomically(partial.File("report.json"),
-                      EdgeReport(result, stations, options).dump(2) + "\n");
+                result);
   const EdgeStation& shown = stations[stations.size() / 2];
   cv::imwrite(partial.File("edges_" + shown.name + ".png"),
-              EdgeOverlay(shown, initial, result.cam_from_lidar, options.min_depth_m));
+              EdgeOverlay(shown, initial, result, options.min_depth_m));
   partial.Commit();
 }
 
@@ -160,13 +212,35 @@ int RunCalibrateEdges(int argc, char** argv) {
   manager.AddDefaultOption("blur_sigma_px", &options.transform.blur_sigma_px);
   manager.AddDefaultOption("alpha", &options.transform.alpha);
   manager.AddDefaultOption("gamma", &options.transform.gamma, "decay per pixel of the transform");
+  std::string profile_axis;
+  EdgeAxisProfileOptions profile_options;
+  manager.AddDefaultOption("profile_axis",
+                           &profile_axis,
+                           "x,y,z in the camera frame: J along the rotation about it instead of "
+                           "the grid search");
+  manager.AddDefaultOption("profile_half_range_deg", &profile_options.half_range_deg);
+  manager.AddDefaultOption("profile_step_deg", &profile_options.step_deg);
   manager.Parse(argc, argv);
+  std::optional<EdgeAxisProfileRequest> profile;
+  if (!profile_axis.empty()) {
+    const std::vector<double> axis = colmap::CSVToVector<double>(profile_axis);
+    if (axis.size() != 3 || Eigen::Vector3d(axis[0], axis[1], axis[2]).norm() == 0) {
+      throw std::invalid_argument("--profile_axis needs x,y,z (not all 0): " + profile_axis);
+    }
+    profile_options.min_depth_m = options.min_depth_m;
+    profile = EdgeAxisProfileRequest{Eigen::Vector3d(axis[0], axis[1], axis[2]), profile_options};
+  }
   options.rotation_steps_deg = colmap::CSVToVector<double>(rotation_steps);
   options.translation_steps_m = colmap::CSVToVector<double>(translation_steps);
   THROW_CHECK_GE(max_points, 0);
   lidar.max_points = static_cast<size_t>(max_points);
-  RunCalibrateEdgesStep(
-      dataset_path, input_path, cam_from_lidar_path, output_path, options, registration_path);
+  RunCalibrateEdgesStep(dataset_path,
+                        input_path,
+                        cam_from_lidar_path,
+                        output_path,
+                        options,
+                        registration_path,
+                        profile);
   return EXIT_SUCCESS;
 }
 

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "bridge/densifier.h"
+#include "bridge/edge_axis_profile.h"
 #include "bridge/edge_calibration.h"
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
@@ -28,6 +29,7 @@
 #include "colmap/controllers/option_manager.h"
 
 #include <chrono>
+#include <optional>
 #include <string>
 
 namespace colmap_lidar {
@@ -188,16 +190,23 @@ void RunDensifierStep(const StationDataset& dataset,
                       const DensifierPaths& paths,
                       const DensifierOptions& options);
 
+// calibrate_edges --profile_axis: J along the rotation about one camera axis instead of the grid.
+struct EdgeAxisProfileRequest {
+  Eigen::Vector3d axis_in_cam;
+  EdgeAxisProfileOptions options;
+};
+
 // calibrate_edges: cam_from_lidar by Levinson & Thrun's edge alignment from a start (the file, or
 // rig.json's guess), over all stations or those registered in `input_path`.
 // `registration_path`: lidar_registrator's output, whose static (de-skewed) clouds replace the
-// dataset's; empty: the dataset's clouds.
+// dataset's; empty: the dataset's clouds. `profile`: the start turned about one axis only.
 void RunCalibrateEdgesStep(const std::string& dataset_path,
                            const std::string& input_path,
                            const std::string& cam_from_lidar_path,
                            const std::string& output_path,
                            const EdgeCalibrationOptions& options,
-                           const std::string& registration_path = "");
+                           const std::string& registration_path = "",
+                           const std::optional<EdgeAxisProfileRequest>& profile = std::nullopt);
 
 // evaluate_calibration: cam_from_lidar and station poses against ground_truth/. `output_path` empty:
 // print the metrics only. `alignment`: rigid | similarity.
