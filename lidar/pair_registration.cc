@@ -227,8 +227,8 @@ void ScreenHypotheses(const StationCloud& source,
   std::vector<std::pair<double, size_t>> overlaps;
   for (size_t k = 0; k < hypotheses->size(); ++k) {
     Hypothesis& h = (*hypotheses)[k];
-    const IcpResult result =
-        PointToPlaneIcp(source.cloud, target.cloud, *target.tree, h.target_from_source, coarse);
+    const IcpResult result = PointToPlaneIcp(
+        source.cloud, target.cloud, *target.tree, h.target_from_source, coarse, &target.curvature);
     h.target_from_source = result.target_from_source;
     overlaps.emplace_back(-result.overlap_ratio, k);  // best first; ties keep the order
   }
@@ -289,8 +289,12 @@ PairRegistration RegisterStationClouds(const StationCloud& source,
   ScreenHypotheses(source, target, options, &hypotheses);
   bool have_candidate = false;
   for (const Hypothesis& h : hypotheses) {
-    const IcpResult fine = PointToPlaneIcp(
-        source.cloud, target.cloud, *target.tree, h.target_from_source, options.icp);
+    const IcpResult fine = PointToPlaneIcp(source.cloud,
+                                           target.cloud,
+                                           *target.tree,
+                                           h.target_from_source,
+                                           options.icp,
+                                           &target.curvature);
     if (have_candidate && fine.overlap_ratio <= result.overlap) continue;
     have_candidate = true;
     TakeIcpResult(fine, &result);
@@ -318,10 +322,13 @@ PairRegistration RegisterFromGuess(const StationCloud& source,
                                    const PairRegistrationOptions& options) {
   ThrowUnlessValid(options, "PairRegistrationOptions");
   PairRegistration result;
-  TakeIcpResult(
-      PointToPlaneIcp(
-          source.cloud, target.cloud, *target.tree, target_from_source_guess, options.icp),
-      &result);
+  TakeIcpResult(PointToPlaneIcp(source.cloud,
+                                target.cloud,
+                                *target.tree,
+                                target_from_source_guess,
+                                options.icp,
+                                &target.curvature),
+                &result);
   result.noise_rms = PairNoiseRms(source, target);
   Judge(options, &result);
   return result;

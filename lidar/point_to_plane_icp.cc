@@ -16,6 +16,8 @@ struct NormalEquations {
   double squared_error = 0;
   double squared_radius = 0;  // sum of |p'|^2: the lever arm of the rotations
   size_t count = 0;
+  // Within the gate, with a normal: `count` plus those left out for their target's curvature.
+  size_t count_in_gate = 0;
 
   void Add(const NormalEquations& other) {
     H += other.H;
@@ -23,16 +25,20 @@ struct NormalEquations {
     squared_error += other.squared_error;
     squared_radius += other.squared_radius;
     count += other.count;
+    count_in_gate += other.count_in_gate;
   }
 };
 
-// Linearised about the current pose: r = n^T (p' - q), d r / d[omega, t] = [p' x n, n].
+// Linearised about the current pose: r = n^T (p' - q), d r / d[omega, t] = [p' x n, n]. Target points
+// above `max_curvature` (if `curvature` is given) count towards the overlap only.
 NormalEquations BuildNormalEquations(const PointCloud& source,
                                      const PointCloud& target,
                                      const KdTree3& tree,
                                      const Eigen::Isometry3d& target_from_source,
                                      size_t stride,
-                                     double gate) {
+                                     double gate,
+                                     const std::vector<double>* curvature,
+                                     double max_curvature) {
   NormalEquations total;
   const long num = static_cast<long>((source.Size() + stride - 1) / stride);
 #pragma omp parallel
@@ -46,6 +52,8 @@ NormalEquations BuildNormalEquations(const PointCloud& source,
       if (!tree.Nearest(p, &index, &squared) || squared > gate * gate) continue;
       const Eigen::Vector3d& n = target.normals[index];
       if (n.squaredNorm() < 0.5) continue;  // no normal estimated there
+      ++local.count_in_gate;
+      if (curvature && (*curvature)[index] > max_curvature) continue;
       const double r = n.dot(p - target.points[index]);
       Eigen::Matrix<double, 6, 1> J;
       J << p.cross(n), n;
@@ -80,14 +88,56 @@ bool IcpOptions::Check() const {
   LIDAR_CHECK_OPTION_GT(min_correspondence_distance, 0);
   LIDAR_CHECK_OPTION_GE(max_correspondence_distance, min_correspondence_distance);
   LIDAR_CHECK_OPTION_GE(max_source_points, 6);
+  LIDAR_CHECK_OPTION_GT(max_target_curvature, 0);
   return true;
 }
+
+namespace {
+
+// Gauss-Newton iterations from *target_from_source until converged (true) or
+// options.max_iterations; *gate and *iterations carry on from their values.
+bool IterateIcp(const PointCloud& source,
+                const PointCloud& target,
+                const KdTree3& target_tree,
+                size_t stride,
+                const std::vector<double>* target_curvature,
+                const IcpOptions& options,
+                Eigen::Isometry3d* target_from_source,
+                double* gate,
+                int* iterations) {
+  for (int it = 0; it < options.max_iterations; ++it) {
+    const NormalEquations eq = BuildNormalEquations(source,
+                                                    target,
+                                                    target_tree,
+                                                    *target_from_source,
+                                                    stride,
+                                                    *gate,
+                                                    target_curvature,
+                                                    options.max_target_curvature);
+    ++*iterations;
+    if (eq.count < 6) return false;
+    const Eigen::Matrix<double, 6, 1> x = eq.H.ldlt().solve(-eq.g);
+    if (!x.allFinite()) return false;
+    *target_from_source = IsometryFromIncrement(x) * *target_from_source;
+    const bool small_step = x.head<3>().norm() < options.convergence_rotation_rad &&
+                            x.tail<3>().norm() < options.convergence_translation_m;
+    const double next_gate = NextIcpGate(
+        *gate, std::sqrt(eq.squared_error / eq.count), options.min_correspondence_distance);
+    // Converged: a small step with the gate settled (at its floor or at a few times the noise).
+    if (small_step && next_gate > 0.98 * *gate) return true;
+    *gate = next_gate;
+  }
+  return false;
+}
+
+}  // namespace
 
 IcpResult PointToPlaneIcp(const PointCloud& source,
                           const PointCloud& target,
                           const KdTree3& target_tree,
                           const Eigen::Isometry3d& initial_target_from_source,
-                          const IcpOptions& options) {
+                          const IcpOptions& options,
+                          const std::vector<double>* target_curvature) {
   ThrowUnlessValid(options, "IcpOptions");
   if (source.Empty() || target.Empty()) throw std::invalid_argument("PointToPlaneIcp: empty cloud");
   if (!target.HasNormals())
@@ -95,35 +145,46 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
   if (target_tree.Size() != target.Size()) {
     throw std::invalid_argument("PointToPlaneIcp: the k-d tree is not built over the target");
   }
+  if (target_curvature && target_curvature->size() != target.Size()) {
+    throw std::invalid_argument("PointToPlaneIcp: one curvature per target point expected");
+  }
   const size_t stride = std::max<size_t>(1, source.Size() / options.max_source_points);
   const size_t num_used = (source.Size() + stride - 1) / stride;
   IcpResult result;
   result.target_from_source = initial_target_from_source;
   double gate = options.max_correspondence_distance;
-  for (int it = 0; it < options.max_iterations; ++it) {
-    const NormalEquations eq =
-        BuildNormalEquations(source, target, target_tree, result.target_from_source, stride, gate);
-    result.iterations = it + 1;
-    if (eq.count < 6) break;
-    const Eigen::Matrix<double, 6, 1> x = eq.H.ldlt().solve(-eq.g);
-    if (!x.allFinite()) break;
-    result.target_from_source = IsometryFromIncrement(x) * result.target_from_source;
-    const double angle = x.head<3>().norm();
-    const bool small_step = angle < options.convergence_rotation_rad &&
-                            x.tail<3>().norm() < options.convergence_translation_m;
-    const double next_gate = NextIcpGate(
-        gate, std::sqrt(eq.squared_error / eq.count), options.min_correspondence_distance);
-    // Converged: a small step with the gate settled (at its floor or at a few times the noise).
-    if (small_step && next_gate > 0.98 * gate) {
-      result.converged = true;
-      break;
-    }
-    gate = next_gate;
+  // Converge on every point first (edges and thin cylinders widen the basin), then, with
+  // curvatures, on the planar ones only (their residuals are not biased at the true pose).
+  result.converged = IterateIcp(source,
+                                target,
+                                target_tree,
+                                stride,
+                                nullptr,
+                                options,
+                                &result.target_from_source,
+                                &gate,
+                                &result.iterations);
+  if (result.converged && target_curvature) {
+    result.converged = IterateIcp(source,
+                                  target,
+                                  target_tree,
+                                  stride,
+                                  target_curvature,
+                                  options,
+                                  &result.target_from_source,
+                                  &gate,
+                                  &result.iterations);
   }
-  const NormalEquations final_eq =
-      BuildNormalEquations(source, target, target_tree, result.target_from_source, stride, gate);
+  const NormalEquations final_eq = BuildNormalEquations(source,
+                                                        target,
+                                                        target_tree,
+                                                        result.target_from_source,
+                                                        stride,
+                                                        gate,
+                                                        target_curvature,
+                                                        options.max_target_curvature);
   result.num_inliers = final_eq.count;
-  result.overlap_ratio = static_cast<double>(final_eq.count) / num_used;
+  result.overlap_ratio = static_cast<double>(final_eq.count_in_gate) / num_used;
   result.rmse = final_eq.count ? std::sqrt(final_eq.squared_error / final_eq.count) : 0;
   result.hessian = final_eq.H;
   result.lever_arm_m = final_eq.count ? std::sqrt(final_eq.squared_radius / final_eq.count) : 0;

@@ -52,6 +52,33 @@ TEST(PointToPlaneIcpTest, DisjointCloudsHaveNoOverlap) {
   EXPECT_FALSE(result.converged);
 }
 
+// Target points marked curved (curvature 1) whose normals are wrong and whose residuals are 2 cm off
+// at the truth bias the plain ICP; with the curvatures they only count towards the overlap, and the
+// ICP ends at the truth.
+TEST(PointToPlaneIcpTest, CurvedTargetPointsEnterOnlyTheOverlap) {
+  PointCloud target = testing::SyntheticRoom(1000, 10, 0.0);
+  const PointCloud source = target;  // the same points: the truth is the identity
+  std::vector<double> curvature(target.Size(), 0.0);
+  for (size_t i = 0; i < target.Size(); i += 10) {
+    target.points[i] += 0.02 * target.normals[i];
+    target.normals[i] = (target.normals[i] + Eigen::Vector3d(0.3, -0.2, 0.4)).normalized();
+    curvature[i] = 1.0;
+  }
+  const KdTree3 tree(target.points);
+  const Eigen::Isometry3d start =
+      MakePose(1, Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.05, 0, 0));
+  const IcpResult plain = PointToPlaneIcp(source, target, tree, start, IcpOptions());
+  const IcpResult planar = PointToPlaneIcp(source, target, tree, start, IcpOptions(), &curvature);
+  EXPECT_GT(plain.target_from_source.translation().norm(), 3e-4);  // measured 0.9 mm
+  EXPECT_TRUE(planar.converged);
+  EXPECT_LT(planar.target_from_source.translation().norm(), 3e-5);  // the convergence tolerances
+  EXPECT_LT(AngleDeg(planar.target_from_source), 1.2e-4);
+  EXPECT_GT(planar.overlap_ratio, 0.99);  // the curved points still overlap
+  const std::vector<double> too_few(3, 0.0);
+  EXPECT_THROW(PointToPlaneIcp(source, target, tree, start, IcpOptions(), &too_few),
+               std::invalid_argument);
+}
+
 TEST(PointToPlaneAssociationTest, ResidualsMeasureTheTransformError) {
   const PointCloud target = testing::SyntheticRoom(200, 14);
   const Eigen::Isometry3d target_from_source =

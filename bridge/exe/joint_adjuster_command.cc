@@ -337,6 +337,9 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("num_samples_per_pair", &options->num_samples_per_pair);
   add.Add("normal_space_sampling", &adjuster.association.normal_space_sampling);
   add.Add("association_max_distance_m", &adjuster.association.max_distance);
+  add.Add("association_max_curvature",
+          &adjuster.association.max_curvature,
+          "target (and landmark) neighbourhoods above this curvature give no residual");
   add.Add("initial_association_distance_m", &adjuster.initial_association_distance_m);
   add.Add("max_association_rounds",
           &adjuster.max_association_rounds,
