@@ -227,8 +227,9 @@ void ScreenHypotheses(const StationCloud& source,
   std::vector<std::pair<double, size_t>> overlaps;
   for (size_t k = 0; k < hypotheses->size(); ++k) {
     Hypothesis& h = (*hypotheses)[k];
-    const IcpResult result = PointToPlaneIcp(
-        source.cloud, target.cloud, *target.tree, h.target_from_source, coarse, &target.curvature);
+    // Every target point (no curvature filter): screening only ranks the basins.
+    const IcpResult result =
+        PointToPlaneIcp(source.cloud, target.cloud, *target.tree, h.target_from_source, coarse);
     h.target_from_source = result.target_from_source;
     overlaps.emplace_back(-result.overlap_ratio, k);  // best first; ties keep the order
   }

@@ -95,7 +95,8 @@ bool IcpOptions::Check() const {
 namespace {
 
 // Gauss-Newton iterations from *target_from_source until converged (true) or
-// options.max_iterations; *gate and *iterations carry on from their values.
+// options.max_iterations; *gate and *iterations carry on from their values. With
+// `target_curvature`, only the planar target points give residuals and the gate stays.
 bool IterateIcp(const PointCloud& source,
                 const PointCloud& target,
                 const KdTree3& target_tree,
@@ -121,8 +122,12 @@ bool IterateIcp(const PointCloud& source,
     *target_from_source = IsometryFromIncrement(x) * *target_from_source;
     const bool small_step = x.head<3>().norm() < options.convergence_rotation_rad &&
                             x.tail<3>().norm() < options.convergence_translation_m;
-    const double next_gate = NextIcpGate(
-        *gate, std::sqrt(eq.squared_error / eq.count), options.min_correspondence_distance);
+    // With curvatures the gate stays where the first phase left it: the planar residuals' smaller
+    // RMS would shrink it, and the overlap (which picks among hypotheses) with it.
+    const double next_gate = target_curvature ? *gate
+                                              : NextIcpGate(*gate,
+                                                            std::sqrt(eq.squared_error / eq.count),
+                                                            options.min_correspondence_distance);
     // Converged: a small step with the gate settled (at its floor or at a few times the noise).
     if (small_step && next_gate > 0.98 * *gate) return true;
     *gate = next_gate;

@@ -243,6 +243,40 @@ std::vector<Edge> ReadAcceptedEdges(const std::string& path, int* num_inconsiste
   return edges;
 }
 
+// Each station's true world_from_lidar: its frame's pose (a sweep's mid instant).
+std::map<std::string, Eigen::Isometry3d> TrueWorldFromLidar(const std::string& dataset_path) {
+  const StationDataset dataset = ReadStationDataset(dataset_path);
+  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const colmap::Rigid3d cam_from_lidar =
+      ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  std::map<std::string, Eigen::Isometry3d> world_from_lidar;
+  for (const std::string& station : dataset.stations) {
+    world_from_lidar[station] =
+        ToIsometry(colmap::Inverse(cam_from_world.at(station)) * cam_from_lidar);
+  }
+  return world_from_lidar;
+}
+
+// The simulated street driven by a one-camera car (seed 1, 120 k rays per sweep): `num_frames`
+// sweeps into DIR/dataset. `frozen`: no motion during a sweep, no range noise, no moving cars.
+std::string SimulateMonoDrive(const testing::ScopedTempDir& dir, int num_frames, bool frozen) {
+  sim::SimulationOptions options;
+  options.scene = "street";
+  options.motion = "drive";
+  options.mono = true;
+  options.seed = 1;
+  options.num_stations = num_frames;
+  options.lidar_points = 120000;
+  if (frozen) {
+    options.range_noise_m = 0;
+    options.sweep_motion = false;
+    options.moving_cars = false;
+  }
+  options.output_path = dir.File("dataset");
+  sim::SimulateDataset(options);
+  return options.output_path;
+}
+
 // Ten sweeps of a car driving down the simulated street (64 beams, 2 cm range noise, no motion
 // compensation, other cars moving): the case where ICP slides along the street. Before the cycle
 // check, all-pairs registration with default options kept two edges 0.6 m off along the street.
@@ -259,15 +293,7 @@ class StreetDriveTest : public ::testing::Test {
     options.lidar_points = 120000;
     options.range_noise_m = 0.02;
     sim::SimulateDataset(options);
-    const StationDataset dataset = ReadStationDataset(options.output_path);
-    const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
-    const colmap::Rigid3d cam_from_lidar =
-        ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
-    for (const std::string& station : dataset.stations) {
-      // The frame's pose is the sweep's mid instant.
-      world_from_lidar_[station] =
-          ToIsometry(colmap::Inverse(cam_from_world.at(station)) * cam_from_lidar);
-    }
+    world_from_lidar_ = TrueWorldFromLidar(options.output_path);
   }
   static void TearDownTestSuite() { delete dir_; }
 
@@ -382,19 +408,7 @@ TEST_F(StreetDriveTest, MovingCarsAreLeftOutOfTheStaticClouds) {
 // over 11 frames was 8.6 m off before edges up to 20 frames were judged).
 TEST(StreetDriveSpeedTest, EdgesThatSlidAlongTheStreetAreRegisteredAgainAtTheirNeighboursSpeed) {
   testing::ScopedTempDir dir("colmap_lidar_street_speed");
-  sim::SimulationOptions options;
-  options.scene = "street";
-  options.motion = "drive";
-  options.mono = true;
-  options.seed = 1;
-  options.num_stations = 40;
-  options.lidar_points = 120000;
-  options.output_path = dir.File("dataset");
-  sim::SimulateDataset(options);
-  const StationDataset dataset = ReadStationDataset(options.output_path);
-  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
-  const colmap::Rigid3d cam_from_lidar =
-      ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  const StationDataset dataset = ReadStationDataset(SimulateMonoDrive(dir, 40, false));
   const auto run =
       testing::RunCommand(std::string(COLMAP_LIDAR_CLI_EXE) + " lidar_registrator --lidar_path " +
                           dir.File("dataset/lidar") + " --output_path " + dir.File("out") +
@@ -403,11 +417,7 @@ TEST(StreetDriveSpeedTest, EdgesThatSlidAlongTheStreetAreRegisteredAgainAtTheirN
   std::cout << run.output.substr(run.output.find("stations"));
   EXPECT_GE(SummaryValue(run.output, "speed_reregistered"), 1);
 
-  std::map<std::string, Eigen::Isometry3d> world_from_lidar;
-  for (const std::string& station : dataset.stations) {
-    world_from_lidar[station] =
-        ToIsometry(colmap::Inverse(cam_from_world.at(station)) * cam_from_lidar);
-  }
+  const auto world_from_lidar = TrueWorldFromLidar(dataset.root);
   int num_inconsistent = 0;
   double worst_m = 0;
   for (const Edge& e : ReadAcceptedEdges(dir.File("out/pairs.txt"), &num_inconsistent)) {
@@ -430,12 +440,6 @@ TEST(StreetDriveSpeedTest, EdgesThatSlidAlongTheStreetAreRegisteredAgainAtTheirN
   EXPECT_LT(length_error, 0.0015);
 }
 
-}  // namespace
-}  // namespace colmap_lidar
-
-namespace colmap_lidar {
-namespace {
-
 // Twenty frozen sweeps of the street (no motion during a sweep, no range noise, no moving cars): every
 // consecutive pair should register without bias. Point-to-plane residuals at edges, junctions and thin
 // poles (normals that mix surfaces) are biased at the true pose, and on forward motion they pitched
@@ -445,22 +449,7 @@ namespace {
 // first ten frames alone: +0.00053, before +0.0021).
 TEST(StreetDriveBiasTest, ConsecutiveFrozenSweepsRegisterWithoutAPitchBias) {
   testing::ScopedTempDir dir("colmap_lidar_street_bias");
-  sim::SimulationOptions options;
-  options.scene = "street";
-  options.motion = "drive";
-  options.mono = true;
-  options.seed = 1;
-  options.num_stations = 20;
-  options.lidar_points = 120000;
-  options.range_noise_m = 0;
-  options.sweep_motion = false;
-  options.moving_cars = false;
-  options.output_path = dir.File("dataset");
-  sim::SimulateDataset(options);
-  const StationDataset dataset = ReadStationDataset(options.output_path);
-  const auto cam_from_world = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
-  const colmap::Rigid3d cam_from_lidar =
-      ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  const auto world_from_lidar = TrueWorldFromLidar(SimulateMonoDrive(dir, 20, true));
   const auto run = testing::RunCommand(
       std::string(COLMAP_LIDAR_CLI_EXE) + " lidar_registrator --lidar_path " +
       dir.File("dataset/lidar") + " --output_path " + dir.File("out") + " --sequential 1");
@@ -470,10 +459,8 @@ TEST(StreetDriveBiasTest, ConsecutiveFrozenSweepsRegisterWithoutAPitchBias) {
   int num_pairs = 0;
   for (const Edge& e : ReadAcceptedEdges(dir.File("out/pairs.txt"), &num_inconsistent)) {
     const Eigen::Isometry3d truth =
-        ToIsometry(cam_from_world.at(e.target) * colmap::Inverse(cam_from_world.at(e.source)));
-    const Eigen::Isometry3d lidar_truth =
-        ToIsometry(colmap::Inverse(cam_from_lidar)) * truth * ToIsometry(cam_from_lidar);
-    const Eigen::AngleAxisd error(e.target_from_source.linear() * lidar_truth.linear().transpose());
+        world_from_lidar.at(e.target).inverse() * world_from_lidar.at(e.source);
+    const Eigen::AngleAxisd error(e.target_from_source.linear() * truth.linear().transpose());
     sum += error.angle() * error.axis() * 180 / M_PI;  // in the target's LiDAR frame (y: left)
     ++num_pairs;
   }
