@@ -1,6 +1,8 @@
 // Point-to-plane ICP (Chen & Medioni 1992): Gauss-Newton on sum_i (n_i^T (T p_i - q_i))^2 over the
 // source points whose nearest target point lies within a gate that shrinks from `max_correspondence_
-// distance` towards six times the residual RMS (never below `min_correspondence_distance`).
+// distance` towards six times the residual RMS (never below `min_correspondence_distance`). Given
+// target curvatures, a second phase from the converged pose keeps that gate and uses the planar
+// target points only (`max_target_curvature`).
 #pragma once
 
 #include "lidar/kd_tree.h"
@@ -24,10 +26,11 @@ struct IcpOptions {
   // switching on noisy clouds, so steps settle around 1e-6 rather than at machine precision.
   double convergence_rotation_rad = 1e-6;
   double convergence_translation_m = 1e-5;
-  // With target curvatures: target points above this (edges, junctions, thin cylinders, whose normals
-  // mix surfaces) enter no residual, only the overlap. Their residuals are biased at the true pose, and
-  // on a car's forward-moving sweeps they pitched every registration by +0.001 deg (with 0.77 m per
-  // frame and 3.5 deg of turning in 40 frames, a bias that tilts the turn axis by 0.4 deg).
+  // With target curvatures, the second phase: target points above this (edges, junctions, thin
+  // cylinders, whose normals mix surfaces) enter no residual, only the overlap. Their residuals are
+  // biased at the true pose: on a car's forward-moving sweeps they pitched every registration by
+  // +0.0013-0.0015 deg (0.00026 without them; docs/mono.md, 2026-12-03). Leaving them out from the
+  // start loses the basin: a street's forward constraint comes mostly from them.
   double max_target_curvature = 0.02;
 
   bool Check() const;
