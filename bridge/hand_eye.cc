@@ -275,10 +275,6 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) / kDegToRad;
 }
 
-// The angle [deg] by which `motion` contradicts `cam_from_lidar`: between the camera's rotation axis
-// and the rotated LiDAR axis (if it rotates enough), and between the camera's translation direction
-// and the one the LiDAR motion predicts, s a = R_X t_B - (R_A - I) t_X (if it translates enough); the
-// larger of the two, 0 when it says neither.
 // The angle [deg] between the camera's rotation axis of `motion` and the rotated LiDAR axis; 0 if it
 // rotates too little to have an axis.
 double AxisResidualDeg(const HandEyeMotion& motion,
@@ -290,6 +286,10 @@ double AxisResidualDeg(const HandEyeMotion& motion,
   return AngleDeg(a.axis(), cam_from_lidar.rotation * b.axis());
 }
 
+// The angle [deg] by which `motion` contradicts `cam_from_lidar`: between the camera's rotation axis
+// and the rotated LiDAR axis (if it rotates enough), and between the camera's translation direction
+// and the one the LiDAR motion predicts, s a = R_X t_B - (R_A - I) t_X (if it translates enough); the
+// larger of the two, 0 when it says neither.
 double MotionResidualDeg(const HandEyeMotion& motion,
                          const HandEyeOptions& options,
                          const colmap::Rigid3d& cam_from_lidar) {

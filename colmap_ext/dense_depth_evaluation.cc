@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 
 namespace colmap_lidar {
@@ -82,18 +81,6 @@ struct Accumulator {
   }
 };
 
-std::vector<std::string> FusedImageNames(const std::string& dense_path) {
-  const fs::path config = fs::path(dense_path) / "stereo" / "fusion.cfg";
-  std::ifstream file(config);
-  if (!file)
-    throw std::runtime_error("Cannot read " + config.string() + " (not a dense workspace)");
-  std::vector<std::string> names;
-  for (std::string line; std::getline(file, line);) {
-    if (!line.empty()) names.push_back(line);
-  }
-  return names;
-}
-
 void CompareImage(const cv::Mat& dense,
                   const cv::Mat& truth,
                   size_t sample_stride,
@@ -120,8 +107,9 @@ void CompareImage(const cv::Mat& dense,
 
 DenseDepthEvaluation EvaluateDenseDepth(const std::string& dense_path,
                                         const std::string& true_depth_path) {
+  // fusion.cfg first: the workspace's constructor creates its folders.
+  const std::vector<std::string> names = ReadFusionImageNames(dense_path);
   const DenseWorkspace workspace(dense_path);
-  const std::vector<std::string> names = FusedImageNames(dense_path);
   DenseDepthEvaluation evaluation;
   Accumulator all;
   for (const std::string& name : names) {

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <limits>
 #include <random>
 
@@ -86,6 +87,7 @@ TEST_F(DenseDepthEvaluationTest,
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find("fusion.cfg"), std::string::npos) << error.what();
   }
+  EXPECT_FALSE(std::filesystem::exists(dir_.File("truth/stereo")));  // nothing created there
 }
 
 }  // namespace

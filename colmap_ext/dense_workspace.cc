@@ -164,6 +164,19 @@ void DenseWorkspace::WriteNormalMap(const std::string& image_name, const cv::Mat
   map.Write(path);
 }
 
+std::vector<std::string> ReadFusionImageNames(const std::string& root) {
+  const fs::path config = fs::path(root) / "stereo" / "fusion.cfg";
+  std::ifstream file(config);
+  if (!file) {
+    throw std::runtime_error("Cannot read " + config.string() + " (not a dense workspace)");
+  }
+  std::vector<std::string> names;
+  for (std::string line; std::getline(file, line);) {
+    if (!line.empty()) names.push_back(line);
+  }
+  return names;
+}
+
 cv::Mat DenseWorkspace::ReadDepthMap(const std::string& image_name) const {
   return ReadColmapDepthMap(DepthMapPath(image_name));
 }

@@ -50,6 +50,11 @@ class DenseWorkspace {
   std::string root_;
 };
 
+// The images that ROOT/stereo/fusion.cfg lists (WriteConfigs). Reads only: call it before
+// constructing a DenseWorkspace on a folder that may not be one. Throws std::runtime_error naming
+// the file when it cannot be read.
+std::vector<std::string> ReadFusionImageNames(const std::string& root);
+
 // True for camera models without distortion (SIMPLE_PINHOLE, PINHOLE).
 bool IsPinholeCamera(const colmap::Camera& camera);
 

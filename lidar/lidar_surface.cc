@@ -79,7 +79,8 @@ void NeighbourDistances(const std::vector<Eigen::Vector3d>& samples,
                         std::vector<double>* kth_distance) {
   spacing->assign(samples.size(), float(options.sample_spacing_m));
   kth_distance->assign(samples.size(), 0.0);
-  const size_t k = options.grow_sparse_neighbourhoods ? std::max(5, options.min_neighbors + 1) : 5;
+  const size_t num_nearest =
+      options.grow_sparse_neighbourhoods ? std::max(5, options.min_neighbors + 1) : 5;
 #pragma omp parallel
   {
     std::vector<size_t> nearest;
@@ -87,7 +88,7 @@ void NeighbourDistances(const std::vector<Eigen::Vector3d>& samples,
 #pragma omp for schedule(dynamic, 256)
     for (size_t i = 0; i < samples.size(); ++i) {
       // The min_neighbors-th nearest only when a sparse sample may grow its neighbourhood.
-      tree.KNearest(samples[i], k, &nearest, &squared);
+      tree.KNearest(samples[i], num_nearest, &nearest, &squared);
       const size_t four = std::min<size_t>(5, nearest.size());
       double sum = 0;
       for (size_t k = 1; k < four; ++k) sum += std::sqrt(squared[k]);

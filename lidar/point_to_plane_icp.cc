@@ -94,18 +94,21 @@ bool IcpOptions::Check() const {
 
 namespace {
 
-// Gauss-Newton iterations from *target_from_source until converged (true) or
-// options.max_iterations; *gate and *iterations carry on from their values. With
-// `target_curvature`, only the planar target points give residuals and the gate stays.
-bool IterateIcp(const PointCloud& source,
-                const PointCloud& target,
-                const KdTree3& target_tree,
-                size_t stride,
-                const std::vector<double>* target_curvature,
-                const IcpOptions& options,
-                Eigen::Isometry3d* target_from_source,
-                double* gate,
-                int* iterations) {
+enum class IcpRun { kConverged, kStopped, kTooFewCorrespondences };
+
+// Gauss-Newton iterations from *target_from_source until converged or options.max_iterations
+// (kStopped), or kTooFewCorrespondences when fewer than 6 remain. *gate and *iterations carry on
+// from their values. With `target_curvature`, only the planar target points give residuals and the
+// gate stays.
+IcpRun IterateIcp(const PointCloud& source,
+                  const PointCloud& target,
+                  const KdTree3& target_tree,
+                  size_t stride,
+                  const std::vector<double>* target_curvature,
+                  const IcpOptions& options,
+                  Eigen::Isometry3d* target_from_source,
+                  double* gate,
+                  int* iterations) {
   for (int it = 0; it < options.max_iterations; ++it) {
     const NormalEquations eq = BuildNormalEquations(source,
                                                     target,
@@ -116,9 +119,9 @@ bool IterateIcp(const PointCloud& source,
                                                     target_curvature,
                                                     options.max_target_curvature);
     ++*iterations;
-    if (eq.count < 6) return false;
+    if (eq.count < 6) return IcpRun::kTooFewCorrespondences;
     const Eigen::Matrix<double, 6, 1> x = eq.H.ldlt().solve(-eq.g);
-    if (!x.allFinite()) return false;
+    if (!x.allFinite()) return IcpRun::kStopped;
     *target_from_source = IsometryFromIncrement(x) * *target_from_source;
     const bool small_step = x.head<3>().norm() < options.convergence_rotation_rad &&
                             x.tail<3>().norm() < options.convergence_translation_m;
@@ -129,10 +132,10 @@ bool IterateIcp(const PointCloud& source,
                                                             std::sqrt(eq.squared_error / eq.count),
                                                             options.min_correspondence_distance);
     // Converged: a small step with the gate settled (at its floor or at a few times the noise).
-    if (small_step && next_gate > 0.98 * *gate) return true;
+    if (small_step && next_gate > 0.98 * *gate) return IcpRun::kConverged;
     *gate = next_gate;
   }
-  return false;
+  return IcpRun::kStopped;
 }
 
 }  // namespace
@@ -159,7 +162,8 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
   result.target_from_source = initial_target_from_source;
   double gate = options.max_correspondence_distance;
   // Converge on every point first (edges and thin cylinders widen the basin), then, with
-  // curvatures, on the planar ones only (their residuals are not biased at the true pose).
+  // curvatures, on the planar ones only (their residuals are not biased at the true pose). Too few
+  // planar correspondences (a scene of trees and poles): the first phase's result stands.
   result.converged = IterateIcp(source,
                                 target,
                                 target_tree,
@@ -168,17 +172,25 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
                                 options,
                                 &result.target_from_source,
                                 &gate,
-                                &result.iterations);
+                                &result.iterations) == IcpRun::kConverged;
+  const std::vector<double>* used_curvature = nullptr;
   if (result.converged && target_curvature) {
-    result.converged = IterateIcp(source,
-                                  target,
-                                  target_tree,
-                                  stride,
-                                  target_curvature,
-                                  options,
-                                  &result.target_from_source,
-                                  &gate,
-                                  &result.iterations);
+    const Eigen::Isometry3d converged_on_every_point = result.target_from_source;
+    const IcpRun planar = IterateIcp(source,
+                                     target,
+                                     target_tree,
+                                     stride,
+                                     target_curvature,
+                                     options,
+                                     &result.target_from_source,
+                                     &gate,
+                                     &result.iterations);
+    if (planar == IcpRun::kTooFewCorrespondences) {
+      result.target_from_source = converged_on_every_point;
+    } else {
+      used_curvature = target_curvature;
+      result.converged = planar == IcpRun::kConverged;
+    }
   }
   const NormalEquations final_eq = BuildNormalEquations(source,
                                                         target,
@@ -186,7 +198,7 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
                                                         result.target_from_source,
                                                         stride,
                                                         gate,
-                                                        target_curvature,
+                                                        used_curvature,
                                                         options.max_target_curvature);
   result.num_inliers = final_eq.count;
   result.overlap_ratio = static_cast<double>(final_eq.count_in_gate) / num_used;

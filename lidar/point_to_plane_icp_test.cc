@@ -74,6 +74,13 @@ TEST(PointToPlaneIcpTest, CurvedTargetPointsEnterOnlyTheOverlap) {
   EXPECT_LT(planar.target_from_source.translation().norm(), 3e-5);  // the convergence tolerances
   EXPECT_LT(AngleDeg(planar.target_from_source), 1.2e-4);
   EXPECT_GT(planar.overlap_ratio, 0.99);  // the curved points still overlap
+  // Every target point curved (a scene of trees and poles): the first phase's result stands.
+  const std::vector<double> all_curved(target.Size(), 1.0);
+  const IcpResult fallback =
+      PointToPlaneIcp(source, target, tree, start, IcpOptions(), &all_curved);
+  EXPECT_TRUE(fallback.converged);
+  EXPECT_TRUE(fallback.target_from_source.isApprox(plain.target_from_source, 1e-12));
+  EXPECT_EQ(fallback.num_inliers, plain.num_inliers);
   const std::vector<double> too_few(3, 0.0);
   EXPECT_THROW(PointToPlaneIcp(source, target, tree, start, IcpOptions(), &too_few),
                std::invalid_argument);

@@ -62,7 +62,7 @@ void RunEvaluateDenseDepthStep(const std::string& dense_path,
             << " mm, mean (bias) " << 1000 * all.mean_error_m << " mm; within 1 / 5 cm "
             << 100 * all.within_1cm << " / " << 100 * all.within_5cm << " %" << std::endl;
 
-  fs::create_directories(output_path);
+  PartialOutputFolder partial(output_path);
   nlohmann::json metrics;
   metrics["all"] = StatisticsJson(all);
   nlohmann::json per_image = nlohmann::json::object();
@@ -72,13 +72,13 @@ void RunEvaluateDenseDepthStep(const std::string& dense_path,
   metrics["per_image"] = per_image;
   metrics["images_without_truth"] = evaluation.images_without_truth;
   metrics["images_of_another_size"] = evaluation.images_of_another_size;
-  WriteFileAtomically((fs::path(output_path) / "metrics.json").string(), metrics.dump(2) + "\n");
+  WriteFileAtomically(partial.File("metrics.json"), metrics.dump(2) + "\n");
   HistogramPlotOptions plot;
   plot.title = "Dense depth error against the true depth";
   plot.x_label = "|dense - true| [mm]";
   plot.value_scale = 1000;
-  WriteHistogramPng(
-      (fs::path(output_path) / "error_histogram.png").string(), evaluation.abs_error_sample, plot);
+  WriteHistogramPng(partial.File("error_histogram.png"), evaluation.abs_error_sample, plot);
+  partial.Commit();
   std::cout << "evaluate_dense_depth: wrote " << output_path
             << "/{metrics.json, error_histogram.png}" << std::endl;
 }

@@ -96,10 +96,6 @@ nlohmann::json EdgeReport(const EdgeCalibrationResult& result,
           {"seconds", result.seconds}};
 }
 
-}  // namespace
-
-namespace {
-
 void PrintAgainstReference(const StationDataset& dataset, const colmap::Rigid3d& cam_from_lidar) {
   if (!dataset.HasReferenceExtrinsic()) return;
   const colmap::Rigid3d truth = ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
@@ -163,6 +159,7 @@ void RunCalibrateEdgesStep(const std::string& dataset_path,
                            const std::string& registration_path,
                            const std::optional<EdgeAxisProfileRequest>& profile) {
   THROW_CHECK(options.Check());
+  if (profile) THROW_CHECK(profile->options.Check());
   const StationDataset dataset =
       registration_path.empty()
           ? ReadStationDataset(dataset_path)
@@ -224,11 +221,14 @@ int RunCalibrateEdges(int argc, char** argv) {
   std::optional<EdgeAxisProfileRequest> profile;
   if (!profile_axis.empty()) {
     const std::vector<double> axis = colmap::CSVToVector<double>(profile_axis);
-    if (axis.size() != 3 || Eigen::Vector3d(axis[0], axis[1], axis[2]).norm() == 0) {
-      throw std::invalid_argument("--profile_axis needs x,y,z (not all 0): " + profile_axis);
+    const Eigen::Vector3d axis_in_cam =
+        axis.size() == 3 ? Eigen::Vector3d(axis[0], axis[1], axis[2]) : Eigen::Vector3d::Zero();
+    if (!axis_in_cam.allFinite() || !(axis_in_cam.norm() > 0)) {
+      throw std::invalid_argument("--profile_axis needs x,y,z (finite, not all 0): " +
+                                  profile_axis);
     }
     profile_options.min_depth_m = options.min_depth_m;
-    profile = EdgeAxisProfileRequest{Eigen::Vector3d(axis[0], axis[1], axis[2]), profile_options};
+    profile = EdgeAxisProfileRequest{axis_in_cam, profile_options};
   }
   options.rotation_steps_deg = colmap::CSVToVector<double>(rotation_steps);
   options.translation_steps_m = colmap::CSVToVector<double>(translation_steps);
