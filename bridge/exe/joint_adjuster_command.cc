@@ -5,6 +5,7 @@
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
 #include "bridge/lidar_registration_files.h"
+#include "bridge/vertical_alignment.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/plot.h"
@@ -368,10 +369,18 @@ void AddJointAdjusterOptions(const std::string& prefix,
           &options->use_stereo_alignment,
           "take INPUT/initialization.json's stereo-LiDAR alignment as a measurement of "
           "cam_from_lidar");
+  add.Add("vertical_alignment",
+          &options->vertical_alignment,
+          "1: walls and vertical image edges measure cam_from_lidar's tilt (a measurement in the "
+          "cost, when no stereo-LiDAR alignment is)");
   add.Add("write_text", &options->write_text, "also write cameras.txt, images.txt, points3D.txt");
 }
 
 namespace {
+
+// [rad^2, m^2] of what the vertical alignment does not measure: no information next to the other
+// terms, and a covariance that stays well conditioned
+constexpr double kUnmeasuredVariance = 1.0;
 
 // What pose_initializer wrote about its start (INPUT/initialization.json), if anything.
 struct InitialisationFacts {
@@ -402,6 +411,49 @@ void PrintMeasurement(const ExtrinsicMeasurement& measurement) {
             << " joins the cost: sigma about the camera axes "
             << sigmas.head<3>().transpose() * 180 / M_PI << " deg, along them "
             << 1000 * sigmas.tail<3>().transpose() << " mm" << std::endl;
+}
+
+// The vertical alignment of every registered image with a cloud, as a measurement of cam_from_lidar's
+// rotation about the two horizontal camera axes; none (with a message) when it is not valid. The
+// vertical's guess is the stations' common turn axis, else the LiDAR's z axis.
+std::optional<ExtrinsicMeasurement> VerticalMeasurement(
+    const StationDataset& dataset,
+    const colmap::Reconstruction& reconstruction,
+    const JointProblemData& data,
+    const colmap::Rigid3d& cam_from_lidar,
+    const JointAdjusterOptions& adjuster) {
+  std::vector<VerticalStationInput> inputs;
+  for (const auto& [image_id, cloud] : data.clouds) {
+    const colmap::Image& image = reconstruction.Image(image_id);
+    inputs.push_back({image.Name(),
+                      (fs::path(dataset.root) / "images" / image.Name()).string(),
+                      &reconstruction.Camera(image.CameraId()),
+                      &cloud->cloud,
+                      &cloud->curvature});
+  }
+  const MotionAnalysis motion = AnalyseMotion(reconstruction, adjuster.observability);
+  const Eigen::Vector3d up_in_lidar_guess =
+      motion.common_axis_in_cam.isZero()
+          ? Eigen::Vector3d::UnitZ()
+          : Eigen::Vector3d(cam_from_lidar.rotation.inverse() * motion.common_axis_in_cam);
+  const VerticalAlignment alignment = MeasureVerticalAlignment(
+      inputs, cam_from_lidar.rotation, up_in_lidar_guess, VerticalAlignmentOptions());
+  std::cout << "Vertical alignment: " << alignment.message << std::endl;
+  if (!alignment.valid) return std::nullopt;
+  ExtrinsicMeasurement measurement;
+  measurement.source = "vertical alignment";
+  measurement.cam_from_lidar = cam_from_lidar;
+  measurement.cam_from_lidar.rotation = alignment.Corrected(cam_from_lidar.rotation);
+  measurement.covariance.setZero();
+  measurement.covariance.topLeftCorner<3, 3>() = alignment.RotationCovariance(kUnmeasuredVariance);
+  measurement.covariance.bottomRightCorner<3, 3>() =
+      kUnmeasuredVariance * Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d correction_deg = alignment.axes * alignment.correction * 180 / M_PI;
+  std::cout << "  correction about the camera axes " << correction_deg.transpose()
+            << " deg; sigma along its two axes "
+            << alignment.covariance.diagonal().cwiseSqrt().transpose() * 180 / M_PI << " deg"
+            << std::endl;
+  return measurement;
 }
 
 // A moving platform: rig.json's clouds are sweeps, or initialization.json reports a one-axis
@@ -481,6 +533,12 @@ void RunJointAdjusterStep(const StationDataset& dataset,
       options.adjuster.mode == JointMode::kJoint) {
     loaded->data.extrinsic_measurement = facts.stereo_alignment;
     PrintMeasurement(*facts.stereo_alignment);
+  }
+  if (options.vertical_alignment == 1 && !loaded->data.extrinsic_measurement &&
+      options.adjuster.mode == JointMode::kJoint) {
+    loaded->data.extrinsic_measurement = VerticalMeasurement(
+        dataset, reconstruction, loaded->data, cam_from_lidar, options.adjuster);
+    if (loaded->data.extrinsic_measurement) PrintMeasurement(*loaded->data.extrinsic_measurement);
   }
   const JointAdjustmentSummary summary =
       JointAdjuster(options.adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);

@@ -156,6 +156,9 @@ struct JointAdjusterStepOptions {
   // of cam_from_lidar in joint mode, when it was used and its covariance is clustered by station
   // (StereoLidarAlignment's min_station_clusters stations with associations).
   bool use_stereo_alignment = true;
+  // Measure cam_from_lidar's tilt from the vertical structure both sensors see
+  // (bridge/vertical_alignment.h) and take it as a measurement: 1 on, 0 off.
+  int vertical_alignment = 0;
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
   bool write_text = false;
 

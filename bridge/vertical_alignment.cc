@@ -1,0 +1,235 @@
+#include "bridge/vertical_alignment.h"
+
+#include "colmap_ext/logging.h"
+
+#include "colmap/geometry/rigid3.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace colmap_lidar {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d skew;
+  skew << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return skew;
+}
+
+PerpendicularDirection LidarVertical(const VerticalStationInput& station,
+                                     const Eigen::Vector3d& guess,
+                                     const VerticalAlignmentOptions& options) {
+  const PointCloud& cloud = *station.cloud;
+  std::vector<Eigen::Vector3d> planar_normals;
+  planar_normals.reserve(cloud.Size());
+  for (size_t i = 0; i < cloud.Size(); ++i) {
+    const bool has_normal = cloud.normals[i].squaredNorm() > 0.5;
+    if (has_normal && (*station.curvature)[i] <= options.max_curvature) {
+      planar_normals.push_back(cloud.normals[i]);  // the fit's gate keeps the walls
+    }
+  }
+  return FitPerpendicularDirection(planar_normals, {}, guess, options.lidar_fit);
+}
+
+PerpendicularDirection CameraVertical(const VerticalStationInput& station,
+                                      const Eigen::Vector3d& guess,
+                                      const VerticalAlignmentOptions& options,
+                                      size_t* num_segments) {
+  const std::vector<LineSegment> segments =
+      DetectLineSegments(station.image_path, options.segments);
+  std::vector<Eigen::Vector3d> plane_normals;
+  std::vector<double> weights;
+  for (const LineSegment& segment : segments) {
+    plane_normals.push_back(InterpretationPlaneNormal(*station.camera, segment));
+    // The plane's tilt error falls with the segment's length (end-point noise / length).
+    weights.push_back(std::pow(segment.Length() / 100.0, 2));
+  }
+  *num_segments = segments.size();
+  return FitPerpendicularDirection(plane_normals, weights, guess, options.camera_fit);
+}
+
+// Station i's linear model: r_i = b_i + A_i alpha with r_i ~ N(0, C_i + s^2 I), in the tangent of
+// its camera vertical d_i; v_i = R up_in_lidar_i, exp(axes alpha) v_i ~ v_i - [v_i]x axes alpha.
+struct StationEquation {
+  Eigen::Vector2d b;
+  Eigen::Matrix2d A;
+  Eigen::Matrix2d C;
+};
+
+StationEquation Linearise(const StationVertical& station,
+                          const Eigen::Matrix3d& cam_from_lidar,
+                          const Eigen::Matrix<double, 3, 2>& axes) {
+  const Eigen::Vector3d up_lidar_in_cam = cam_from_lidar * station.up_in_lidar.direction;
+  const Eigen::Matrix<double, 3, 2>& tangent = station.up_in_cam.tangent;
+  StationEquation equation;
+  equation.b = tangent.transpose() * (up_lidar_in_cam - station.up_in_cam.direction);
+  equation.A = -tangent.transpose() * Skew(up_lidar_in_cam) * axes;
+  const Eigen::Matrix2d lidar_to_cam_tangent =
+      tangent.transpose() * cam_from_lidar * station.up_in_lidar.tangent;
+  equation.C =
+      lidar_to_cam_tangent * station.up_in_lidar.covariance * lidar_to_cam_tangent.transpose() +
+      station.up_in_cam.covariance;
+  return equation;
+}
+
+struct WeightedFit {
+  Eigen::Vector2d alpha = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  double chi2 = 0;
+  size_t num_used = 0;
+};
+
+WeightedFit SolveWeighted(const std::vector<StationEquation>& equations,
+                          const std::vector<bool>& used,
+                          double station_variance) {
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d gradient = Eigen::Vector2d::Zero();
+  WeightedFit fit;
+  for (size_t i = 0; i < equations.size(); ++i) {
+    if (!used[i]) continue;
+    const StationEquation& e = equations[i];
+    const Eigen::Matrix2d weight = (e.C + station_variance * Eigen::Matrix2d::Identity()).inverse();
+    information += e.A.transpose() * weight * e.A;
+    gradient += e.A.transpose() * weight * e.b;
+    ++fit.num_used;
+  }
+  fit.covariance = information.inverse();
+  fit.alpha = -fit.covariance * gradient;
+  for (size_t i = 0; i < equations.size(); ++i) {
+    if (!used[i]) continue;
+    const StationEquation& e = equations[i];
+    const Eigen::Vector2d r = e.b + e.A * fit.alpha;
+    fit.chi2 += r.dot((e.C + station_variance * Eigen::Matrix2d::Identity()).inverse() * r);
+  }
+  return fit;
+}
+
+// The structure variance s^2 that brings chi2 to its degrees of freedom (0 if already below), by
+// bisection in log s^2 between (0.0006 deg)^2 and (6 deg)^2.
+double StationVariance(const std::vector<StationEquation>& equations,
+                       const std::vector<bool>& used) {
+  const WeightedFit plain = SolveWeighted(equations, used, 0.0);
+  const double dof = 2.0 * plain.num_used - 2.0;
+  if (plain.chi2 <= dof) return 0.0;
+  double low = std::log(1e-10), high = std::log(1e-2);
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (low + high);
+    (SolveWeighted(equations, used, std::exp(mid)).chi2 > dof ? low : high) = mid;
+  }
+  return std::exp(high);
+}
+
+void MeasureStations(const std::vector<VerticalStationInput>& inputs,
+                     const Eigen::Matrix3d& cam_from_lidar,
+                     const Eigen::Vector3d& up_in_lidar_guess,
+                     const VerticalAlignmentOptions& options,
+                     std::vector<StationVertical>* stations) {
+  stations->resize(inputs.size());
+#pragma omp parallel for schedule(dynamic)
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    StationVertical& station = (*stations)[i];
+    station.name = inputs[i].name;
+    station.up_in_lidar = LidarVertical(inputs[i], up_in_lidar_guess, options);
+    if (!station.up_in_lidar.valid) continue;
+    station.up_in_cam = CameraVertical(
+        inputs[i], cam_from_lidar * station.up_in_lidar.direction, options, &station.num_segments);
+  }
+}
+
+double StationChi2(const StationEquation& e,
+                   const Eigen::Vector2d& alpha,
+                   double station_variance) {
+  const Eigen::Vector2d r = e.b + e.A * alpha;
+  return r.dot((e.C + station_variance * Eigen::Matrix2d::Identity()).inverse() * r);
+}
+
+// Random-effects fit, stations beyond max_station_chi2 left out once, fit again; fills the result.
+void FitAndReject(const std::vector<StationEquation>& equations,
+                  const VerticalAlignmentOptions& options,
+                  std::vector<bool>* used,
+                  VerticalAlignment* result) {
+  double variance = StationVariance(equations, *used);
+  const WeightedFit first = SolveWeighted(equations, *used, variance);
+  for (size_t i = 0; i < equations.size(); ++i) {
+    if ((*used)[i] && StationChi2(equations[i], first.alpha, variance) > options.max_station_chi2) {
+      (*used)[i] = false;
+    }
+  }
+  variance = StationVariance(equations, *used);
+  const WeightedFit fit = SolveWeighted(equations, *used, variance);
+  result->correction = fit.alpha;
+  result->covariance = fit.covariance;
+  result->station_variance = variance;
+  for (size_t i = 0; i < equations.size(); ++i) {
+    StationVertical& station = result->stations[i];
+    station.used = (*used)[i];
+    if (station.up_in_cam.valid) {
+      station.residual_deg = kRadToDeg * (equations[i].b + equations[i].A * fit.alpha);
+    }
+  }
+  std::ostringstream message;
+  message << fit.num_used << " of " << equations.size() << " stations, structure scatter "
+          << kRadToDeg * std::sqrt(variance) << " deg per station";
+  result->message = message.str();
+  result->valid = fit.num_used >= options.min_num_stations;
+}
+
+}  // namespace
+
+bool VerticalAlignmentOptions::Check() const {
+  CHECK_OPTION(lidar_fit.Check());
+  CHECK_OPTION(camera_fit.Check());
+  CHECK_OPTION(segments.Check());
+  CHECK_OPTION_GT(max_curvature, 0);
+  CHECK_OPTION_GT(max_station_chi2, 0);
+  CHECK_OPTION_GE(min_num_stations, 2);
+  return true;
+}
+
+Eigen::Quaterniond VerticalAlignment::Corrected(
+    const Eigen::Quaterniond& cam_from_lidar_rotation) const {
+  const Eigen::Vector3d omega = axes * correction;
+  const double angle = omega.norm();
+  if (angle == 0) return cam_from_lidar_rotation;
+  return (Eigen::Quaterniond(Eigen::AngleAxisd(angle, omega / angle)) * cam_from_lidar_rotation)
+      .normalized();
+}
+
+Eigen::Matrix3d VerticalAlignment::RotationCovariance(double unmeasured_variance) const {
+  const Eigen::Vector3d vertical = axes.col(0).cross(axes.col(1));
+  return axes * covariance * axes.transpose() +
+         unmeasured_variance * vertical * vertical.transpose();
+}
+
+VerticalAlignment MeasureVerticalAlignment(const std::vector<VerticalStationInput>& inputs,
+                                           const Eigen::Quaterniond& cam_from_lidar_rotation,
+                                           const Eigen::Vector3d& up_in_lidar_guess,
+                                           const VerticalAlignmentOptions& options) {
+  THROW_CHECK(options.Check());
+  const Eigen::Matrix3d cam_from_lidar = cam_from_lidar_rotation.toRotationMatrix();
+  VerticalAlignment result;
+  MeasureStations(inputs, cam_from_lidar, up_in_lidar_guess, options, &result.stations);
+  std::vector<bool> used(inputs.size());
+  Eigen::Vector3d mean_vertical = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    used[i] = result.stations[i].up_in_lidar.valid && result.stations[i].up_in_cam.valid;
+    if (used[i]) mean_vertical += result.stations[i].up_in_cam.direction;
+  }
+  if (std::count(used.begin(), used.end(), true) < long(options.min_num_stations)) {
+    result.message = "too few stations with a vertical in both the cloud and the image";
+    return result;
+  }
+  result.axes = TangentBasis(mean_vertical.normalized());
+  std::vector<StationEquation> equations;
+  for (const StationVertical& station : result.stations) {
+    equations.push_back(station.up_in_cam.valid ? Linearise(station, cam_from_lidar, result.axes)
+                                                : StationEquation{});
+  }
+  FitAndReject(equations, options, &used, &result);
+  return result;
+}
+
+}  // namespace colmap_lidar
