@@ -289,12 +289,13 @@ double AxisResidualDeg(const HandEyeMotion& motion,
 // The angle [deg] by which `motion` contradicts `cam_from_lidar`: between the camera's rotation axis
 // and the rotated LiDAR axis (if it rotates enough), and between the camera's translation direction
 // and the one the LiDAR motion predicts, s a = R_X t_B - (R_A - I) t_X (if it translates enough); the
-// larger of the two, 0 when it says neither.
+// larger of the two, 0 when it says neither. With `axis_protected` the axis does not count.
 double MotionResidualDeg(const HandEyeMotion& motion,
                          const HandEyeOptions& options,
-                         const colmap::Rigid3d& cam_from_lidar) {
+                         const colmap::Rigid3d& cam_from_lidar,
+                         bool axis_protected) {
   const Eigen::AngleAxisd a(motion.cam_i_from_cam_j.rotation);
-  double residual = AxisResidualDeg(motion, options, cam_from_lidar);
+  double residual = axis_protected ? 0.0 : AxisResidualDeg(motion, options, cam_from_lidar);
   const Eigen::Vector3d& t_a = motion.cam_i_from_cam_j.translation;
   const Eigen::Vector3d& t_b = motion.lidar_i_from_lidar_j.translation;
   if (t_b.norm() >= kMinTranslationM && t_a.norm() > 0) {
@@ -313,18 +314,20 @@ struct Contradiction {
   bool by_axis = false;
 };
 
-// The largest MotionResidualDeg if above options.max_motion_residual_deg; else, if `by_axis_allowed`
-// and a general fit's axes do not fit one rotation (rotation_rms_deg above
-// options.max_axis_residual_deg), the largest AxisResidualDeg.
+// The largest MotionResidualDeg if above options.max_motion_residual_deg (axes not counted when
+// `axes_protected`); else, if `by_axis_allowed` and a general fit's axes do not fit one rotation
+// (rotation_rms_deg above options.max_axis_residual_deg), the largest AxisResidualDeg.
 Contradiction MostContradictingMotion(const std::vector<HandEyeMotion>& motions,
                                       const HandEyeOptions& options,
                                       const HandEyeResult& result,
                                       bool planar,
-                                      bool by_axis_allowed) {
+                                      bool by_axis_allowed,
+                                      bool axes_protected) {
   Contradiction worst, worst_axis{-1, true};
   double worst_deg = options.max_motion_residual_deg, worst_axis_deg = 0;
   for (size_t k = 0; k < motions.size(); ++k) {
-    const double residual = MotionResidualDeg(motions[k], options, result.cam_from_lidar);
+    const double residual =
+        MotionResidualDeg(motions[k], options, result.cam_from_lidar, axes_protected);
     if (residual > worst_deg) std::tie(worst.index, worst_deg) = std::make_pair(int(k), residual);
     const double axis = AxisResidualDeg(motions[k], options, result.cam_from_lidar);
     if (axis > worst_axis_deg)
@@ -341,13 +344,17 @@ Contradiction MostContradictingMotion(const std::vector<HandEyeMotion>& motions,
 // the planar variant, whose translation is 0. Only one motion is left out for its axis alone: the
 // noisy axes of a car's small turns must not be thinned until a few happen to fit. Fails
 // (rotation_unique false) when more than half of the motions would be left out, or when a general
-// fit's remaining axes are parallel.
+// fit's remaining axes are parallel. A planar fit keeps at least half of its rotating motions: the
+// axes of a drive's 1-2 deg turns from two-view geometries scatter by 10-25 deg, and leaving them out
+// worst first left none (a 40-frame drive failed to initialise); the rest are then judged by their
+// translation directions only.
 HandEyeResult FitWithoutContradictingMotions(std::vector<HandEyeMotion> motions,
                                              const HandEyeOptions& options,
                                              const Eigen::Vector3d& axis_translation_fallback,
                                              bool per_motion_scale,
                                              bool planar) {
   const size_t num_given = motions.size();
+  const size_t num_rotating_given = RotatingMotions(motions, options).motions.size();
   bool left_out_by_axis = false;
   for (int left_out = 0;; ++left_out) {
     HandEyeResult result =
@@ -355,8 +362,10 @@ HandEyeResult FitWithoutContradictingMotions(std::vector<HandEyeMotion> motions,
     result.num_contradicting = left_out;
     result.axis_misfit_left_out = left_out_by_axis;
     if (!result.message.empty()) return result;  // degenerate
-    const Contradiction worst =
-        MostContradictingMotion(motions, options, result, planar, !left_out_by_axis);
+    const bool axes_protected =
+        planar && 2 * RotatingMotions(motions, options).motions.size() < num_rotating_given + 2;
+    const Contradiction worst = MostContradictingMotion(
+        motions, options, result, planar, !left_out_by_axis, axes_protected);
     if (worst.index < 0) return result;
     if (2 * static_cast<size_t>(left_out + 1) > num_given) {
       result.rotation_unique = result.unique = false;

@@ -15,8 +15,8 @@ namespace {
 constexpr double kDegToRad = M_PI / 180.0;
 // an eigenvalue of the normal matrix below this fraction of the largest carries no information
 constexpr double kMinRelativeInformation = 1e-2;
-// the gate never cuts the residuals' distribution closer than this many RMS
-constexpr double kGateRms = 3.0;
+// the gate never cuts the residuals' distribution closer than this many robust sigmas
+constexpr double kGateSigmas = 3.0;
 
 struct NormalEquations {
   Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
@@ -24,6 +24,8 @@ struct NormalEquations {
   double weighted_square_sum = 0;
   double weight_sum = 0;
   size_t num_inliers = 0;
+  // 1.4826 median |r| of the inliers: the gate's scale, which outliers within the gate do not inflate
+  double robust_sigma = 0;
 };
 
 // Residual r_i = v_i . d of the inliers within `max_angle_rad` of perpendicular, linearised in the
@@ -34,6 +36,7 @@ NormalEquations Accumulate(const std::vector<Eigen::Vector3d>& vectors,
                            const Eigen::Matrix<double, 3, 2>& tangent,
                            double max_angle_rad) {
   NormalEquations equations;
+  std::vector<double> abs_residuals;
   const double max_residual = std::sin(max_angle_rad);
   for (size_t i = 0; i < vectors.size(); ++i) {
     const double residual = vectors[i].dot(direction);
@@ -45,6 +48,12 @@ NormalEquations Accumulate(const std::vector<Eigen::Vector3d>& vectors,
     equations.weighted_square_sum += weight * residual * residual;
     equations.weight_sum += weight;
     ++equations.num_inliers;
+    abs_residuals.push_back(std::abs(residual));
+  }
+  if (!abs_residuals.empty()) {
+    auto middle = abs_residuals.begin() + abs_residuals.size() / 2;
+    std::nth_element(abs_residuals.begin(), middle, abs_residuals.end());
+    equations.robust_sigma = 1.4826 * *middle;
   }
   return equations;
 }
@@ -112,11 +121,12 @@ PerpendicularDirection FitPerpendicularDirection(const std::vector<Eigen::Vector
   }
   PerpendicularDirection result;
   result.direction = guess.normalized();
+  double robust_sigma = 0;
   // The last pass only measures: covariance and RMS in the final direction's own tangent.
   for (int k = 0; k <= options.num_iterations; ++k) {
     result.tangent = TangentBasis(result.direction);
     const double gate = std::max(GateRad(options, std::min(k, options.num_iterations - 1)),
-                                 k == 0 ? 0.0 : kGateRms * result.rms_deg * kDegToRad);
+                                 kGateSigmas * robust_sigma);
     const NormalEquations equations =
         Accumulate(unit_vectors, weights, result.direction, result.tangent, gate);
     const GaussNewtonStep step = Solve(equations);
@@ -124,6 +134,7 @@ PerpendicularDirection FitPerpendicularDirection(const std::vector<Eigen::Vector
       return PerpendicularDirection();
     }
     result.num_inliers = equations.num_inliers;
+    robust_sigma = equations.robust_sigma;
     result.covariance = step.covariance;
     result.rms_deg = std::sqrt(equations.weighted_square_sum / equations.weight_sum) / kDegToRad;
     if (k < options.num_iterations) {

@@ -15,8 +15,8 @@ namespace colmap_lidar {
 struct PerpendicularDirectionOptions {
   // a vector takes part in the first iteration when within this angle of perpendicular [deg]
   double initial_max_angle_deg = 10;
-  // ... and in the last one within this angle, or 3 RMS of the previous iteration's inliers when
-  // wider; the gate shrinks geometrically in between [deg]
+  // ... and in the last one within this angle, or 3 robust sigmas (1.4826 median) of the previous
+  // iteration's inliers when wider; the gate shrinks geometrically in between [deg]
   double final_max_angle_deg = 1;
   int num_iterations = 6;
   // fewer inliers: no direction

@@ -290,6 +290,7 @@ void PrintUncertainty(const JointAdjustmentSummary& summary, const std::string& 
 }  // namespace
 
 bool JointAdjusterStepOptions::Check() {
+  CHECK_OPTION(vertical_alignment >= -1 && vertical_alignment <= 1);
   adjuster.mode = JointModeFromName(mode);
   adjuster.hold_translation = ParseHeldAxes(hold_translation);
   CHECK_OPTION_GT(num_samples_per_pair, 0);
@@ -371,8 +372,9 @@ void AddJointAdjusterOptions(const std::string& prefix,
           "cam_from_lidar");
   add.Add("vertical_alignment",
           &options->vertical_alignment,
-          "1: walls and vertical image edges measure cam_from_lidar's tilt (a measurement in the "
-          "cost, when no stereo-LiDAR alignment is)");
+          "walls and vertical image edges measure cam_from_lidar's tilt (a measurement in the "
+          "cost, when no stereo-LiDAR alignment is): 1 on, 0 off, -1 on for a moving platform "
+          "whose stations do not rotate about two axes");
   add.Add("write_text", &options->write_text, "also write cameras.txt, images.txt, points3D.txt");
 }
 
@@ -436,8 +438,12 @@ std::optional<ExtrinsicMeasurement> VerticalMeasurement(
       motion.common_axis_in_cam.isZero()
           ? Eigen::Vector3d::UnitZ()
           : Eigen::Vector3d(cam_from_lidar.rotation.inverse() * motion.common_axis_in_cam);
-  const VerticalAlignment alignment = MeasureVerticalAlignment(
-      inputs, cam_from_lidar.rotation, up_in_lidar_guess, VerticalAlignmentOptions());
+  VerticalAlignmentOptions options;
+  // The hand-eye of a drive can leave the roll several degrees off.
+  options.camera_fit.initial_max_angle_deg = 20;
+  options.camera_fit.num_iterations = 8;
+  const VerticalAlignment alignment =
+      MeasureVerticalAlignment(inputs, cam_from_lidar.rotation, up_in_lidar_guess, options);
   std::cout << "Vertical alignment: " << alignment.message << std::endl;
   if (!alignment.valid) return std::nullopt;
   ExtrinsicMeasurement measurement;
@@ -482,10 +488,12 @@ void ResolveAutomaticOptions(const StationDataset& dataset,
                              const InitialisationFacts& facts,
                              const colmap::Reconstruction& reconstruction,
                              JointAdjusterStepOptions* options) {
-  if (options->landmark_lidar_weight >= 0) return;
+  if (options->landmark_lidar_weight >= 0 && options->vertical_alignment >= 0) return;
   const MotionAnalysis motion = AnalyseMotion(reconstruction, options->adjuster.observability);
   const bool degenerate_motion =
       facts.one_axis || (!motion.unique && dataset.rig.lidar_sweep.has_value());
+  if (options->vertical_alignment < 0) options->vertical_alignment = degenerate_motion ? 1 : 0;
+  if (options->landmark_lidar_weight >= 0) return;
   options->adjuster.landmark_lidar_weight =
       degenerate_motion ? kMovingPlatformLandmarkWeight : (dataset.rig.IsStereo() ? 0.0 : 1.0);
   if (degenerate_motion) {
@@ -538,7 +546,12 @@ void RunJointAdjusterStep(const StationDataset& dataset,
       options.adjuster.mode == JointMode::kJoint) {
     loaded->data.extrinsic_measurement = VerticalMeasurement(
         dataset, reconstruction, loaded->data, cam_from_lidar, options.adjuster);
-    if (loaded->data.extrinsic_measurement) PrintMeasurement(*loaded->data.extrinsic_measurement);
+    if (loaded->data.extrinsic_measurement) {
+      PrintMeasurement(*loaded->data.extrinsic_measurement);
+      // Start from it: a drive's hand-eye can leave the roll degrees off, and the first round's wide
+      // associations then settle the height wrongly.
+      cam_from_lidar.rotation = loaded->data.extrinsic_measurement->cam_from_lidar.rotation;
+    }
   }
   const JointAdjustmentSummary summary =
       JointAdjuster(options.adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);

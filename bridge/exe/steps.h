@@ -157,8 +157,10 @@ struct JointAdjusterStepOptions {
   // (StereoLidarAlignment's min_station_clusters stations with associations).
   bool use_stereo_alignment = true;
   // Measure cam_from_lidar's tilt from the vertical structure both sensors see
-  // (bridge/vertical_alignment.h) and take it as a measurement: 1 on, 0 off.
-  int vertical_alignment = 0;
+  // (bridge/vertical_alignment.h), start from it and take it as a measurement, in joint mode when no
+  // stereo-LiDAR alignment is one: 1 on, 0 off, -1 on for a moving platform whose stations do not
+  // rotate about two axes (decided by RunJointAdjusterStep, as for landmark_lidar_weight).
+  int vertical_alignment = -1;
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
   bool write_text = false;
 
