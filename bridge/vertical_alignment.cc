@@ -167,7 +167,9 @@ void FitAndReject(const std::vector<StationEquation>& equations,
     StationVertical& station = result->stations[i];
     station.used = (*used)[i];
     if (station.up_in_cam.valid) {
-      station.residual_deg = kRadToDeg * (equations[i].b + equations[i].A * fit.alpha);
+      const Eigen::Vector2d residual = equations[i].b + equations[i].A * fit.alpha;
+      station.residual_deg =
+          kRadToDeg * result->axes.transpose() * station.up_in_cam.tangent * residual;
     }
   }
   std::ostringstream message;

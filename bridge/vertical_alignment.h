@@ -52,7 +52,7 @@ struct StationVertical {
   PerpendicularDirection up_in_cam;
   size_t num_segments = 0;
   bool used = false;
-  // R_e up_in_lidar - up_in_cam at the result, in up_in_cam's tangent [deg]
+  // R_e up_in_lidar - up_in_cam at the result, on the measured `axes` of VerticalAlignment [deg]
   Eigen::Vector2d residual_deg = Eigen::Vector2d::Zero();
 };
 

@@ -2,10 +2,10 @@
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "bridge/exe/stereo_alignment_report.h"
+#include "bridge/exe/vertical_alignment_step.h"
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
 #include "bridge/lidar_registration_files.h"
-#include "bridge/vertical_alignment.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/plot.h"
@@ -140,8 +140,10 @@ void WriteReport(const std::string& directory,
                  const colmap::Rigid3d& initial,
                  const colmap::Rigid3d& refined,
                  const JointAdjustmentSummary& summary,
-                 const std::string& caveat) {
+                 const std::string& caveat,
+                 const std::optional<VerticalAlignment>& vertical) {
   nlohmann::json report;
+  if (vertical) report["vertical_alignment"] = VerticalAlignmentJson(*vertical);
   report["mode"] = JointModeName(options.mode);
   report["conventions"] =
       "cam_from_lidar maps LiDAR points into the left camera; quaternions w "
@@ -380,10 +382,6 @@ void AddJointAdjusterOptions(const std::string& prefix,
 
 namespace {
 
-// [rad^2, m^2] of what the vertical alignment does not measure: no information next to the other
-// terms, and a covariance that stays well conditioned
-constexpr double kUnmeasuredVariance = 1.0;
-
 // What pose_initializer wrote about its start (INPUT/initialization.json), if anything.
 struct InitialisationFacts {
   bool one_axis = false;  // every rotation about one axis (a driving platform)
@@ -413,53 +411,6 @@ void PrintMeasurement(const ExtrinsicMeasurement& measurement) {
             << " joins the cost: sigma about the camera axes "
             << sigmas.head<3>().transpose() * 180 / M_PI << " deg, along them "
             << 1000 * sigmas.tail<3>().transpose() << " mm" << std::endl;
-}
-
-// The vertical alignment of every registered image with a cloud, as a measurement of cam_from_lidar's
-// rotation about the two horizontal camera axes; none (with a message) when it is not valid. The
-// vertical's guess is the stations' common turn axis, else the LiDAR's z axis.
-std::optional<ExtrinsicMeasurement> VerticalMeasurement(
-    const StationDataset& dataset,
-    const colmap::Reconstruction& reconstruction,
-    const JointProblemData& data,
-    const colmap::Rigid3d& cam_from_lidar,
-    const JointAdjusterOptions& adjuster) {
-  std::vector<VerticalStationInput> inputs;
-  for (const auto& [image_id, cloud] : data.clouds) {
-    const colmap::Image& image = reconstruction.Image(image_id);
-    inputs.push_back({image.Name(),
-                      (fs::path(dataset.root) / "images" / image.Name()).string(),
-                      &reconstruction.Camera(image.CameraId()),
-                      &cloud->cloud,
-                      &cloud->curvature});
-  }
-  const MotionAnalysis motion = AnalyseMotion(reconstruction, adjuster.observability);
-  const Eigen::Vector3d up_in_lidar_guess =
-      motion.common_axis_in_cam.isZero()
-          ? Eigen::Vector3d::UnitZ()
-          : Eigen::Vector3d(cam_from_lidar.rotation.inverse() * motion.common_axis_in_cam);
-  VerticalAlignmentOptions options;
-  // The hand-eye of a drive can leave the roll several degrees off.
-  options.camera_fit.initial_max_angle_deg = 20;
-  options.camera_fit.num_iterations = 8;
-  const VerticalAlignment alignment =
-      MeasureVerticalAlignment(inputs, cam_from_lidar.rotation, up_in_lidar_guess, options);
-  std::cout << "Vertical alignment: " << alignment.message << std::endl;
-  if (!alignment.valid) return std::nullopt;
-  ExtrinsicMeasurement measurement;
-  measurement.source = "vertical alignment";
-  measurement.cam_from_lidar = cam_from_lidar;
-  measurement.cam_from_lidar.rotation = alignment.Corrected(cam_from_lidar.rotation);
-  measurement.covariance.setZero();
-  measurement.covariance.topLeftCorner<3, 3>() = alignment.RotationCovariance(kUnmeasuredVariance);
-  measurement.covariance.bottomRightCorner<3, 3>() =
-      kUnmeasuredVariance * Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d correction_deg = alignment.axes * alignment.correction * 180 / M_PI;
-  std::cout << "  correction about the camera axes " << correction_deg.transpose()
-            << " deg; sigma along its two axes "
-            << alignment.covariance.diagonal().cwiseSqrt().transpose() * 180 / M_PI << " deg"
-            << std::endl;
-  return measurement;
 }
 
 // A moving platform: rig.json's clouds are sweeps, or initialization.json reports a one-axis
@@ -542,12 +493,13 @@ void RunJointAdjusterStep(const StationDataset& dataset,
     loaded->data.extrinsic_measurement = facts.stereo_alignment;
     PrintMeasurement(*facts.stereo_alignment);
   }
+  std::optional<VerticalAlignment> vertical;
   if (options.vertical_alignment == 1 && !loaded->data.extrinsic_measurement &&
       options.adjuster.mode == JointMode::kJoint) {
-    loaded->data.extrinsic_measurement = VerticalMeasurement(
-        dataset, reconstruction, loaded->data, cam_from_lidar, options.adjuster);
-    if (loaded->data.extrinsic_measurement) {
-      PrintMeasurement(*loaded->data.extrinsic_measurement);
+    vertical = MeasureStationVerticals(
+        dataset, reconstruction, loaded->data, cam_from_lidar, options.adjuster.observability);
+    if (vertical->valid) {
+      loaded->data.extrinsic_measurement = VerticalAlignmentMeasurement(*vertical, cam_from_lidar);
       // Start from it: a drive's hand-eye can leave the roll degrees off, and the first round's wide
       // associations then settle the height wrongly.
       cam_from_lidar.rotation = loaded->data.extrinsic_measurement->cam_from_lidar.rotation;
@@ -564,8 +516,18 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                     "); qw qx qy qz tx ty tz",
                 cam_from_lidar);
   const std::string caveat = UncertaintyCaveat(summary.motion, IsMovingPlatform(dataset, facts));
-  WriteReport(partial.Path(), options.adjuster, *loaded, initial, cam_from_lidar, summary, caveat);
+  WriteReport(partial.Path(),
+              options.adjuster,
+              *loaded,
+              initial,
+              cam_from_lidar,
+              summary,
+              caveat,
+              vertical);
   WritePlots(partial.Path(), summary);
+  if (vertical && vertical->valid) {
+    WriteVerticalAlignmentPlot(partial.File("vertical_alignment.png"), *vertical);
+  }
   partial.Commit();
   PrintUncertainty(summary, caveat);
   std::cout << "Wrote " << paths.output_path << " (" << SecondsSince(start) << " s)" << std::endl;
