@@ -427,8 +427,9 @@ std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform
                                ? DescribeAxis(motion.common_axis_in_cam)
                                : std::string("no turn of 2 deg");
   return "not validated for a moving platform turning about one axis (" + axis +
-         "): on simulated 40-frame street drives the errors reached 5 of these sigmas (the "
-         "rotation about the driving direction); read them as lower bounds";
+         "): on simulated 40-frame street drives the errors reached 3 of these sigmas with the "
+         "vertical alignment (the rotation about the driving direction), 5-8 without it; read "
+         "them as lower bounds";
 }
 
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(

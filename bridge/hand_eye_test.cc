@@ -210,6 +210,19 @@ TEST(SimilarityHandEye, LeavesOutOneMisfittingAxisOfStations) {
   EXPECT_LT((result.cam_from_lidar.translation - kCamFromLidar.translation).norm(), 1e-9);
 }
 
+// The first `count` motions' LiDAR rotation: the camera's angle about the true vertical (camera y),
+// so that the noise of their axes is the camera's (two-view geometry).
+void TurnLidarAboutTheVertical(size_t count, std::vector<HandEyeMotion>* motions) {
+  for (size_t k = 0; k < count; ++k) {
+    HandEyeMotion& motion = (*motions)[k];
+    const Eigen::AngleAxisd a(motion.cam_i_from_cam_j.rotation);
+    const Eigen::AngleAxisd vertical(a.angle(),
+                                     (a.axis().y() < 0 ? -1.0 : 1.0) * Eigen::Vector3d::UnitY());
+    motion.lidar_i_from_lidar_j.rotation =
+        kCamFromLidar.rotation.inverse() * Eigen::Quaterniond(vertical) * kCamFromLidar.rotation;
+  }
+}
+
 // A car's small turns have noisy axes (2-3 deg turns, axes 5-8.5 deg off the vertical all round):
 // they span more than 10 deg but fit no general rotation, and leaving out one axis does not change
 // that. The planar variant is used, not a general fit of a few axes that happen to agree.
@@ -224,13 +237,7 @@ TEST(SimilarityHandEye, NoisyTurnsOfADriveStayPlanar) {
   turns.push_back(Motion(0, {0, 1, 0}, {0.02, 0, 5.0}));
   std::vector<HandEyeMotion> motions = Conjugate(turns);
   // The noise is the camera's (two-view geometry): the LiDAR turns about the true vertical.
-  for (size_t k = 0; k + 1 < motions.size(); ++k) {
-    const Eigen::AngleAxisd a(motions[k].cam_i_from_cam_j.rotation);
-    const Eigen::AngleAxisd vertical(a.angle(),
-                                     (a.axis().y() < 0 ? -1.0 : 1.0) * Eigen::Vector3d::UnitY());
-    motions[k].lidar_i_from_lidar_j.rotation =
-        kCamFromLidar.rotation.inverse() * Eigen::Quaterniond(vertical) * kCamFromLidar.rotation;
-  }
+  TurnLidarAboutTheVertical(motions.size() - 1, &motions);
   for (HandEyeMotion& motion : motions) motion.cam_i_from_cam_j.translation.normalize();
   const HandEyeResult result =
       SolveSimilarityHandEye(motions, MonocularOptions(), Eigen::Vector3d::Zero(), true);
@@ -254,13 +261,7 @@ TEST(SimilarityHandEye, PlanarFitKeepsHalfOfItsRotatingMotions) {
   }
   for (int k = 0; k < 6; ++k) turns.push_back(Motion(0, {0, 1, 0}, {0.03 * k - 0.08, 0, 5.0}));
   std::vector<HandEyeMotion> motions = Conjugate(turns);
-  for (size_t k = 0; k < 5; ++k) {  // the LiDAR turns about the true vertical
-    const Eigen::AngleAxisd a(motions[k].cam_i_from_cam_j.rotation);
-    const Eigen::AngleAxisd vertical(a.angle(),
-                                     (a.axis().y() < 0 ? -1.0 : 1.0) * Eigen::Vector3d::UnitY());
-    motions[k].lidar_i_from_lidar_j.rotation =
-        kCamFromLidar.rotation.inverse() * Eigen::Quaterniond(vertical) * kCamFromLidar.rotation;
-  }
+  TurnLidarAboutTheVertical(5, &motions);
   for (HandEyeMotion& motion : motions) motion.cam_i_from_cam_j.translation.normalize();
   const HandEyeResult result =
       SolveSimilarityHandEye(motions, MonocularOptions(), Eigen::Vector3d::Zero(), true);

@@ -17,15 +17,20 @@ bool EdgeDistanceTransformOptions::Check() const {
   return true;
 }
 
-cv::Mat EdgeImage(const cv::Mat& image, double blur_sigma_px) {
+cv::Mat GreyImage(const cv::Mat& image) {
   THROW_CHECK(!image.empty());
   cv::Mat grey;
   if (image.channels() == 3) {
     cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   } else {
-    grey = image;
+    grey = image.clone();
   }
   THROW_CHECK_EQ(grey.type(), CV_8UC1);
+  return grey;
+}
+
+cv::Mat EdgeImage(const cv::Mat& image, double blur_sigma_px) {
+  cv::Mat grey = GreyImage(image);
   if (blur_sigma_px > 0) cv::GaussianBlur(grey, grey, cv::Size(), blur_sigma_px);
   // max_q |I(p) - I(q)| over the 3x3 neighbourhood = max(dilate(I) - I, I - erode(I)); OpenCV's
   // default border of dilate/erode leaves pixels outside the image out.

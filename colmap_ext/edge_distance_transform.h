@@ -24,6 +24,9 @@ struct EdgeDistanceTransformOptions {
   bool Check() const;
 };
 
+// An 8-bit grey copy of an 8-bit grey or BGR image (never a view: callers blur it in place).
+cv::Mat GreyImage(const cv::Mat& image);
+
 // CV_8UC1 (or CV_8UC3, converted to grey) -> CV_32F edge image E (of the blurred image if
 // blur_sigma_px > 0).
 cv::Mat EdgeImage(const cv::Mat& image, double blur_sigma_px = 0.0);

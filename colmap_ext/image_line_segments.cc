@@ -1,5 +1,6 @@
 #include "colmap_ext/image_line_segments.h"
 
+#include "colmap_ext/edge_distance_transform.h"
 #include "colmap_ext/logging.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -20,14 +21,7 @@ bool LineSegmentOptions::Check() const {
 std::vector<LineSegment> DetectLineSegments(const cv::Mat& image,
                                             const LineSegmentOptions& options) {
   THROW_CHECK(options.Check());
-  THROW_CHECK(!image.empty());
-  cv::Mat grey;
-  if (image.channels() == 3) {
-    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  } else {
-    grey = image;
-  }
-  THROW_CHECK_EQ(grey.type(), CV_8UC1);
+  cv::Mat grey = GreyImage(image);
   const double scale =
       std::min(1.0, double(options.max_image_size) / std::max(grey.cols, grey.rows));
   if (scale < 1.0) cv::resize(grey, grey, cv::Size(), scale, scale, cv::INTER_AREA);
