@@ -1,6 +1,7 @@
 #include "bridge/vertical_alignment.h"
 
 #include "colmap_ext/logging.h"
+#include "lidar/parallel_for_each.h"
 
 #include "colmap/geometry/rigid3.h"
 
@@ -12,6 +13,7 @@ namespace colmap_lidar {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
+constexpr int kNumLinearisations = 3;
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d skew;
@@ -54,9 +56,9 @@ PerpendicularDirection CameraVertical(const VerticalStationInput& station,
 // Station i's linear model: r_i = b_i + A_i alpha with r_i ~ N(0, C_i + s^2 I), in the tangent of
 // its camera vertical d_i; v_i = R up_in_lidar_i, exp(axes alpha) v_i ~ v_i - [v_i]x axes alpha.
 struct StationEquation {
-  Eigen::Vector2d b;
-  Eigen::Matrix2d A;
-  Eigen::Matrix2d C;
+  Eigen::Vector2d offset;      // b_i
+  Eigen::Matrix2d jacobian;    // A_i
+  Eigen::Matrix2d covariance;  // C_i
 };
 
 StationEquation Linearise(const StationVertical& station,
@@ -65,11 +67,11 @@ StationEquation Linearise(const StationVertical& station,
   const Eigen::Vector3d up_lidar_in_cam = cam_from_lidar * station.up_in_lidar.direction;
   const Eigen::Matrix<double, 3, 2>& tangent = station.up_in_cam.tangent;
   StationEquation equation;
-  equation.b = tangent.transpose() * (up_lidar_in_cam - station.up_in_cam.direction);
-  equation.A = -tangent.transpose() * Skew(up_lidar_in_cam) * axes;
+  equation.offset = tangent.transpose() * (up_lidar_in_cam - station.up_in_cam.direction);
+  equation.jacobian = -tangent.transpose() * Skew(up_lidar_in_cam) * axes;
   const Eigen::Matrix2d lidar_to_cam_tangent =
       tangent.transpose() * cam_from_lidar * station.up_in_lidar.tangent;
-  equation.C =
+  equation.covariance =
       lidar_to_cam_tangent * station.up_in_lidar.covariance * lidar_to_cam_tangent.transpose() +
       station.up_in_cam.covariance;
   return equation;
@@ -91,9 +93,10 @@ WeightedFit SolveWeighted(const std::vector<StationEquation>& equations,
   for (size_t i = 0; i < equations.size(); ++i) {
     if (!used[i]) continue;
     const StationEquation& e = equations[i];
-    const Eigen::Matrix2d weight = (e.C + station_variance * Eigen::Matrix2d::Identity()).inverse();
-    information += e.A.transpose() * weight * e.A;
-    gradient += e.A.transpose() * weight * e.b;
+    const Eigen::Matrix2d weight =
+        (e.covariance + station_variance * Eigen::Matrix2d::Identity()).inverse();
+    information += e.jacobian.transpose() * weight * e.jacobian;
+    gradient += e.jacobian.transpose() * weight * e.offset;
     ++fit.num_used;
   }
   fit.covariance = information.inverse();
@@ -101,8 +104,9 @@ WeightedFit SolveWeighted(const std::vector<StationEquation>& equations,
   for (size_t i = 0; i < equations.size(); ++i) {
     if (!used[i]) continue;
     const StationEquation& e = equations[i];
-    const Eigen::Vector2d r = e.b + e.A * fit.alpha;
-    fit.chi2 += r.dot((e.C + station_variance * Eigen::Matrix2d::Identity()).inverse() * r);
+    const Eigen::Vector2d r = e.offset + e.jacobian * fit.alpha;
+    fit.chi2 +=
+        r.dot((e.covariance + station_variance * Eigen::Matrix2d::Identity()).inverse() * r);
   }
   return fit;
 }
@@ -128,22 +132,22 @@ void MeasureStations(const std::vector<VerticalStationInput>& inputs,
                      const VerticalAlignmentOptions& options,
                      std::vector<StationVertical>* stations) {
   stations->resize(inputs.size());
-#pragma omp parallel for schedule(dynamic)
-  for (size_t i = 0; i < inputs.size(); ++i) {
+  // An unreadable image throws; ParallelForEach carries it out of the OpenMP region.
+  ParallelForEach(static_cast<int>(inputs.size()), [&](int i) {
     StationVertical& station = (*stations)[i];
     station.name = inputs[i].name;
     station.up_in_lidar = LidarVertical(inputs[i], up_in_lidar_guess, options);
-    if (!station.up_in_lidar.valid) continue;
+    if (!station.up_in_lidar.valid) return;
     station.up_in_cam = CameraVertical(
         inputs[i], cam_from_lidar * station.up_in_lidar.direction, options, &station.num_segments);
-  }
+  });
 }
 
 double StationChi2(const StationEquation& e,
                    const Eigen::Vector2d& alpha,
                    double station_variance) {
-  const Eigen::Vector2d r = e.b + e.A * alpha;
-  return r.dot((e.C + station_variance * Eigen::Matrix2d::Identity()).inverse() * r);
+  const Eigen::Vector2d r = e.offset + e.jacobian * alpha;
+  return r.dot((e.covariance + station_variance * Eigen::Matrix2d::Identity()).inverse() * r);
 }
 
 // Random-effects fit, stations beyond max_station_chi2 left out once, fit again; fills the result.
@@ -167,7 +171,7 @@ void FitAndReject(const std::vector<StationEquation>& equations,
     StationVertical& station = result->stations[i];
     station.used = (*used)[i];
     if (station.up_in_cam.valid) {
-      const Eigen::Vector2d residual = equations[i].b + equations[i].A * fit.alpha;
+      const Eigen::Vector2d residual = equations[i].offset + equations[i].jacobian * fit.alpha;
       station.residual_deg =
           kRadToDeg * result->axes.transpose() * station.up_in_cam.tangent * residual;
     }
@@ -225,12 +229,22 @@ VerticalAlignment MeasureVerticalAlignment(const std::vector<VerticalStationInpu
     return result;
   }
   result.axes = TangentBasis(mean_vertical.normalized());
-  std::vector<StationEquation> equations;
-  for (const StationVertical& station : result.stations) {
-    equations.push_back(station.up_in_cam.valid ? Linearise(station, cam_from_lidar, result.axes)
-                                                : StationEquation{});
+  // Gauss-Newton: linearised again at the corrected rotation (a drive's start can be degrees off;
+  // one linear step from 8 deg left 0.12 deg).
+  Eigen::Vector2d correction = Eigen::Vector2d::Zero();
+  for (int k = 0; k < kNumLinearisations; ++k) {
+    result.correction = correction;
+    const Eigen::Matrix3d rotation = result.Corrected(cam_from_lidar_rotation).toRotationMatrix();
+    std::vector<StationEquation> equations;
+    for (const StationVertical& station : result.stations) {
+      equations.push_back(station.up_in_cam.valid ? Linearise(station, rotation, result.axes)
+                                                  : StationEquation{});
+    }
+    std::vector<bool> used_now = used;
+    FitAndReject(equations, options, &used_now, &result);
+    correction += result.correction;
   }
-  FitAndReject(equations, options, &used, &result);
+  result.correction = correction;
   return result;
 }
 

@@ -23,9 +23,21 @@
 
 namespace colmap_lidar {
 
+// PerpendicularDirectionOptions whose first gate is `initial_max_angle_deg`, in 8 iterations.
+inline PerpendicularDirectionOptions WideGate(double initial_max_angle_deg) {
+  PerpendicularDirectionOptions options;
+  options.initial_max_angle_deg = initial_max_angle_deg;
+  options.num_iterations = 8;
+  return options;
+}
+
 struct VerticalAlignmentOptions {
-  PerpendicularDirectionOptions lidar_fit;
-  PerpendicularDirectionOptions camera_fit;
+  // Wide first gates: on a drive the guesses come from noisy turn axes (their span reached 14 deg)
+  // and a hand-eye (roll up to 9.5 deg off). A gate narrower than the guess's error leaves the walls
+  // out and fits whatever lies near perpendicular, consistently wrong at every station; the ground
+  // (normal along the vertical) stays out of any gate below 50 deg.
+  PerpendicularDirectionOptions lidar_fit = WideGate(35);
+  PerpendicularDirectionOptions camera_fit = WideGate(20);
   LineSegmentOptions segments;
   // LiDAR samples above this curvature are not walls
   double max_curvature = 0.02;

@@ -271,9 +271,7 @@ TEST(KittiSampleTest, WallsAndVerticalEdgesGiveAnHonestTilt) {
                       &clouds[i]->cloud,
                       &clouds[i]->curvature});
   }
-  VerticalAlignmentOptions options;
-  options.camera_fit.initial_max_angle_deg = 20;
-  options.camera_fit.num_iterations = 8;
+  const VerticalAlignmentOptions options;
   const Eigen::Quaterniond perturbation =
       Eigen::AngleAxisd(2.0 * M_PI / 180, Eigen::Vector3d::UnitZ()) *
       Eigen::AngleAxisd(0.5 * M_PI / 180, Eigen::Vector3d::UnitX());

@@ -4,7 +4,9 @@
 #include "lidar/plot.h"
 
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 
 namespace colmap_lidar {
 namespace {
@@ -48,20 +50,18 @@ VerticalAlignment MeasureStationVerticals(const StationDataset& dataset,
       motion.common_axis_in_cam.isZero()
           ? Eigen::Vector3d::UnitZ()
           : Eigen::Vector3d(cam_from_lidar.rotation.inverse() * motion.common_axis_in_cam);
-  VerticalAlignmentOptions options;
-  // The hand-eye of a drive can leave the roll several degrees off.
-  options.camera_fit.initial_max_angle_deg = 20;
-  options.camera_fit.num_iterations = 8;
+  const VerticalAlignmentOptions options;
   const VerticalAlignment alignment =
       MeasureVerticalAlignment(inputs, cam_from_lidar.rotation, up_in_lidar_guess, options);
-  std::cout << "Vertical alignment (walls and vertical image edges): " << alignment.message;
+  std::ostringstream line;  // std::cout may hold a fixed precision of 1
+  line << "Vertical alignment (walls and vertical image edges): " << alignment.message;
   if (alignment.valid) {
-    std::cout << "; correction about the camera axes "
-              << (alignment.axes * alignment.correction).transpose() * kRadToDeg
-              << " deg, sigma along its two axes "
-              << alignment.covariance.diagonal().cwiseSqrt().transpose() * kRadToDeg << " deg";
+    line << std::setprecision(3) << "; correction about the camera axes "
+         << (alignment.axes * alignment.correction).transpose() * kRadToDeg
+         << " deg, sigma along its two axes "
+         << alignment.covariance.diagonal().cwiseSqrt().transpose() * kRadToDeg << " deg";
   }
-  std::cout << std::endl;
+  std::cout << line.str() << std::endl;
   return alignment;
 }
 
