@@ -199,8 +199,8 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(const std::string& databas
   auto loaded = std::make_unique<LoadedJointData>();
   std::vector<colmap::image_t> image_ids = reconstruction.RegImageIds();
   std::sort(image_ids.begin(), image_ids.end());
-  const std::map<colmap::image_t, size_t> station_of_image =
-      StationOfImage(dataset, reconstruction, image_ids);
+  loaded->station_of_image = StationOfImage(dataset, reconstruction, image_ids);
+  const std::map<colmap::image_t, size_t>& station_of_image = loaded->station_of_image;
   ImagePairSet pairs;
   {
     const colmap::Database database(database_path);

@@ -10,6 +10,7 @@
 #include "bridge/joint_adjuster.h"
 #include "colmap_ext/station_dataset.h"
 
+#include <map>
 #include <memory>
 #include <string>
 
@@ -30,6 +31,8 @@ struct JointDataOptions {
 struct LoadedJointData {
   JointProblemData data;
   std::vector<std::unique_ptr<StationCloud>> clouds;  // owns what data.clouds points to
+  // index into the dataset's stations of every registered image (by the image name's stem)
+  std::map<colmap::image_t, size_t> station_of_image;
   size_t num_image_pairs = 0;
   size_t num_lidar_pairs = 0;
 };

@@ -3,6 +3,7 @@
 #include "colmap_ext/logging.h"
 #include "lidar/parallel_for_each.h"
 
+#include "colmap/geometry/pose.h"
 #include "colmap/geometry/rigid3.h"
 
 #include <algorithm>
@@ -14,12 +15,6 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr int kNumLinearisations = 3;
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d skew;
-  skew << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return skew;
-}
 
 PerpendicularDirection LidarVertical(const VerticalStationInput& station,
                                      const Eigen::Vector3d& guess,
@@ -68,13 +63,25 @@ StationEquation Linearise(const StationVertical& station,
   const Eigen::Matrix<double, 3, 2>& tangent = station.up_in_cam.tangent;
   StationEquation equation;
   equation.offset = tangent.transpose() * (up_lidar_in_cam - station.up_in_cam.direction);
-  equation.jacobian = -tangent.transpose() * Skew(up_lidar_in_cam) * axes;
+  equation.jacobian = -tangent.transpose() * colmap::CrossProductMatrix(up_lidar_in_cam) * axes;
   const Eigen::Matrix2d lidar_to_cam_tangent =
       tangent.transpose() * cam_from_lidar * station.up_in_lidar.tangent;
   equation.covariance =
       lidar_to_cam_tangent * station.up_in_lidar.covariance * lidar_to_cam_tangent.transpose() +
       station.up_in_cam.covariance;
   return equation;
+}
+
+// (C_i + s^2 I)^-1
+Eigen::Matrix2d StationWeight(const StationEquation& e, double station_variance) {
+  return (e.covariance + station_variance * Eigen::Matrix2d::Identity()).inverse();
+}
+
+double StationChi2(const StationEquation& e,
+                   const Eigen::Vector2d& alpha,
+                   double station_variance) {
+  const Eigen::Vector2d r = e.offset + e.jacobian * alpha;
+  return r.dot(StationWeight(e, station_variance) * r);
 }
 
 struct WeightedFit {
@@ -93,8 +100,7 @@ WeightedFit SolveWeighted(const std::vector<StationEquation>& equations,
   for (size_t i = 0; i < equations.size(); ++i) {
     if (!used[i]) continue;
     const StationEquation& e = equations[i];
-    const Eigen::Matrix2d weight =
-        (e.covariance + station_variance * Eigen::Matrix2d::Identity()).inverse();
+    const Eigen::Matrix2d weight = StationWeight(e, station_variance);
     information += e.jacobian.transpose() * weight * e.jacobian;
     gradient += e.jacobian.transpose() * weight * e.offset;
     ++fit.num_used;
@@ -102,11 +108,7 @@ WeightedFit SolveWeighted(const std::vector<StationEquation>& equations,
   fit.covariance = information.inverse();
   fit.alpha = -fit.covariance * gradient;
   for (size_t i = 0; i < equations.size(); ++i) {
-    if (!used[i]) continue;
-    const StationEquation& e = equations[i];
-    const Eigen::Vector2d r = e.offset + e.jacobian * fit.alpha;
-    fit.chi2 +=
-        r.dot((e.covariance + station_variance * Eigen::Matrix2d::Identity()).inverse() * r);
+    if (used[i]) fit.chi2 += StationChi2(equations[i], fit.alpha, station_variance);
   }
   return fit;
 }
@@ -141,13 +143,6 @@ void MeasureStations(const std::vector<VerticalStationInput>& inputs,
     station.up_in_cam = CameraVertical(
         inputs[i], cam_from_lidar * station.up_in_lidar.direction, options, &station.num_segments);
   });
-}
-
-double StationChi2(const StationEquation& e,
-                   const Eigen::Vector2d& alpha,
-                   double station_variance) {
-  const Eigen::Vector2d r = e.offset + e.jacobian * alpha;
-  return r.dot((e.covariance + station_variance * Eigen::Matrix2d::Identity()).inverse() * r);
 }
 
 // Random-effects fit, stations beyond max_station_chi2 left out once, fit again; fills the result.
@@ -215,6 +210,13 @@ VerticalAlignment MeasureVerticalAlignment(const std::vector<VerticalStationInpu
                                            const Eigen::Vector3d& up_in_lidar_guess,
                                            const VerticalAlignmentOptions& options) {
   THROW_CHECK(options.Check());
+  for (const VerticalStationInput& input : inputs) {
+    THROW_CHECK(input.camera && input.cloud && input.curvature) << "station " << input.name;
+    THROW_CHECK_EQ(input.cloud->normals.size(), input.cloud->Size())
+        << "station " << input.name << ": the cloud needs normals";
+    THROW_CHECK_EQ(input.curvature->size(), input.cloud->Size())
+        << "station " << input.name << ": one curvature per point";
+  }
   const Eigen::Matrix3d cam_from_lidar = cam_from_lidar_rotation.toRotationMatrix();
   VerticalAlignment result;
   MeasureStations(inputs, cam_from_lidar, up_in_lidar_guess, options, &result.stations);

@@ -159,6 +159,20 @@ TEST(VerticalAlignmentTest, FarGuessesStillFindTheWalls) {
   EXPECT_LT(on_axes.cwiseAbs().maxCoeff(), 0.13);
 }
 
+TEST(VerticalAlignmentTest, ACloudWithoutNormalsIsRefusedNamingTheStation) {
+  testing::ScopedTempDir dir;
+  SyntheticDrive drive;
+  MakeDrive(TrueCamFromLidar(), 1, dir, &drive);
+  drive.clouds[2].normals.clear();
+  try {
+    MeasureVerticalAlignment(
+        drive.inputs, TrueCamFromLidar(), Eigen::Vector3d::UnitZ(), VerticalAlignmentOptions());
+    FAIL() << "no error";
+  } catch (const std::exception& error) {
+    EXPECT_NE(std::string(error.what()).find("station 2"), std::string::npos) << error.what();
+  }
+}
+
 TEST(VerticalAlignmentTest, AMissingImageIsOneErrorNamingIt) {
   testing::ScopedTempDir dir;
   SyntheticDrive drive;

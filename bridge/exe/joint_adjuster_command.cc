@@ -497,7 +497,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   if (options.vertical_alignment == 1 && !loaded->data.extrinsic_measurement &&
       options.adjuster.mode == JointMode::kJoint) {
     vertical = MeasureStationVerticals(
-        dataset, reconstruction, loaded->data, cam_from_lidar, options.adjuster.observability);
+        dataset, reconstruction, *loaded, cam_from_lidar, options.adjuster.observability);
     if (vertical->valid) {
       loaded->data.extrinsic_measurement = VerticalAlignmentMeasurement(*vertical, cam_from_lidar);
       // Start from it: a drive's hand-eye can leave the roll degrees off, and the first round's wide

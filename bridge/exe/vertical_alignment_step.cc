@@ -3,7 +3,6 @@
 #include "colmap_ext/logging.h"
 #include "lidar/plot.h"
 
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -33,15 +32,16 @@ std::string NearestCameraAxis(const Eigen::Vector3d& axis) {
 
 VerticalAlignment MeasureStationVerticals(const StationDataset& dataset,
                                           const colmap::Reconstruction& reconstruction,
-                                          const JointProblemData& data,
+                                          const LoadedJointData& loaded,
                                           const colmap::Rigid3d& cam_from_lidar,
                                           const ObservabilityOptions& observability) {
   std::vector<VerticalStationInput> inputs;
-  for (const auto& [image_id, cloud] : data.clouds) {
-    const colmap::Image& image = reconstruction.Image(image_id);
-    inputs.push_back({image.Name(),
-                      (std::filesystem::path(dataset.root) / "images" / image.Name()).string(),
-                      &reconstruction.Camera(image.CameraId()),
+  for (const auto& [image_id, cloud] : loaded.data.clouds) {
+    // The dataset's own image file: a user's database may name its images otherwise.
+    const size_t station = loaded.station_of_image.at(image_id);
+    inputs.push_back({dataset.stations[station],
+                      dataset.LeftImagePath(station),
+                      &reconstruction.Camera(reconstruction.Image(image_id).CameraId()),
                       &cloud->cloud,
                       &cloud->curvature});
   }

@@ -5,6 +5,7 @@
 
 #include "bridge/extrinsic_observability.h"
 #include "bridge/joint_adjuster.h"
+#include "bridge/joint_problem_data.h"
 #include "bridge/vertical_alignment.h"
 #include "colmap_ext/station_dataset.h"
 
@@ -16,11 +17,12 @@
 
 namespace colmap_lidar {
 
-// Every registered image of `data.clouds`; the vertical's guess is the stations' common turn axis,
+// Every registered image with a cloud (`loaded.data.clouds`), its image read from the dataset; the
+// vertical's guess is the stations' common turn axis,
 // else the LiDAR's z axis. Prints its summary.
 VerticalAlignment MeasureStationVerticals(const StationDataset& dataset,
                                           const colmap::Reconstruction& reconstruction,
-                                          const JointProblemData& data,
+                                          const LoadedJointData& loaded,
                                           const colmap::Rigid3d& cam_from_lidar,
                                           const ObservabilityOptions& observability);
 
