@@ -223,7 +223,7 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
     // sweeps), whose stereo is decimetres off at 10-30 m: on the simulated stereo drive the median
     // depth error fell from 52 to 11 mm. Not on tripods (the T specimen: 2.00 -> 2.03 mm).
     surface_options.grow_sparse_neighbourhoods |=
-        depth_path.empty() || dataset.rig.lidar_sweep.has_value();
+        depth_path.empty() || dataset.rig.IsMovingPlatform();
     const LidarSurface surface = BuildLidarSurface(in_view, surface_options);
     refined = RefineDepthWithLidar(stereo_depth, surface, intrinsics, options.refinement);
   } else {

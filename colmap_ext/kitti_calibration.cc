@@ -73,7 +73,8 @@ std::map<std::string, std::vector<double>> ReadKittiCalibFile(const std::string&
     std::vector<double> numbers;
     if (ParseNumbers(line.substr(colon + 1), &numbers)) {
       values[key] = numbers;
-    } else if (key.find("rect") != std::string::npos || key == "R" || key == "T") {
+    } else if (key.find("rect") != std::string::npos || key == "R" || key == "T" || key == "Tr" ||
+               (key.size() == 2 && key[0] == 'P')) {
       // A key ReadKittiCamera needs, with a value that is not a finite number.
       throw std::runtime_error(path + ":" + std::to_string(number) + ": " + key +
                                " has a value that is not a finite number");
@@ -81,6 +82,37 @@ std::map<std::string, std::vector<double>> ReadKittiCalibFile(const std::string&
   }
   return values;
 }
+
+namespace {
+
+// A PINHOLE camera of the given size from a rectified projection P = K [I | K^-1 P[:,3]], placed by
+// cam_from_velo = [I | K^-1 P[:,3]] * rect_from_velo.
+KittiCamera CameraFromProjection(const Eigen::Matrix<double, 3, 4>& p,
+                                 int index,
+                                 int width,
+                                 int height,
+                                 const colmap::Rigid3d& rect_from_velo) {
+  KittiCamera result;
+  result.camera = colmap::Camera::CreateFromModelName(
+      index + 1, "PINHOLE", p(0, 0), static_cast<size_t>(width), static_cast<size_t>(height));
+  result.camera.params = {p(0, 0), p(1, 1), p(0, 2), p(1, 2)};
+  result.projection_offset = p.leftCols<3>().inverse() * p.col(3);
+  const colmap::Rigid3d offset(Eigen::Quaterniond::Identity(), result.projection_offset);
+  result.cam_from_velo = offset * rect_from_velo;
+  return result;
+}
+
+// A 3x3 block that is a rotation to KITTI's printed precision, as a unit quaternion.
+Eigen::Quaterniond CheckedRotation(const Eigen::Matrix3d& r,
+                                   const std::string& path,
+                                   const std::string& key) {
+  if (!(r.transpose() * r - Eigen::Matrix3d::Identity()).isZero(1e-4) || r.determinant() < 0) {
+    throw std::runtime_error(path + ": " + key + " does not hold a rotation");
+  }
+  return Eigen::Quaterniond(r).normalized();
+}
+
+}  // namespace
 
 KittiCamera ReadKittiCamera(const std::string& calib_dir, int index) {
   if (index < 0 || index > 3) throw std::invalid_argument("KITTI cameras are 0..3");
@@ -99,17 +131,40 @@ KittiCamera ReadKittiCamera(const std::string& calib_dir, int index) {
     throw std::runtime_error(cam_path + ": " + Key("P_rect_", index) + "/" + Key("S_rect_", index) +
                              " give no valid pinhole camera");
   }
-  KittiCamera result;
-  result.camera = colmap::Camera::CreateFromModelName(
-      index + 1, "PINHOLE", p(0, 0), static_cast<size_t>(size[0]), static_cast<size_t>(size[1]));
-  result.camera.params = {p(0, 0), p(1, 1), p(0, 2), p(1, 2)};
-  result.projection_offset = p.leftCols<3>().inverse() * p.col(3);
   const colmap::Rigid3d cam0_from_velo(Eigen::Quaterniond(Eigen::Matrix3d(r)).normalized(), t);
   const colmap::Rigid3d rect_from_cam0(Eigen::Quaterniond(Eigen::Matrix3d(r_rect)).normalized(),
                                        Eigen::Vector3d::Zero());
-  const colmap::Rigid3d offset(Eigen::Quaterniond::Identity(), result.projection_offset);
-  result.cam_from_velo = offset * rect_from_cam0 * cam0_from_velo;
-  return result;
+  return CameraFromProjection(p,
+                              index,
+                              static_cast<int>(size[0]),
+                              static_cast<int>(size[1]),
+                              rect_from_cam0 * cam0_from_velo);
+}
+
+KittiCamera ReadKittiOdometryCamera(const std::string& calib_file,
+                                    int index,
+                                    int width,
+                                    int height) {
+  if (index < 0 || index > 3) throw std::invalid_argument("KITTI cameras are 0..3");
+  const auto calib = ReadKittiCalibFile(calib_file);
+  const std::string key = "P" + std::to_string(index);
+  const Eigen::Matrix<double, 3, 4, Eigen::RowMajor> p(Require(calib, key, 12, calib_file).data());
+  const Eigen::Matrix<double, 3, 4, Eigen::RowMajor> tr(
+      Require(calib, "Tr", 12, calib_file).data());
+  if (!(p(0, 0) > 0) || !(p(1, 1) > 0) || width < 1 || height < 1) {
+    throw std::runtime_error(calib_file + ": " + key + " gives no valid pinhole camera");
+  }
+  const colmap::Rigid3d rect_from_velo(CheckedRotation(tr.leftCols<3>(), calib_file, "Tr"),
+                                       tr.col(3));
+  return CameraFromProjection(p, index, width, height, rect_from_velo);
+}
+
+colmap::Rigid3d ReadKittiVeloFromImu(const std::string& calib_dir) {
+  const std::string path = (fs::path(calib_dir) / "calib_imu_to_velo.txt").string();
+  const auto values = ReadKittiCalibFile(path);
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> r(Require(values, "R", 9, path).data());
+  return colmap::Rigid3d(CheckedRotation(r, path, "R"),
+                         Eigen::Vector3d(Require(values, "T", 3, path).data()));
 }
 
 colmap::Rigid3d KittiRightFromLeft(const KittiCamera& left, const KittiCamera& right) {

@@ -33,6 +33,18 @@ struct KittiCamera {
 // Camera `index` (0..3) of CALIB_DIR; throws naming the file and the missing or malformed key.
 KittiCamera ReadKittiCamera(const std::string& calib_dir, int index);
 
+// Camera `index` (0..3) of a KITTI odometry sequence's calib.txt ("P0:" .. "P3:" 3x4 rectified
+// projections and "Tr:" 3x4, the rectified camera 0 from the Velodyne), for images of the given size:
+//   camX_from_velo = [I | K^-1 P_X[:,3]] * Tr.
+// Throws naming the file and the missing or malformed key (a calib.txt without Tr among them).
+KittiCamera ReadKittiOdometryCamera(const std::string& calib_file,
+                                    int index,
+                                    int width,
+                                    int height);
+
+// calib_imu_to_velo.txt of CALIB_DIR (R: 3x3 row-major, T: 3): velo_from_imu.
+colmap::Rigid3d ReadKittiVeloFromImu(const std::string& calib_dir);
+
 // The rectified right camera from the rectified left one: identity rotation, translation the difference
 // of their projection offsets (about -0.54 m in x between cameras 2 and 3).
 colmap::Rigid3d KittiRightFromLeft(const KittiCamera& left, const KittiCamera& right);

@@ -1,101 +1,108 @@
 #include "colmap_ext/kitti_import.h"
 
 #include "colmap_ext/atomic_file.h"
-#include "colmap_ext/kitti_calibration.h"
+#include "colmap_ext/kitti_source.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/pose_perturbation.h"
 #include "colmap_ext/station_dataset.h"
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <filesystem>
 #include <iostream>
 #include <stdexcept>
-#include <vector>
 
 namespace colmap_lidar {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path ImageFolder(const KittiImportOptions& options, int camera) {
-  return fs::path(options.kitti_path) / ("image_0" + std::to_string(camera)) / "data";
+StationRig MakeRig(const KittiSource& source, const KittiImportOptions& options) {
+  StationRig rig;
+  rig.left = source.left.camera;
+  rig.lidar_model = "HDL-64";
+  rig.moving_platform = true;
+  // Raw sweeps: one revolution per frame, from behind, counter-clockwise; de-skewed by the pipeline.
+  if (!source.motion_compensated) rig.lidar_sweep = StationRig::LidarSweep();
+  if (source.right) {
+    rig.right = source.right->camera;
+    rig.right_from_left = KittiRightFromLeft(source.left, *source.right);
+  }
+  if (options.write_guess) {
+    rig.cam_from_lidar_guess = PerturbPose(source.left.cam_from_velo,
+                                           options.guess_rotation_deg,
+                                           options.guess_translation_m,
+                                           options.seed);
+  }
+  return rig;
 }
 
-fs::path CloudPath(const KittiImportOptions& options, const std::string& frame) {
-  return fs::path(options.kitti_path) / "velodyne_points" / "data" / (frame + ".bin");
-}
-
-// The frames of the left camera (file stems, sorted) within first..last, every step-th.
-std::vector<std::string> SelectFrames(const KittiImportOptions& options) {
-  const fs::path folder = ImageFolder(options, options.camera);
-  if (!fs::is_directory(folder)) {
-    throw std::runtime_error("no images of camera " + std::to_string(options.camera) + ": " +
-                             folder.string() + " does not exist");
-  }
-  std::vector<std::string> all;
-  for (const auto& entry : fs::directory_iterator(folder)) {
-    if (entry.path().extension() == ".png") all.push_back(entry.path().stem().string());
-  }
-  std::sort(all.begin(), all.end());
-  std::vector<std::string> frames;
-  for (const std::string& frame : all) {
-    int index = -1;
-    try {
-      index = std::stoi(frame);
-    } catch (const std::exception&) {
-      throw std::runtime_error(folder.string() + "/" + frame +
-                               ".png: not a KITTI frame name (%010d.png)");
-    }
-    if (index < options.first || (options.last >= 0 && index > options.last) ||
-        (index - options.first) % options.step != 0) {
-      continue;
-    }
-    frames.push_back(frame);
-  }
-  if (frames.empty()) throw std::runtime_error("no frames selected in " + folder.string());
-  return frames;
-}
-
-// A KITTI .bin holds float32 x y z reflectance: a whole, non-empty number of 16-byte points.
-void CheckCloud(const fs::path& path, const std::string& frame) {
-  if (!fs::is_regular_file(path)) {
-    throw std::runtime_error(path.string() + ": frame " + frame + " has no Velodyne cloud");
-  }
-  const uintmax_t size = fs::file_size(path);
-  if (size == 0 || size % 16 != 0) {
-    throw std::runtime_error(path.string() + ": truncated KITTI cloud (" + std::to_string(size) +
-                             " bytes, not a whole number of 16-byte points)");
-  }
-}
-
-void CheckImageSize(const fs::path& path, const colmap::Camera& camera) {
-  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw std::runtime_error(path.string() + ": cannot read the image");
-  if (image.cols != static_cast<int>(camera.width) ||
-      image.rows != static_cast<int>(camera.height)) {
-    throw std::runtime_error(path.string() + ": the image is " + std::to_string(image.cols) + "x" +
-                             std::to_string(image.rows) + " but S_rect says " +
+void CheckImageSize(const std::string& path, const colmap::Camera& camera) {
+  const auto [width, height] = KittiImageSize(path);
+  if (width != static_cast<int>(camera.width) || height != static_cast<int>(camera.height)) {
+    throw std::runtime_error(path + ": the image is " + std::to_string(width) + "x" +
+                             std::to_string(height) + " but the calibration says " +
                              std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
 }
 
-// The right camera's images exist for every selected frame.
-bool HasRightImages(const KittiImportOptions& options, const std::vector<std::string>& frames) {
-  if (!options.use_right || options.camera == 3) return false;
-  for (const std::string& frame : frames) {
-    if (!fs::is_regular_file(ImageFolder(options, options.camera + 1) / (frame + ".png"))) {
-      return false;
+// Images and clouds, checked and copied frame by frame.
+void CopyFrames(const KittiSource& source, const StationRig& rig, const fs::path& partial) {
+  fs::create_directories(partial / "images" / "left");
+  fs::create_directories(partial / "lidar");
+  if (rig.IsStereo()) fs::create_directories(partial / "images" / "right");
+  for (size_t k = 0; k < source.frames.size(); ++k) {
+    const std::string& frame = source.frames[k];
+    CheckImageSize(source.left_images[k], rig.left);
+    CheckKittiCloud(source.clouds[k], frame);
+    fs::copy_file(source.left_images[k], partial / "images" / "left" / (frame + ".png"));
+    fs::copy_file(source.clouds[k], partial / "lidar" / (frame + ".bin"));
+    if (rig.IsStereo()) {
+      CheckImageSize(source.right_images[k], *rig.right);
+      fs::copy_file(source.right_images[k], partial / "images" / "right" / (frame + ".png"));
+    }
+    if ((k + 1) % 20 == 0 || k + 1 == source.frames.size()) {
+      std::cout << "import_kitti: " << k + 1 << "/" << source.frames.size() << " frames"
+                << std::endl;
     }
   }
-  return true;
+}
+
+void WriteReferences(const KittiSource& source, int camera, const fs::path& partial) {
+  fs::create_directories(partial / "ground_truth");
+  WritePoseFile((partial / "ground_truth" / "cam_from_lidar.txt").string(),
+                "KITTI's reference extrinsic of rectified camera " + std::to_string(camera) +
+                    " from the Velodyne: [I | K^-1 P[:,3]] times the rectified camera 0 from the "
+                    "Velodyne; cam_from_lidar (x_cam = R x_lidar + t)",
+                source.left.cam_from_velo);
+  if (!source.reference_cam_from_world.empty()) {
+    std::map<std::string, colmap::Rigid3d> poses;
+    for (size_t k = 0; k < source.frames.size(); ++k) {
+      poses[source.frames[k]] = source.reference_cam_from_world[k];
+    }
+    WriteNamedPoses((partial / "ground_truth" / "cam_from_world.txt").string(),
+                    "reference trajectory, not perfect truth: " + source.reference_description +
+                        "; cam_from_world of rectified camera " + std::to_string(camera),
+                    poses);
+  }
+  if (!source.frame_times.empty()) {
+    WriteStationTimes((partial / "timestamps.txt").string(), source.frames, source.frame_times);
+  }
+  if (!source.sweep_times.empty()) {
+    WriteSweepTimes((partial / "sweep_times.txt").string(), source.frames, source.sweep_times);
+  }
 }
 
 }  // namespace
 
+KittiFormat KittiFormatFromName(const std::string& name) {
+  if (name == "raw") return KittiFormat::kRaw;
+  if (name == "odometry") return KittiFormat::kOdometry;
+  throw std::invalid_argument("unknown KITTI format '" + name + "' (raw, odometry)");
+}
+
 bool KittiImportOptions::Check() const {
   CHECK_OPTION(!kitti_path.empty());
-  CHECK_OPTION(!calib_path.empty());
+  CHECK_OPTION(format == KittiFormat::kOdometry || !calib_path.empty());
+  CHECK_OPTION(format == KittiFormat::kOdometry || poses_path.empty());
   CHECK_OPTION(!output_path.empty());
   CHECK_OPTION_GE(first, 0);
   CHECK_OPTION_GE(step, 1);
@@ -106,64 +113,31 @@ bool KittiImportOptions::Check() const {
   return true;
 }
 
-KittiImportSummary ImportKittiDrive(const KittiImportOptions& options) {
+KittiImportSummary ImportKitti(const KittiImportOptions& options) {
   THROW_CHECK(options.Check());
   const fs::path output(options.output_path);
   if (fs::exists(output) && !options.overwrite) {
     throw std::runtime_error(output.string() + " exists; pass --overwrite 1 to replace it");
   }
-  const KittiCamera left = ReadKittiCamera(options.calib_path, options.camera);
-  const std::vector<std::string> frames = SelectFrames(options);
-  const bool stereo = HasRightImages(options, frames);
-  StationRig rig;
-  rig.left = left.camera;
-  rig.lidar_model = "HDL-64";
-  rig.lidar_sweep = StationRig::LidarSweep();  // one revolution per frame, from behind, ccw
-  if (stereo) {
-    const KittiCamera right = ReadKittiCamera(options.calib_path, options.camera + 1);
-    rig.right = right.camera;
-    rig.right_from_left = KittiRightFromLeft(left, right);
-  }
-  if (options.write_guess) {
-    rig.cam_from_lidar_guess = PerturbPose(
-        left.cam_from_velo, options.guess_rotation_deg, options.guess_translation_m, options.seed);
-  }
-
+  const KittiSource source = options.format == KittiFormat::kRaw
+                                 ? ReadKittiRawDrive(options)
+                                 : ReadKittiOdometrySequence(options);
+  for (const std::string& note : source.notes) std::cout << "import_kitti: " << note << std::endl;
+  const StationRig rig = MakeRig(source, options);
   PartialOutputFolder partial_folder(options.output_path);
   const fs::path partial = partial_folder.Path();
-  fs::create_directories(partial / "images" / "left");
-  fs::create_directories(partial / "lidar");
-  fs::create_directories(partial / "ground_truth");
-  if (stereo) fs::create_directories(partial / "images" / "right");
-  for (size_t k = 0; k < frames.size(); ++k) {
-    const std::string& frame = frames[k];
-    const fs::path left_image = ImageFolder(options, options.camera) / (frame + ".png");
-    CheckImageSize(left_image, rig.left);
-    CheckCloud(CloudPath(options, frame), frame);
-    fs::copy_file(left_image, partial / "images" / "left" / (frame + ".png"));
-    fs::copy_file(CloudPath(options, frame), partial / "lidar" / (frame + ".bin"));
-    if (stereo) {
-      const fs::path right_image = ImageFolder(options, options.camera + 1) / (frame + ".png");
-      CheckImageSize(right_image, *rig.right);
-      fs::copy_file(right_image, partial / "images" / "right" / (frame + ".png"));
-    }
-    if ((k + 1) % 20 == 0 || k + 1 == frames.size()) {
-      std::cout << "import_kitti: " << k + 1 << "/" << frames.size() << " frames" << std::endl;
-    }
-  }
+  CopyFrames(source, rig, partial);
   WriteRigJson((partial / "rig.json").string(), rig);
-  WritePoseFile((partial / "ground_truth" / "cam_from_lidar.txt").string(),
-                "KITTI's reference extrinsic of rectified camera " +
-                    std::to_string(options.camera) +
-                    " from the Velodyne: [I | K^-1 P_rect[:,3]] R_rect_00 [R|T]; "
-                    "cam_from_lidar (x_cam = R x_lidar + t)",
-                left.cam_from_velo);
+  WriteReferences(source, options.camera, partial);
   partial_folder.Commit();
   KittiImportSummary summary;
-  summary.num_frames = static_cast<int>(frames.size());
-  summary.stereo = stereo;
+  summary.num_frames = static_cast<int>(source.frames.size());
+  summary.stereo = rig.IsStereo();
   summary.width = static_cast<int>(rig.left.width);
   summary.height = static_cast<int>(rig.left.height);
+  summary.reference_trajectory = !source.reference_cam_from_world.empty();
+  summary.frame_times = !source.frame_times.empty();
+  summary.sweep_times = !source.sweep_times.empty();
   return summary;
 }
 

@@ -1,13 +1,17 @@
-// `import_kitti`: a KITTI raw drive converted into our station dataset (docs/dataset_format.md):
-//   DRIVE/image_0X/data/%010d.png          rectified images of camera X (2 by default; 0 for the grey
-//                                          pair); camera X+1 when present makes a stereo rig
-//   DRIVE/velodyne_points/data/%010d.bin   float32 x y z reflectance per point (copied as lidar/*.bin)
-//   CALIB/calib_cam_to_cam.txt, calib_velo_to_cam.txt   (colmap_ext/kitti_calibration.h)
-// Frames are matched by index (timestamps.txt and OXTS are optional and not read). The left camera is
-// PINHOLE from P_rect_0X; ground_truth/cam_from_lidar.txt gets KITTI's reference extrinsic
-// camX_from_velo = [I | K^-1 P_rect_0X[:,3]] R_rect_00 [R|T]; a drive has no ground-truth poses or
-// surface. rig.json gets a cam_from_lidar_guess only with `write_guess` (the reference perturbed, seeded,
-// as the simulator does). Quaternions are written w first.
+// `import_kitti`: a KITTI drive converted into our station dataset (docs/dataset_format.md), from
+// either of KITTI's two layouts (colmap_ext/kitti_source.h reads them):
+//   raw        DRIVE/image_0X/data/%010d.png, DRIVE/velodyne_points/data/%010d.bin, the day's
+//              calib_cam_to_cam.txt and calib_velo_to_cam.txt; optional OXTS packets
+//              (oxts/data/%010d.txt, with calib_imu_to_velo.txt) as the reference trajectory and
+//              timestamps (image_0X/timestamps.txt, velodyne_points/timestamps_start/_end.txt)
+//   odometry   SEQ/image_X/%06d.png, SEQ/velodyne/%06d.bin, SEQ/calib.txt (P0..P3, Tr),
+//              SEQ/times.txt and, optionally, the benchmark's poses/NN.txt as the reference
+// The left camera is PINHOLE from its rectified projection; ground_truth/cam_from_lidar.txt gets
+// KITTI's reference extrinsic camX_from_velo, ground_truth/cam_from_world.txt the reference
+// trajectory as camera poses when there is one (GPS/IMU: a reference, not perfect truth).
+// Raw sweeps are marked for de-skewing (rig.json lidar.sweep); the odometry benchmark's scans are
+// already motion-compensated and are marked as a moving platform only. rig.json gets a
+// cam_from_lidar_guess only with `write_guess` (the reference perturbed, seeded).
 #pragma once
 
 #include <cstdint>
@@ -15,9 +19,16 @@
 
 namespace colmap_lidar {
 
+enum class KittiFormat { kRaw, kOdometry };
+
+// "raw" or "odometry"; throws std::invalid_argument on another name.
+KittiFormat KittiFormatFromName(const std::string& name);
+
 struct KittiImportOptions {
-  std::string kitti_path;   // the drive folder (…_drive_NNNN_sync)
-  std::string calib_path;   // the day's folder with the two calibration files
+  KittiFormat format = KittiFormat::kRaw;
+  std::string kitti_path;   // the raw drive folder (…_drive_NNNN_sync) or the odometry sequence
+  std::string calib_path;   // raw: the day's folder with the calibration files
+  std::string poses_path;   // odometry: the reference poses/NN.txt (optional)
   std::string output_path;  // the dataset to write
   // Frame indices first..last (last < 0: to the end), every step-th.
   int first = 0;
@@ -40,11 +51,16 @@ struct KittiImportSummary {
   int num_frames = 0;
   bool stereo = false;
   int width = 0, height = 0;
+  bool reference_trajectory = false;
+  bool frame_times = false;
+  bool sweep_times = false;
 };
 
-// Writes OUTPUT.partial and renames it to OUTPUT when complete (nothing is left on failure). Throws std::runtime_error naming the
-// file (and key or line): a missing P_rect_0X, a frame without a cloud, a truncated .bin, an image of
-// another size than S_rect_0X, an existing output without `overwrite`.
-KittiImportSummary ImportKittiDrive(const KittiImportOptions& options);
+// Writes OUTPUT.partial and renames it to OUTPUT when complete (nothing is left on failure). Throws
+// std::runtime_error naming the file (and key or line): a missing calibration key (Tr, P_rect_0X), a
+// frame without a cloud, a truncated .bin, an image of another size, a poses or times file with
+// fewer lines than frames, a NaN in an OXTS packet, timestamps out of order, an existing output
+// without `overwrite`.
+KittiImportSummary ImportKitti(const KittiImportOptions& options);
 
 }  // namespace colmap_lidar

@@ -1,5 +1,7 @@
 #include "colmap_ext/station_dataset.h"
 
+#include "colmap_ext/text_lines.h"
+
 #include "colmap/sensor/models.h"
 
 #include <nlohmann/json.hpp>
@@ -183,6 +185,12 @@ StationRig ReadRigJson(const std::string& path) {
       rig.lidar_range_noise_m = lidar["range_noise_m"].get<double>();
     }
     if (lidar.contains("sweep")) rig.lidar_sweep = ParseSweep(lidar["sweep"], path);
+    if (lidar.contains("moving_platform")) {
+      if (!lidar["moving_platform"].is_boolean()) {
+        Fail(path, "'lidar.moving_platform' must be true or false");
+      }
+      rig.moving_platform = lidar["moving_platform"].get<bool>();
+    }
   }
   return rig;
 }
@@ -205,6 +213,7 @@ void WriteRigJson(const std::string& path, const StationRig& rig) {
   if (!rig.lidar_model.empty()) {
     root["lidar"] = {{"model", rig.lidar_model}, {"range_noise_m", rig.lidar_range_noise_m}};
   }
+  if (rig.moving_platform) root["lidar"]["moving_platform"] = true;
   if (rig.lidar_sweep) {
     root["lidar"]["sweep"] = {{"start_azimuth_deg", rig.lidar_sweep->start_azimuth_deg},
                               {"counter_clockwise", rig.lidar_sweep->counter_clockwise}};
@@ -259,6 +268,50 @@ void CheckEveryCloudHasOneImage(const std::string& root, const std::vector<std::
   }
 }
 
+// "<station> v1 .. vN" per line of an optional dataset file, one line per station, as a table in
+// station order; an absent file gives an empty table.
+std::vector<std::vector<double>> ReadStationTable(const StationDataset& dataset,
+                                                  const std::string& name,
+                                                  size_t num_values) {
+  const std::string path = (fs::path(dataset.root) / name).string();
+  if (!fs::is_regular_file(path)) return {};
+  std::map<std::string, std::vector<double>> rows;
+  ForEachDataLine(path, [&](const std::string& line, size_t number) {
+    std::istringstream tokens(line);
+    std::string station, rest;
+    tokens >> station;
+    std::getline(tokens, rest);
+    if (!rows.emplace(station, ParseNumberLine(rest, path, number, num_values)).second) {
+      FailAtLine(path, number, "station '" + station + "' appears twice");
+    }
+  });
+  std::vector<std::vector<double>> table;
+  for (const std::string& station : dataset.stations) {
+    const auto it = rows.find(station);
+    if (it == rows.end()) Fail(path, "no line for station " + station);
+    table.push_back(it->second);
+  }
+  return table;
+}
+
+// timestamps.txt and sweep_times.txt: increasing in station order, sweeps ending after they start.
+void ReadOptionalTimes(StationDataset* dataset) {
+  for (const std::vector<double>& row : ReadStationTable(*dataset, "timestamps.txt", 1)) {
+    if (!dataset->frame_times.empty() && !(row[0] > dataset->frame_times.back())) {
+      Fail(dataset->root + "/timestamps.txt", "times do not increase in station order");
+    }
+    dataset->frame_times.push_back(row[0]);
+  }
+  for (const std::vector<double>& row : ReadStationTable(*dataset, "sweep_times.txt", 2)) {
+    if (!(row[1] > row[0]) ||
+        (!dataset->sweep_times.empty() && !(row[0] > dataset->sweep_times.back().first))) {
+      Fail(dataset->root + "/sweep_times.txt",
+           "sweeps must end after they start and start later in station order");
+    }
+    dataset->sweep_times.emplace_back(row[0], row[1]);
+  }
+}
+
 }  // namespace
 
 StationDataset ReadStationDataset(const std::string& root) {
@@ -303,7 +356,30 @@ StationDataset ReadStationDataset(const std::string& root) {
     dataset.cloud_paths.push_back(cloud);
   }
   CheckEveryCloudHasOneImage(root, dataset.stations);
+  ReadOptionalTimes(&dataset);
   return dataset;
+}
+
+void WriteStationTimes(const std::string& path,
+                       const std::vector<std::string>& stations,
+                       const std::vector<double>& times) {
+  std::ostringstream out;
+  out << "# <station> time [s]: when the station's frame was taken (the camera's trigger)\n"
+      << std::fixed << std::setprecision(9);
+  for (size_t k = 0; k < stations.size(); ++k) out << stations[k] << " " << times.at(k) << "\n";
+  WriteFileAtomically(path, out.str());
+}
+
+void WriteSweepTimes(const std::string& path,
+                     const std::vector<std::string>& stations,
+                     const std::vector<std::pair<double, double>>& times) {
+  std::ostringstream out;
+  out << "# <station> start end [s]: the first and last point of the station's LiDAR sweep\n"
+      << std::fixed << std::setprecision(9);
+  for (size_t k = 0; k < stations.size(); ++k) {
+    out << stations[k] << " " << times.at(k).first << " " << times.at(k).second << "\n";
+  }
+  WriteFileAtomically(path, out.str());
 }
 
 std::map<std::string, colmap::Rigid3d> ReadNamedPoses(const std::string& path) {

@@ -18,6 +18,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace colmap_lidar {
@@ -39,6 +40,11 @@ struct StationRig {
     bool counter_clockwise = true;
   };
   std::optional<LidarSweep> lidar_sweep;
+  // "lidar": {"moving_platform": true}: the stations are frames of a moving platform (a car, a
+  // backpack) even where the clouds need no de-skewing (motion-compensated scans); implied by `sweep`.
+  bool moving_platform = false;
+
+  bool IsMovingPlatform() const { return moving_platform || lidar_sweep.has_value(); }
 
   bool IsStereo() const { return right.has_value(); }
   // 0 for a monocular rig.
@@ -55,6 +61,10 @@ struct StationDataset {
   StationRig rig;
   std::vector<std::string> stations;     // sorted file stems, e.g. "000"
   std::vector<std::string> cloud_paths;  // absolute, one per station
+  // DATASET/timestamps.txt: each station's frame time [s] (empty when the file is absent).
+  std::vector<double> frame_times;
+  // DATASET/sweep_times.txt: each station's sweep start and end [s] (empty when absent).
+  std::vector<std::pair<double, double>> sweep_times;
 
   std::string LeftImagePath(size_t i) const;
   std::string RightImagePath(size_t i) const;
@@ -72,6 +82,15 @@ struct StationDataset {
 // camera). Throws
 // std::runtime_error naming the missing or bad file.
 StationDataset ReadStationDataset(const std::string& root);
+
+// "<station> t" per line (timestamps.txt), stations in the order given.
+void WriteStationTimes(const std::string& path,
+                       const std::vector<std::string>& stations,
+                       const std::vector<double>& times);
+// "<station> start end" per line (sweep_times.txt).
+void WriteSweepTimes(const std::string& path,
+                     const std::vector<std::string>& stations,
+                     const std::vector<std::pair<double, double>>& times);
 
 // "<station> qw qx qy qz tx ty tz" per line (cam_from_world.txt, lidar_poses.txt, ...). '#' starts a comment.
 std::map<std::string, colmap::Rigid3d> ReadNamedPoses(const std::string& path);

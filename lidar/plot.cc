@@ -3,6 +3,7 @@
 #include "lidar/atomic_file.h"
 #include "lidar/statistics.h"
 
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -108,6 +109,94 @@ void WriteLinePlotPng(const std::string& path,
   PutText(&canvas, options.title, {kLeft, 30}, 0.6);
   PutText(&canvas, options.x_label, {kLeft + plot_w / 2 - 60, kHeight - 12}, 0.5);
   PutText(&canvas, options.y_label + (options.log_y ? " (log)" : ""), {5, kTop - 10}, 0.45);
+  WritePngAtomically(path, canvas);
+}
+
+namespace {
+
+// The reference's centroid and its two axes of largest spread (a drive's ground plane).
+struct PlotFrame {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis_u = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d axis_v = Eigen::Vector3d::UnitY();
+};
+
+PlotFrame PrincipalPlane(const std::vector<Eigen::Vector3d>& points) {
+  PlotFrame frame;
+  if (points.empty()) return frame;
+  for (const Eigen::Vector3d& p : points) frame.centre += p / static_cast<double>(points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points)
+    scatter += (p - frame.centre) * (p - frame.centre).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+  frame.axis_u = solver.eigenvectors().col(2);
+  frame.axis_v = solver.eigenvectors().col(1);
+  return frame;
+}
+
+void DrawColourBar(cv::Mat* canvas,
+                   const cv::Rect& box,
+                   double max_value,
+                   const std::string& label) {
+  for (int y = 0; y < box.height; ++y) {
+    const Color3ub c = ErrorColor(box.height - 1 - y, box.height - 1);
+    cv::line(
+        *canvas, {box.x, box.y + y}, {box.x + box.width, box.y + y}, cv::Scalar(c[2], c[1], c[0]));
+  }
+  PutText(canvas, Format(max_value), {box.x + box.width + 5, box.y + 10}, 0.45);
+  PutText(canvas, "0", {box.x + box.width + 5, box.y + box.height}, 0.45);
+  PutText(canvas, label, {box.x - 40, box.y - 10}, 0.45);
+}
+
+}  // namespace
+
+void WriteTopViewPng(const std::string& path,
+                     const std::vector<Eigen::Vector3d>& reference,
+                     const std::vector<Eigen::Vector3d>& estimate,
+                     const std::vector<double>& values,
+                     const TopViewPlotOptions& options) {
+  constexpr int kWidth = 900, kHeight = 700, kMargin = 60, kBar = 120;
+  cv::Mat canvas(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+  const PlotFrame frame = PrincipalPlane(reference);
+  const auto plane = [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector2d((p - frame.centre).dot(frame.axis_u),
+                           (p - frame.centre).dot(frame.axis_v));
+  };
+  Eigen::AlignedBox2d box;
+  for (const auto* points : {&reference, &estimate}) {
+    for (const Eigen::Vector3d& p : *points) box.extend(plane(p));
+  }
+  const double span = std::max({box.sizes().x(), box.sizes().y(), 1e-6});
+  const double scale = std::min(kWidth - 2 * kMargin - kBar, kHeight - 2 * kMargin) / span;
+  const auto pixel = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector2d q = (plane(p) - box.min()) * scale;
+    return cv::Point(kMargin + static_cast<int>(q.x()),
+                     kHeight - kMargin - static_cast<int>(q.y()));
+  };
+  for (size_t k = 1; k < reference.size(); ++k) {
+    cv::line(canvas,
+             pixel(reference[k - 1]),
+             pixel(reference[k]),
+             cv::Scalar(150, 150, 150),
+             3,
+             cv::LINE_AA);
+  }
+  const double max_value =
+      values.empty() ? 1.0 : std::max(*std::max_element(values.begin(), values.end()), 1e-12);
+  for (size_t k = 0; k < estimate.size(); ++k) {
+    const Color3ub c = ErrorColor(k < values.size() ? values[k] : 0.0, max_value);
+    cv::circle(
+        canvas, pixel(estimate[k]), 4, cv::Scalar(c[2], c[1], c[0]), cv::FILLED, cv::LINE_AA);
+  }
+  DrawColourBar(&canvas,
+                cv::Rect(kWidth - kBar + 20, kMargin + 20, 20, kHeight - 2 * kMargin - 40),
+                max_value * options.value_scale,
+                options.value_label);
+  PutText(&canvas, options.title, {kMargin, 30}, 0.6);
+  PutText(&canvas,
+          "grey: reference; points: estimate; the view spans " + Format(span) + " m",
+          {kMargin, kHeight - 20},
+          0.45);
   WritePngAtomically(path, canvas);
 }
 

@@ -42,6 +42,22 @@ void WriteLinePlotPng(const std::string& path,
                       const std::vector<PlotSeries>& series,
                       const LinePlotOptions& options);
 
+struct TopViewPlotOptions {
+  std::string title;
+  std::string value_label;  // of the colour bar, e.g. "step error [cm]"
+  double value_scale = 1;   // values are multiplied by this for the colour bar's labels
+};
+
+// Writes a top view of two paths (atomically): the plane of the two largest spreads of the
+// reference's positions, equal scales on both axes; the reference in grey, the estimate as points
+// coloured by `values` (one per estimated position; ErrorColor from 0 to their maximum) with a
+// colour bar.
+void WriteTopViewPng(const std::string& path,
+                     const std::vector<Eigen::Vector3d>& reference,
+                     const std::vector<Eigen::Vector3d>& estimate,
+                     const std::vector<double>& values,
+                     const TopViewPlotOptions& options);
+
 // A blue-green-yellow-red colour for value/max_value in [0, 1] (clamped).
 Color3ub ErrorColor(double value, double max_value);
 

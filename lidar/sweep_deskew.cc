@@ -2,6 +2,7 @@
 
 #include "lidar/check_option.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -64,6 +65,22 @@ std::vector<SweepMotion> SweepMotionsFromPoses(
     if (has_previous && !has_next) motions[i].mid_from_next_mid = previous.inverse();
   }
   return motions;
+}
+
+std::vector<double> SweepClockFromTimes(const std::vector<std::pair<double, double>>& start_end) {
+  std::vector<double> durations;
+  for (const auto& [start, end] : start_end) {
+    if (!(end > start)) throw std::invalid_argument("a sweep that does not end after it starts");
+    durations.push_back(end - start);
+  }
+  std::vector<double> clock;
+  if (durations.empty()) return clock;
+  std::nth_element(durations.begin(), durations.begin() + durations.size() / 2, durations.end());
+  const double period = durations[durations.size() / 2];
+  const double origin = 0.5 * (start_end.front().first + start_end.front().second);
+  for (const auto& [start, end] : start_end)
+    clock.push_back((0.5 * (start + end) - origin) / period);
+  return clock;
 }
 
 PointCloud DeskewSweep(const PointCloud& sweep,

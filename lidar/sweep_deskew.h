@@ -18,6 +18,7 @@
 
 #include <Eigen/Geometry>
 
+#include <utility>
 #include <vector>
 
 namespace colmap_lidar {
@@ -49,6 +50,12 @@ std::vector<SweepMotion> SweepMotionsFromPoses(
     const std::vector<Eigen::Isometry3d>& world_from_lidar,
     const std::vector<double>& frame,
     const std::vector<int>& component);
+
+// Each sweep's middle in units of the median sweep duration, from the start and end time [s] of
+// every sweep (a driver's timestamps): the `frame` of SweepMotionsFromPoses when frames are not
+// evenly spaced (KITTI raw drops frames), so that the motion per sweep follows the clock. Throws
+// std::invalid_argument for a sweep that does not end after it starts.
+std::vector<double> SweepClockFromTimes(const std::vector<std::pair<double, double>>& start_end);
 
 // The sweep in the LiDAR frame at its middle; normals are not carried (they change with the points).
 PointCloud DeskewSweep(const PointCloud& sweep,

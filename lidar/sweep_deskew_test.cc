@@ -122,5 +122,19 @@ TEST(SweepDeskew, MotionsFromPosesArePerFrameAndMirroredAtTheEnds) {
                std::invalid_argument);
 }
 
+TEST(SweepClock, FollowsTheTimestampsAcrossADroppedFrame) {
+  // Sweeps of 0.1 s, frame 2 dropped by the driver: the third sweep's middle is 3 sweeps after the
+  // first, so SweepMotionsFromPoses divides its motion by 3.
+  const std::vector<std::pair<double, double>> times = {
+      {100.00, 100.10}, {100.10, 100.20}, {100.30, 100.40}, {100.40, 100.5004}};
+  const std::vector<double> clock = SweepClockFromTimes(times);
+  ASSERT_EQ(clock.size(), 4u);
+  EXPECT_NEAR(clock[0], 0.0, 1e-9);
+  EXPECT_NEAR(clock[1], 1.0, 1e-6);
+  EXPECT_NEAR(clock[2], 3.0, 1e-6);
+  EXPECT_NEAR(clock[3], 4.002, 1e-6);
+  EXPECT_THROW(SweepClockFromTimes({{1.0, 1.0}}), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace colmap_lidar

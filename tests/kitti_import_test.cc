@@ -85,9 +85,27 @@ TEST_F(KittiImportTest, GivesBackTheSimulatorsTruth) {
   const colmap::Rigid3d truth = sim::TrueCamFromLidar();
   EXPECT_LT(reference.rotation.angularDistance(truth.rotation), 1e-9);
   EXPECT_LT((reference.translation - truth.translation).norm(), 1e-9);
-  // A drive has no true poses or surface: only the reference extrinsic.
-  EXPECT_FALSE(dataset.HasGroundTruth());
+  // The drive's OXTS packets give the reference trajectory: each motion between frames as the
+  // simulator's truth has it (the world is the first frame's IMU, so only motions compare).
+  ASSERT_TRUE(dataset.HasGroundTruth());
   EXPECT_TRUE(dataset.HasReferenceExtrinsic());
+  const auto reference_poses = ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt"));
+  const auto true_poses = ReadNamedPoses(dir_->File("kitti/ground_truth/cam_from_world.txt"));
+  ASSERT_EQ(reference_poses.size(), 5u);
+  for (size_t i = 1; i < dataset.stations.size(); ++i) {
+    const auto motion = [&](const std::map<std::string, colmap::Rigid3d>& poses) {
+      return poses.at(dataset.stations[i]) * colmap::Inverse(poses.at(dataset.stations[0]));
+    };
+    EXPECT_LT((motion(reference_poses).translation - motion(true_poses).translation).norm(), 1e-6);
+    EXPECT_LT(motion(reference_poses).rotation.angularDistance(motion(true_poses).rotation), 1e-8);
+  }
+  // The frames' and sweeps' timestamps: 0.1 s apart, each sweep 0.05 s either side of its frame.
+  ASSERT_EQ(dataset.frame_times.size(), 5u);
+  ASSERT_EQ(dataset.sweep_times.size(), 5u);
+  EXPECT_NEAR(dataset.frame_times[3] - dataset.frame_times[0], 0.3, 1e-6);
+  EXPECT_NEAR(dataset.sweep_times[2].first, dataset.frame_times[2] - 0.05, 1e-6);
+  EXPECT_NEAR(dataset.sweep_times[2].second, dataset.frame_times[2] + 0.05, 1e-6);
+  EXPECT_TRUE(dataset.rig.IsMovingPlatform());
   // The clouds are KITTI's .bin, read as they are.
   EXPECT_EQ(fs::path(dataset.cloud_paths[2]).extension(), ".bin");
   EXPECT_GT(ReadPointCloud(dataset.cloud_paths[2]).Size(), 10000u);
@@ -159,6 +177,42 @@ TEST_F(KittiImportTest, BadDrivesAreRefusedNamingTheFile) {
   fs::resize_file(cloud, fs::file_size(cloud) - 5);
   ExpectRefused(
       Import(dir_->File("out3"), "", drive), "0000000003.bin", "truncated", dir_->File("out3"));
+}
+
+// Replaces the first match of `pattern` in the text file at `path`.
+void Edit(const std::string& path, const std::string& pattern, const std::string& replacement) {
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(path) << std::regex_replace(
+      text, std::regex(pattern), replacement, std::regex_constants::format_first_only);
+}
+
+TEST_F(KittiImportTest, BadPacketsAndTimestampsAreRefusedNamingFileAndLine) {
+  const std::string drive = CopyOf(Drive(), dir_->File("bad_oxts"));
+  const std::string packet = drive + "/oxts/data/0000000002.txt";
+  Edit(packet, "^[^ ]+ [^ ]+ [^ ]+", "49 8.4 nan");
+  ExpectRefused(Import(dir_->File("out4"), "", drive),
+                packet + ":1:",
+                "'nan' is not a finite number",
+                dir_->File("out4"));
+  fs::remove_all(drive + "/oxts");
+  const std::string starts = drive + "/velodyne_points/timestamps_start.txt";
+  Edit(starts, "\n[^\n]*\n", "\n2011-09-26 13:02:20.000000000\n");
+  ExpectRefused(Import(dir_->File("out5"), "", drive),
+                starts + ":2:",
+                "is not after the one before",
+                dir_->File("out5"));
+  // Without OXTS and timestamps the drive imports, saying once what it lacks.
+  fs::remove(starts);
+  const auto run = Import(dir_->File("out6"), "", drive);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("oxts/data is absent: no reference trajectory"), std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("timestamps_end.txt is absent"), std::string::npos) << run.output;
+  const StationDataset dataset = ReadStationDataset(dir_->File("out6"));
+  EXPECT_FALSE(dataset.HasGroundTruth());
+  EXPECT_TRUE(dataset.sweep_times.empty());
+  EXPECT_EQ(dataset.frame_times.size(), 5u);
 }
 
 }  // namespace

@@ -53,6 +53,10 @@ int RunEvaluateModel(int argc, char** argv);
 // Error of an estimated cam_from_lidar and of a sparse model's station poses against ground truth.
 int RunEvaluateCalibration(int argc, char** argv);
 
+// A trajectory (lidar_poses.txt, a COLMAP model, KITTI or TUM poses) against a reference: KITTI's
+// relative errors, per-step and absolute errors, plots (bridge/trajectory_evaluation.h).
+int RunEvaluateTrajectory(int argc, char** argv);
+
 // The database's depth priors against ground_truth/depth/: errors in units of sigma_d, at and away
 // from depth edges (colmap_ext/depth_prior_evaluation.h).
 int RunEvaluateDepthPriors(int argc, char** argv);

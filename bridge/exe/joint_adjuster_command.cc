@@ -416,7 +416,7 @@ void PrintMeasurement(const ExtrinsicMeasurement& measurement) {
 // A moving platform: rig.json's clouds are sweeps, or initialization.json reports a one-axis
 // hand-eye.
 bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& facts) {
-  return dataset.rig.lidar_sweep.has_value() || facts.one_axis;
+  return dataset.rig.IsMovingPlatform() || facts.one_axis;
 }
 
 // The -1 (automatic) options. E_m: on for a monocular rig, and for a stereo rig on a moving
@@ -442,7 +442,7 @@ void ResolveAutomaticOptions(const StationDataset& dataset,
   if (options->landmark_lidar_weight >= 0 && options->vertical_alignment >= 0) return;
   const MotionAnalysis motion = AnalyseMotion(reconstruction, options->adjuster.observability);
   const bool degenerate_motion =
-      facts.one_axis || (!motion.unique && dataset.rig.lidar_sweep.has_value());
+      facts.one_axis || (!motion.unique && dataset.rig.IsMovingPlatform());
   if (options->vertical_alignment < 0) options->vertical_alignment = degenerate_motion ? 1 : 0;
   if (options->landmark_lidar_weight >= 0) return;
   options->adjuster.landmark_lidar_weight =
@@ -515,6 +515,9 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                 "cam_from_lidar refined by colmap-lidar joint_adjuster (" + options.mode +
                     "); qw qx qy qz tx ty tz",
                 cam_from_lidar);
+  Trajectory cameras = ModelCameraTrajectory(reconstruction);
+  AttachStationTimes(dataset.stations, dataset.frame_times, &cameras);
+  WriteTrajectoryExports(partial.File("camera_poses"), cameras);
   const std::string caveat = UncertaintyCaveat(summary.motion, IsMovingPlatform(dataset, facts));
   WriteReport(partial.Path(),
               options.adjuster,

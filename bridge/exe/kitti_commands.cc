@@ -1,4 +1,5 @@
-// import_kitti: a KITTI raw drive into our station dataset (colmap_ext/kitti_import.h).
+// import_kitti: a KITTI raw drive or odometry sequence into our station dataset
+// (colmap_ext/kitti_import.h).
 #include "bridge/exe/commands.h"
 #include "colmap_ext/kitti_import.h"
 #include "colmap_ext/logging.h"
@@ -12,10 +13,19 @@ namespace colmap_lidar {
 int RunImportKitti(int argc, char** argv) {
   KittiImportOptions import;
   int seed = 0;
+  std::string format = "raw", sequence_path;
   colmap::OptionManager options;
-  options.AddRequiredOption("kitti_path", &import.kitti_path, "the drive folder (..._sync)");
-  options.AddRequiredOption(
-      "calib_path", &import.calib_path, "folder with calib_cam_to_cam.txt, calib_velo_to_cam.txt");
+  options.AddDefaultOption(
+      "format", &format, "raw (a raw drive) or odometry (a benchmark sequence)");
+  options.AddDefaultOption("kitti_path", &import.kitti_path, "raw: the drive folder (..._sync)");
+  options.AddDefaultOption(
+      "sequence_path", &sequence_path, "odometry: the sequence folder (calib.txt, image_2, ...)");
+  options.AddDefaultOption("calib_path",
+                           &import.calib_path,
+                           "raw: folder with calib_cam_to_cam.txt, calib_velo_to_cam.txt "
+                           "(and calib_imu_to_velo.txt for OXTS)");
+  options.AddDefaultOption(
+      "poses_path", &import.poses_path, "odometry: the reference poses/NN.txt (optional)");
   options.AddRequiredOption("output_path", &import.output_path);
   options.AddDefaultOption("first", &import.first, "first frame index");
   options.AddDefaultOption("last", &import.last, "last frame index; -1: to the end");
@@ -31,13 +41,30 @@ int RunImportKitti(int argc, char** argv) {
   options.AddDefaultOption("seed", &seed);
   options.AddDefaultOption("overwrite", &import.overwrite);
   options.Parse(argc, argv);
+  import.format = KittiFormatFromName(format);
+  if (import.format == KittiFormat::kOdometry) {
+    THROW_CHECK(import.kitti_path.empty() || sequence_path.empty())
+        << "give the sequence as --sequence_path only";
+    if (!sequence_path.empty()) import.kitti_path = sequence_path;
+  } else {
+    THROW_CHECK(sequence_path.empty()) << "--sequence_path is for --format odometry";
+  }
+  THROW_CHECK(!import.kitti_path.empty())
+      << (import.format == KittiFormat::kRaw ? "--kitti_path" : "--sequence_path")
+      << " is required";
+  THROW_CHECK(import.format == KittiFormat::kOdometry || !import.calib_path.empty())
+      << "--calib_path is required for a raw drive";
   import.seed = static_cast<uint64_t>(seed);
   THROW_CHECK(import.Check());
-  const KittiImportSummary summary = ImportKittiDrive(import);
+  const KittiImportSummary summary = ImportKitti(import);
   std::cout << "import_kitti: wrote " << summary.num_frames << " frames ("
             << (summary.stereo ? "stereo" : "monocular") << ", " << summary.width << "x"
             << summary.height << ") to " << import.output_path
-            << "; ground_truth/cam_from_lidar.txt holds KITTI's reference extrinsic" << std::endl;
+            << "; ground_truth/cam_from_lidar.txt holds KITTI's reference extrinsic"
+            << (summary.reference_trajectory ? ", ground_truth/cam_from_world.txt the reference "
+                                               "trajectory"
+                                             : "")
+            << std::endl;
   return EXIT_SUCCESS;
 }
 

@@ -5,15 +5,19 @@
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "colmap_ext/station_dataset.h"
+#include "colmap_ext/trajectory_files.h"
 #include "lidar/cloud_io.h"
 #include "lidar/lidar_pose_graph.h"
+#include "lidar/odometry_registration.h"
 #include "lidar/preprocessing.h"
+#include "lidar/sweep_deskew.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/scene/reconstruction.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -44,6 +48,7 @@ LidarPairRecord ToRecord(const std::vector<std::string>& names, const LidarEdge&
 // pairs.txt (accepted edges, refused pairs as comments with the reason) and lidar_poses.txt.
 void WritePairsAndPoses(const std::string& output_path,
                         const std::vector<std::string>& names,
+                        const std::vector<double>& times,
                         const LidarGraph& graph) {
   std::vector<LidarPairRecord> accepted;
   for (const LidarEdge& e : graph.edges) accepted.push_back(ToRecord(names, e));
@@ -58,6 +63,13 @@ void WritePairsAndPoses(const std::string& output_path,
                   "LiDAR station poses world_from_lidar (world = first station "
                   "of each component)",
                   poses);
+  Trajectory trajectory;
+  trajectory.names = names;
+  for (const Eigen::Isometry3d& pose : graph.world_from_lidar) {
+    trajectory.world_from_sensor.push_back(ToRigid3d(pose));
+  }
+  if (times.size() == names.size()) trajectory.times = times;
+  WriteTrajectoryExports((fs::path(output_path) / "lidar_poses").string(), trajectory);
 }
 
 // summary.txt: counts, components, 3-cycles, pose-graph cost, time.
@@ -116,7 +128,8 @@ bool LidarRegistratorStepOptions::Check() {
   graph.sequential = static_cast<size_t>(sequential);
   CHECK_OPTION_GE(remove_moving_points, -1);
   CHECK_OPTION_LE(remove_moving_points, 1);
-  return sweep_timing.Check() && moving.Check();
+  CHECK_OPTION(method == "auto" || method == "pairwise" || method == "odometry");
+  return sweep_timing.Check() && moving.Check() && odometry.Check();
 }
 
 void AddLidarRegistratorOptions(const std::string& prefix,
@@ -169,6 +182,13 @@ void AddLidarRegistratorOptions(const std::string& prefix,
           "clouds compared on each side (name order)");
   add.Add("moving_margin_m", &options->moving.margin_m, "plus moving_margin_ratio x range");
   add.Add("moving_margin_ratio", &options->moving.margin_ratio);
+  add.Add("method",
+          &options->method,
+          "auto | pairwise (BSC + RANSAC + ICP per pair) | odometry (sweeps: frame-to-map ICP); "
+          "auto: odometry for the sweeps of a moving platform");
+  add.Add("odometry_max_range_m", &options->odometry.max_range_m);
+  add.Add("odometry_min_range_m", &options->odometry.min_range_m, "nearer returns: the platform");
+  add.Add("odometry_voxel_size_m", &options->odometry.voxel_size_m, "0: max range / 100");
 }
 
 namespace {
@@ -231,11 +251,14 @@ std::vector<double> FrameIndices(const std::vector<std::string>& names) {
   return frames;
 }
 
-// Each station's sweep motion from its neighbours in name order (frames from numeric names).
-std::vector<SweepMotion> SweepMotions(const std::vector<std::string>& names,
-                                      const LidarGraph& graph) {
-  return SweepMotionsFromPoses(graph.world_from_lidar, FrameIndices(names), graph.component);
+}  // namespace
+
+std::vector<double> SweepClock(const StationDataset& dataset) {
+  return dataset.sweep_times.empty() ? FrameIndices(dataset.stations)
+                                     : SweepClockFromTimes(dataset.sweep_times);
 }
+
+namespace {
 
 // Flags the moving points of the registered clouds (`cloud_paths`, in station order), writes every
 // cloud without them to `static_path`/<station>.pcd and all of them, in the world of the first
@@ -276,6 +299,99 @@ void RemoveMovingPoints(const std::vector<std::string>& names,
             << moving_ply.string() << ")" << std::endl;
 }
 
+// Odometry when asked for (--method odometry); auto: the pairwise path.
+bool UseOdometry(const LidarRegistratorStepOptions& options) {
+  if (options.method != "auto") return options.method == "odometry";
+  // The odometry is opt-in: from a moving start on a street whose facades leave the driving
+  // direction to few features (the simulator's), frame-to-map ICP without a first velocity does
+  // not leave the start (docs/benchmarks/odometry.md); the pairwise path finds that motion by BSC.
+  std::cout << "lidar_registrator: pairwise registration (BSC + RANSAC + ICP)"
+            << (options.deskew_sweeps || options.moving_platform
+                    ? "; --method odometry registers the frames of a moving platform faster"
+                    : "")
+            << std::endl;
+  return false;
+}
+
+void WriteDeskewedSweeps(const std::vector<fs::path>& files,
+                         const std::vector<SweepMotion>& motions,
+                         const SweepTimingOptions& timing,
+                         const fs::path& deskewed_path) {
+  for (size_t i = 0; i < files.size(); ++i) {
+    const PointCloud raw = ReadStationCloud(files[i].string());
+    WritePointCloud((deskewed_path / (files[i].stem().string() + ".pcd")).string(),
+                    DeskewSweep(raw, motions[i], timing));
+  }
+}
+
+// OUTPUT/odometry.csv: one line per frame of the odometry's diagnostics.
+void WriteOdometryTable(const fs::path& path,
+                        const std::vector<std::string>& names,
+                        const std::vector<OdometryFrame>& frames) {
+  std::ostringstream csv;
+  csv << "# frame, converged, iterations, source points, correspondences, threshold m, rms m, "
+         "plane rms m, constraint ratio, weakest axis, degenerate, sigma tx ty tz [m], sigma rx ry "
+         "rz [deg] (empty: no covariance)\n";
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const OdometryFrame& f = frames[k];
+    csv << names[k] << "," << f.converged << "," << f.num_iterations << "," << f.num_source_points
+        << "," << f.num_correspondences << "," << f.threshold_m << "," << f.rms_m << ","
+        << f.plane_rms_m << "," << f.constraints.weakest_ratio << ","
+        << f.constraints.WeakestAxisName() << "," << f.degenerate;
+    for (int a = 0; a < 6; ++a) {
+      const int index = a < 3 ? a + 3 : a - 3;  // translation first
+      csv << ",";
+      if (f.covariance) {
+        csv << std::sqrt((*f.covariance)(index, index)) * (a < 3 ? 1.0 : 180.0 / M_PI);
+      }
+    }
+    csv << "\n";
+  }
+  WriteFileAtomically(path.string(), csv.str());
+}
+
+LidarGraph RegisterByOdometry(const std::vector<fs::path>& files,
+                              const std::vector<double>& clock,
+                              const LidarRegistratorStepOptions& options,
+                              const std::string& output_path,
+                              std::string* method_line) {
+  LidarOdometryOptions odometry = options.odometry;
+  odometry.deskew = options.deskew_sweeps;
+  odometry.timing = options.sweep_timing;
+  std::vector<std::string> paths, names;
+  for (const fs::path& file : files) {
+    paths.push_back(file.string());
+    names.push_back(file.stem().string());
+  }
+  const auto progress = [](size_t done, size_t total) {
+    if (done % 50 == 0 || done == total) {
+      std::cout << "lidar_registrator: odometry " << done << "/" << total << " frames" << std::endl;
+    }
+  };
+  const OdometryRegistration result = RegisterSweepsByOdometry(paths, clock, odometry, progress);
+  size_t degenerate = 0;
+  for (size_t k = 0; k < result.frames.size(); ++k) {
+    if (!result.frames[k].degenerate) continue;
+    ++degenerate;
+    std::cout << "lidar_registrator: WARNING: frame " << names[k] << " is degenerate (weakest "
+              << result.frames[k].constraints.WeakestAxisName() << ", ratio "
+              << result.frames[k].constraints.weakest_ratio << "): its pose is the odometry's "
+              << "best guess along that direction" << std::endl;
+  }
+  const double rate = result.frames.size() / std::max(result.seconds_registering, 1e-9);
+  std::cout << "lidar_registrator: odometry registered " << result.frames.size() << " frames at "
+            << std::fixed << std::setprecision(1) << rate << " frames/s" << std::defaultfloat
+            << std::setprecision(6) << ", " << degenerate << " degenerate" << std::endl;
+  fs::create_directories(output_path);
+  WriteOdometryTable(fs::path(output_path) / "odometry.csv", names, result.frames);
+  std::ostringstream line;
+  line << "method odometry (frames of a moving platform: frame-to-map "
+          "ICP)\nodometry_frames_per_second "
+       << rate << "\ndegenerate_frames " << degenerate << "\n";
+  *method_line = line.str();
+  return result.graph;
+}
+
 }  // namespace
 
 void RunLidarRegistratorStep(const std::string& lidar_path,
@@ -292,17 +408,33 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
   fs::remove_all(static_path);  // with moving_points.ply: no stale output of an earlier run
   fs::remove(fs::path(output_path) / "moving_points.ply");
   // Sweeps of a moving platform: their frames in time order turn on the speed check.
-  const std::vector<double> frames = options.deskew_sweeps || options.graph.sequential > 0
-                                         ? FrameIndices(names)
-                                         : std::vector<double>();
-  LidarGraph graph = RegisterClouds(files, options, nullptr, "", frames, start);
+  THROW_CHECK(options.sweep_clock.empty() || options.sweep_clock.size() == names.size())
+      << "sweep times for " << options.sweep_clock.size() << " stations, but " << names.size()
+      << " clouds in " << lidar_path;
+  const std::vector<double> clock =
+      options.sweep_clock.empty() ? FrameIndices(names) : options.sweep_clock;
+  const std::vector<double> frames =
+      options.deskew_sweeps || options.graph.sequential > 0 ? clock : std::vector<double>();
+  const bool odometry = UseOdometry(options);
+  LidarGraph graph;
+  std::string method_line;
+  if (odometry) {
+    graph = RegisterByOdometry(files, clock, options, output_path, &method_line);
+  } else {
+    method_line = "method pairwise (BSC + RANSAC + ICP over station pairs)\n";
+    graph = RegisterClouds(files, options, nullptr, "", frames, start);
+  }
   if (options.deskew_sweeps) {
-    std::cout << "lidar_registrator: de-skewing every sweep with the registered motion and "
-                 "registering again"
-              << std::endl;
-    const std::vector<SweepMotion> motions = SweepMotions(names, graph);
+    std::cout << "lidar_registrator: de-skewing every sweep with the registered motion"
+              << (odometry ? "" : " and registering again") << std::endl;
+    const std::vector<SweepMotion> motions =
+        SweepMotionsFromPoses(graph.world_from_lidar, clock, graph.component);
     fs::create_directories(deskewed_path);
-    graph = RegisterClouds(files, options, &motions, deskewed_path.string(), frames, start);
+    if (odometry) {
+      WriteDeskewedSweeps(files, motions, options.sweep_timing, deskewed_path);
+    } else {
+      graph = RegisterClouds(files, options, &motions, deskewed_path.string(), frames, start);
+    }
   }
 
   fs::create_directories(output_path);
@@ -321,8 +453,8 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
                        static_path,
                        fs::path(output_path) / "moving_points.ply");
   }
-  WritePairsAndPoses(output_path, names, graph);
-  const std::string summary = Summary(names, graph, SecondsSince(start));
+  WritePairsAndPoses(output_path, names, options.station_times, graph);
+  const std::string summary = method_line + Summary(names, graph, SecondsSince(start));
   WriteFileAtomically((fs::path(output_path) / "summary.txt").string(), summary);
   std::cout << summary;
   if (graph.num_components > 1) {
@@ -365,7 +497,7 @@ void RunDeskewSweepsStep(const StationDataset& dataset,
                              dataset.LeftImageName(0) + "): no trajectory to de-skew with");
   }
   const std::vector<SweepMotion> motions =
-      SweepMotionsFromPoses(world_from_lidar, FrameIndices(dataset.stations), component);
+      SweepMotionsFromPoses(world_from_lidar, SweepClock(dataset), component);
   PartialOutputFolder partial(output_path);
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
     const PointCloud raw = ReadStationCloud(dataset.cloud_paths[i]);
@@ -400,6 +532,14 @@ int RunLidarRegistrator(int argc, char** argv) {
   AddLidarRegistratorOptions("", &manager, &registrator);
   manager.Parse(argc, argv);
   THROW_CHECK(registrator.Check());  // before any file is read
+  // A dataset's lidar/ folder: the dataset's sweep times, when it has them, time the sweeps.
+  const fs::path dataset_root = fs::path(lidar_path).parent_path();
+  if (fs::is_regular_file(dataset_root / "rig.json")) {
+    const StationDataset dataset = ReadStationDataset(dataset_root.string());
+    registrator.station_times = dataset.frame_times;
+    registrator.moving_platform = dataset.rig.IsMovingPlatform();
+    if (!dataset.sweep_times.empty()) registrator.sweep_clock = SweepClock(dataset);
+  }
   RunLidarRegistratorStep(lidar_path, output_path, registrator);
   return EXIT_SUCCESS;
 }

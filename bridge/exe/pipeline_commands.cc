@@ -262,6 +262,26 @@ struct WorkspacePaths {
   std::string database, stereo, lidar, initial, joint, dense, evaluation;
 };
 
+// The LiDAR trajectory (lidar_poses.txt, against the reference moved to the LiDAR by the reference
+// extrinsic) and the joint model's camera poses against the dataset's reference trajectory.
+std::vector<PipelineStep> TrajectoryEvaluationSteps(const StationDataset& dataset,
+                                                    const WorkspacePaths& paths) {
+  TrajectoryEvaluationStepOptions camera;
+  camera.reference_path = dataset.GroundTruthPath("cam_from_world.txt");
+  camera.trajectory_path = paths.joint;
+  camera.output_path = (fs::path(paths.evaluation) / "camera_trajectory").string();
+  std::vector<PipelineStep> steps;
+  if (dataset.HasReferenceExtrinsic()) {
+    TrajectoryEvaluationStepOptions lidar = camera;
+    lidar.trajectory_path = (fs::path(paths.lidar) / "lidar_poses.txt").string();
+    lidar.reference_sensor_from_sensor_path = dataset.GroundTruthPath("cam_from_lidar.txt");
+    lidar.output_path = (fs::path(paths.evaluation) / "lidar_trajectory").string();
+    steps.push_back({"evaluate_lidar_trajectory", [=] { RunEvaluateTrajectoryStep(lidar); }});
+  }
+  steps.push_back({"evaluate_camera_trajectory", [=] { RunEvaluateTrajectoryStep(camera); }});
+  return steps;
+}
+
 // The evaluation steps: what the dataset's ground truth holds.
 std::vector<PipelineStep> EvaluationSteps(const StationDataset& dataset,
                                           const PipelineOptions& options) {
@@ -291,6 +311,10 @@ std::vector<PipelineStep> EvaluationSteps(const StationDataset& dataset,
                        RunEvaluateDenseDepthStep(
                            dense, dataset.root, (fs::path(evaluation) / "dense_depth").string());
                      }});
+  }
+  if (dataset.HasGroundTruth()) {
+    const std::vector<PipelineStep> trajectory_steps = TrajectoryEvaluationSteps(dataset, paths);
+    steps.insert(steps.end(), trajectory_steps.begin(), trajectory_steps.end());
   }
   if (!dataset.HasGroundTruth() || !fs::is_regular_file(dataset.GroundTruthPath("surface.ply"))) {
     return steps;
@@ -473,6 +497,12 @@ int RunPipeline(int argc, char** argv) {
               << "/rig.json: the clouds are sweeps of a moving platform (lidar.sweep): "
                  "lidar_registrator de-skews them"
               << std::endl;
+  }
+  pipeline.registrator.station_times = dataset.frame_times;
+  pipeline.registrator.moving_platform = dataset.rig.IsMovingPlatform();
+  if (!dataset.sweep_times.empty()) {
+    pipeline.registrator.sweep_clock = SweepClock(dataset);
+    std::cout << dataset.root << "/sweep_times.txt times the sweeps" << std::endl;
   }
   const fs::path ws(pipeline.workspace_path);
   const WorkspaceLock lock(pipeline.workspace_path);

@@ -14,12 +14,14 @@
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
 #include "bridge/pose_initializer.h"
+#include "bridge/trajectory_evaluation.h"
 #include "colmap_ext/dataset_import.h"
 #include "colmap_ext/depth_prior_evaluation.h"
 #include "colmap_ext/depth_prior_extractor.h"
 #include "colmap_ext/elapsed.h"
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/stereo_depth.h"
+#include "lidar/lidar_odometry.h"
 #include "lidar/lidar_pose_graph.h"
 #include "lidar/model_evaluation.h"
 #include "lidar/moving_points.h"
@@ -98,6 +100,18 @@ struct LidarRegistratorStepOptions {
   // the later steps of `pipeline` use the de-skewed clouds.
   bool deskew_sweeps = false;
   SweepTimingOptions sweep_timing;
+  // Each station's sweep middle in sweep durations (lidar/sweep_deskew.h SweepClockFromTimes of
+  // the dataset's sweep_times.txt); empty: frame indices from the station names.
+  std::vector<double> sweep_clock;
+  // Each station's frame time [s] (the dataset's timestamps.txt) for the TUM export; empty: none.
+  std::vector<double> station_times;
+  // auto | pairwise | odometry. Pairwise: BSC + RANSAC + ICP over station pairs (tripod stations,
+  // any prior). Odometry: sequential frame-to-map ICP (lidar/lidar_odometry.h) for the sweeps of a
+  // moving platform. Auto: pairwise (the odometry does not yet start from a moving platform whose
+  // first motion the geometry leaves open).
+  std::string method = "auto";
+  bool moving_platform = false;  // the dataset's rig.json says so
+  LidarOdometryOptions odometry;
   // After registration, flag the points of moving objects by free space (lidar/moving_points.h) and
   // write each cloud without them to OUTPUT/static/<station>.pcd (and all flagged points, in the
   // first station's frame, to OUTPUT/moving_points.ply); the later steps of `pipeline` use them.
@@ -111,6 +125,9 @@ struct LidarRegistratorStepOptions {
 void AddLidarRegistratorOptions(const std::string& prefix,
                                 colmap::OptionManager* manager,
                                 LidarRegistratorStepOptions* options);
+// Each station's sweep middle in sweep durations: from the dataset's sweep_times.txt, else the
+// frame index of numeric station names (else the position in name order).
+std::vector<double> SweepClock(const StationDataset& dataset);
 void RunLidarRegistratorStep(const std::string& lidar_path,
                              const std::string& output_path,
                              LidarRegistratorStepOptions options);
@@ -220,6 +237,22 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
                                 const std::string& cam_from_lidar_path,
                                 const std::string& output_path,
                                 const std::string& alignment);
+
+// evaluate_trajectory: a trajectory against a reference (bridge/trajectory_evaluation.h).
+struct TrajectoryEvaluationStepOptions {
+  std::string trajectory_path, reference_path, output_path;
+  std::string trajectory_format = "auto", reference_format = "auto";
+  // A pose file reference_sensor_from_sensor applied to every reference pose (empty: same sensor).
+  std::string reference_sensor_from_sensor_path;
+  // A dataset whose timestamps.txt times named poses (empty: none).
+  std::string timestamps_path;
+  TrajectoryAlignment alignment = TrajectoryAlignment::kRigid;
+  std::vector<double> lengths_m;  // empty: 10, 20, ... m
+  double max_time_difference_s = 0.01;
+
+  bool Check() const;
+};
+TrajectoryError RunEvaluateTrajectoryStep(const TrajectoryEvaluationStepOptions& options);
 
 // evaluate_depth_priors: the database's priors against DATASET/ground_truth/depth/, metrics.json
 // and a histogram into `output_path`.

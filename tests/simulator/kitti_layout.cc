@@ -3,6 +3,7 @@
 #include "colmap_ext/kitti_calibration.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
+#include "tests/simulator/sensor_pod.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -75,6 +76,77 @@ KittiCalibrationFiles CalibrationOf(const StationDataset& dataset) {
   return files;
 }
 
+// KITTI's IMU sits about 0.8 m behind and below the Velodyne; a generic small misalignment.
+colmap::Rigid3d VeloFromImu() {
+  return colmap::Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(
+                             0.5 * M_PI / 180, Eigen::Vector3d(0.2, 0.9, -0.4).normalized())),
+                         Eigen::Vector3d(-0.81, 0.32, -0.80));
+}
+
+void WriteImuCalibration(const fs::path& calib_dir, const colmap::Rigid3d& velo_from_imu) {
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> r = velo_from_imu.rotation.toRotationMatrix();
+  std::ostringstream file;
+  file << "calib_time: 01-Jan-2026 00:00:00\nR:" << std::scientific << std::setprecision(15);
+  for (int k = 0; k < 9; ++k) file << " " << r.data()[k];
+  file << "\nT:";
+  for (int k = 0; k < 3; ++k) file << " " << velo_from_imu.translation[k];
+  file << "\n";
+  std::ofstream((calib_dir / "calib_imu_to_velo.txt").string()) << file.str();
+}
+
+// The OXTS packet of an IMU pose in the simulator's world (x east, y north, z up): the inverse of
+// the devkit's Mercator projection with the scale of the first packet's latitude, 49 deg north; the
+// first packet sits at longitude 8.4 deg.
+std::string OxtsPacketLine(const colmap::Rigid3d& world_from_imu, const Eigen::Vector3d& first) {
+  constexpr double kRadius = 6378137.0, kLatitude0 = 49.0, kLongitude0 = 8.4;
+  const double scale = std::cos(kLatitude0 * M_PI / 180);
+  const double x0 = scale * kRadius * kLongitude0 * M_PI / 180;
+  const double y0 = scale * kRadius * std::log(std::tan((90 + kLatitude0) * M_PI / 360));
+  const Eigen::Vector3d mercator =
+      world_from_imu.translation - first + Eigen::Vector3d(x0, y0, 120);
+  const double longitude = mercator.x() / (scale * kRadius) * 180 / M_PI;
+  const double latitude = 360 / M_PI * std::atan(std::exp(mercator.y() / (scale * kRadius))) - 90;
+  const Eigen::Matrix3d r = world_from_imu.rotation.toRotationMatrix();
+  const double yaw = std::atan2(r(1, 0), r(0, 0)), pitch = -std::asin(r(2, 0));
+  const double roll = std::atan2(r(2, 1), r(2, 2));
+  std::ostringstream line;
+  line << std::setprecision(17) << latitude << " " << longitude << " " << mercator.z() << " "
+       << roll << " " << pitch << " " << yaw;
+  for (int k = 6; k < 30; ++k) line << " 0";
+  return line.str() + "\n";
+}
+
+std::string TimestampLine(double seconds_after_start) {
+  // 2011-09-26 13:02:25 plus the offset, with nanoseconds as KITTI writes them.
+  const double seconds = 25.0 + seconds_after_start;
+  std::ostringstream line;
+  line << "2011-09-26 13:02:" << std::setw(12) << std::setfill('0') << std::fixed
+       << std::setprecision(9) << seconds << "\n";
+  return line.str();
+}
+
+// oxts/data/*.txt and calib_imu_to_velo.txt from the true poses, and the frames' and sweeps'
+// timestamps (a sweep runs from halfway since the previous frame to halfway to the next).
+void WriteOxtsAndTimes(const std::vector<colmap::Rigid3d>& world_from_velo,
+                       const fs::path& drive,
+                       const fs::path& calib_dir) {
+  const colmap::Rigid3d velo_from_imu = VeloFromImu();
+  WriteImuCalibration(calib_dir, velo_from_imu);
+  fs::create_directories(drive / "oxts" / "data");
+  std::ofstream frames((drive / "image_02" / "timestamps.txt").string());
+  std::ofstream starts((drive / "velodyne_points" / "timestamps_start.txt").string());
+  std::ofstream ends((drive / "velodyne_points" / "timestamps_end.txt").string());
+  const Eigen::Vector3d first = (world_from_velo.front() * velo_from_imu).translation;
+  for (size_t i = 0; i < world_from_velo.size(); ++i) {
+    std::ofstream((drive / "oxts" / "data" / (FrameName(i) + ".txt")).string())
+        << OxtsPacketLine(world_from_velo[i] * velo_from_imu, first);
+    const double time = kDriveFramePeriod * static_cast<double>(i);
+    frames << TimestampLine(time);
+    starts << TimestampLine(time - 0.5 * kDriveFramePeriod);
+    ends << TimestampLine(time + 0.5 * kDriveFramePeriod);
+  }
+}
+
 }  // namespace
 
 void WriteKittiLayout(const std::string& dataset_path, const std::string& kitti_root) {
@@ -98,6 +170,13 @@ void WriteKittiLayout(const std::string& dataset_path, const std::string& kitti_
                   ReadPointCloud(dataset.cloud_paths[i]));
     cam_from_world[frame] = truth.at(dataset.stations[i]);
   }
+  const colmap::Rigid3d cam_from_lidar =
+      ReadPoseFile(dataset.GroundTruthPath("cam_from_lidar.txt"));
+  std::vector<colmap::Rigid3d> world_from_velo;
+  for (const auto& [frame, pose] : cam_from_world) {
+    world_from_velo.push_back(colmap::Inverse(pose) * cam_from_lidar);
+  }
+  WriteOxtsAndTimes(world_from_velo, drive, root / "calibration");
   fs::create_directories(root / "ground_truth");
   WriteNamedPoses((root / "ground_truth" / "cam_from_world.txt").string(),
                   "True pose of each frame's camera 2: cam_from_world",

@@ -1,0 +1,119 @@
+// LiDAR odometry for the sweeps of a moving platform (Vizzo et al., "KISS-ICP: In Defense of
+// Point-to-Point ICP", RA-L 2023): frame by frame,
+//   1. constant-velocity prediction: T_pred = T_{k-1} Exp(v dt), v the last motion per sweep;
+//   2. de-skewing of the sweep by that velocity (lidar/sweep_deskew.h; per-point times from the
+//      sweep model's azimuth), unless the scans are already motion-compensated;
+//   3. subsampling: one point per voxel of alpha v for the map, of beta v for the registration
+//      (alpha = 0.5, beta = 1.5; v = voxel size);
+//   4. robust point-to-point ICP against the local voxel-hash map (lidar/frame_to_map_icp.h) with
+//      the adaptive threshold (lidar/adaptive_threshold.h);
+//   5. the map updated with the registered frame, far voxels dropped.
+// The first motion has no velocity to predict it: it is found by the pairwise registration of the
+// first two sweeps (BSC + RANSAC + ICP, lidar/pair_registration.h), global and without a prior,
+// so that a platform that is already moving when the recording starts is followed from its first
+// frame. Every frame gets a pose. Its information is measured point-to-plane against the map; a frame
+// whose weakest constrained direction is below `degenerate_ratio` of its strongest (a tunnel, a
+// street of bare facades) is flagged with that direction, never silently accepted.
+#pragma once
+
+#include "lidar/adaptive_threshold.h"
+#include "lidar/frame_to_map_icp.h"
+#include "lidar/pair_registration.h"
+#include "lidar/registration_quality.h"
+#include "lidar/sweep_deskew.h"
+#include "lidar/voxel_hash_map.h"
+
+#include <Eigen/Geometry>
+
+#include <optional>
+#include <vector>
+
+namespace colmap_lidar {
+
+struct LidarOdometryOptions {
+  double max_range_m = 100.0;
+  // Returns nearer than this are the platform itself.
+  double min_range_m = 2.0;
+  // Edge of the map's voxels; 0: max_range_m / 100 (KISS-ICP).
+  double voxel_size_m = 0;
+  int max_points_per_voxel = 20;
+  // The adaptive threshold before the first moving frame, and the motion that counts as moving.
+  double initial_sigma_m = 2.0;
+  double min_motion_m = 0.1;
+  // Sweeps taken while moving are de-skewed with the predicted motion; off for scans that are
+  // already motion-compensated.
+  bool deskew = true;
+  SweepTimingOptions timing;
+  FrameToMapIcpOptions icp;
+  // The first motion from the pairwise registration of the first two sweeps (else: from rest).
+  bool bootstrap = true;
+  StationCloudOptions bootstrap_cloud;
+  PairRegistrationOptions bootstrap_pair;
+  // Weakest over strongest eigenvalue of the translation's information (the Schur complement of the
+  // rotation in the point-to-plane information) below which the frame is degenerate.
+  double degenerate_ratio = 0.02;
+
+  double VoxelSize() const { return voxel_size_m > 0 ? voxel_size_m : max_range_m / 100.0; }
+  bool Check() const;
+};
+
+struct OdometryFrame {
+  Eigen::Isometry3d world_from_lidar = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d prediction = Eigen::Isometry3d::Identity();
+  // [omega, t] of a right increment in the LiDAR frame: plane_rms^2 H^-1; absent for the first
+  // frame (the world's origin) and for a degenerate frame (a direction without information).
+  std::optional<Eigen::Matrix<double, 6, 6>> covariance;
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  ConstraintAnalysis constraints;
+  bool degenerate = false;
+  bool converged = false;
+  // The second frame: its prediction came from the pairwise registration (accepted), or from rest.
+  bool bootstrapped = false;
+  int num_iterations = 0;
+  size_t num_points = 0;  // after the range filter
+  size_t num_source_points = 0;
+  size_t num_correspondences = 0;
+  double threshold_m = 0;  // tau of this frame's ICP
+  double rms_m = 0;
+  double plane_rms_m = 0;
+};
+
+class LidarOdometry {
+ public:
+  // Throws std::invalid_argument for invalid options.
+  explicit LidarOdometry(const LidarOdometryOptions& options);
+
+  // Registers the next frame: its points in its LiDAR frame, taken at `clock` (the sweep's middle,
+  // in sweep durations; increasing). Throws std::invalid_argument for a clock that does not
+  // increase and std::runtime_error for a frame with no point in range.
+  const OdometryFrame& RegisterFrame(const std::vector<Eigen::Vector3d>& points, double clock);
+
+  // Replaces the motion per sweep duration used for the next prediction (a start from rest: the
+  // motion of the first two frames found otherwise).
+  void SetVelocity(const Eigen::Isometry3d& velocity) { velocity_ = velocity; }
+
+  const std::vector<OdometryFrame>& Frames() const { return frames_; }
+  // The motion of the last registered frame per sweep duration (identity before two frames).
+  const Eigen::Isometry3d& Velocity() const { return velocity_; }
+  const VoxelHashMap& Map() const { return map_; }
+
+ private:
+  std::vector<Eigen::Vector3d> Preprocess(const std::vector<Eigen::Vector3d>& points) const;
+  void FinishFrame(const FrameToMapIcpResult& icp, OdometryFrame* frame) const;
+  // The first motion by pairwise registration of the first sweep and `points`; false if refused.
+  bool Bootstrap(const std::vector<Eigen::Vector3d>& points, double clock);
+
+  LidarOdometryOptions options_;
+  VoxelHashMap map_;
+  AdaptiveThreshold threshold_;
+  std::vector<OdometryFrame> frames_;
+  double last_clock_ = 0;
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Vector3d> first_sweep_;  // kept for the bootstrap only
+};
+
+// The motion `motion` scaled to `fraction` of itself (rotation angle and translation), constant
+// velocity's interpolation and extrapolation.
+Eigen::Isometry3d ScaleMotion(const Eigen::Isometry3d& motion, double fraction);
+
+}  // namespace colmap_lidar

@@ -1,0 +1,54 @@
+// The local map of LiDAR odometry (Vizzo et al., "KISS-ICP", RA-L 2023, Sec. III-D): points in the
+// world frame, kept in a hash of voxels of edge `voxel_size` holding at most `max_points_per_voxel`
+// points each (a new point enters only a voxel with room: the map keeps its oldest points, spread
+// by construction), voxels farther than `max_distance` from the sensor dropped. The nearest map point
+// of a query is searched among the 27 voxels around it.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <unordered_map>
+#include <vector>
+
+namespace colmap_lidar {
+
+class VoxelHashMap {
+ public:
+  // Throws std::invalid_argument for a non-positive size, distance or count.
+  VoxelHashMap(double voxel_size, double max_distance, int max_points_per_voxel);
+
+  // Adds the points (world frame), then drops the voxels farther than max_distance from `origin`.
+  void Update(const std::vector<Eigen::Vector3d>& points_in_world, const Eigen::Vector3d& origin);
+
+  // The nearest map point among the 27 voxels around `query`; false when they are empty.
+  bool NearestNeighbor(const Eigen::Vector3d& query,
+                       Eigen::Vector3d* neighbor,
+                       double* distance) const;
+
+  // The map points within `radius` of `query` (searched in the voxels the ball touches).
+  std::vector<Eigen::Vector3d> PointsNear(const Eigen::Vector3d& query, double radius) const;
+
+  double VoxelSize() const { return voxel_size_; }
+  bool Empty() const { return voxels_.empty(); }
+  size_t NumVoxels() const { return voxels_.size(); }
+  std::vector<Eigen::Vector3d> Points() const;
+
+ private:
+  struct VoxelHash {
+    size_t operator()(const Eigen::Vector3i& voxel) const;
+  };
+  Eigen::Vector3i VoxelOf(const Eigen::Vector3d& point) const;
+
+  double voxel_size_;
+  double max_distance_;
+  size_t max_points_per_voxel_;
+  std::unordered_map<Eigen::Vector3i, std::vector<Eigen::Vector3d>, VoxelHash> voxels_;
+};
+
+// One point per occupied voxel of edge `voxel_size`: the first point that falls into it (in input
+// order, so the result does not depend on the hash's order). KISS-ICP's subsampling: the kept points
+// are measured ones, not averages, and the pass is a single hash lookup per point.
+std::vector<Eigen::Vector3d> FirstPointPerVoxel(const std::vector<Eigen::Vector3d>& points,
+                                                double voxel_size);
+
+}  // namespace colmap_lidar
