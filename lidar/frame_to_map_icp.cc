@@ -37,30 +37,49 @@ Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   return m;
 }
 
-// One Gauss-Newton system of the point-to-point residuals at `pose` (Eq. 7-8).
-NormalSystem PointToPointSystem(const std::vector<Eigen::Vector3d>& points,
-                                const VoxelHashMap& map,
-                                const Eigen::Isometry3d& pose,
-                                double max_distance,
-                                double kernel) {
+// One residual's contribution: point-to-plane where the map is a plane, point-to-point where it is
+// scattered; none on a line (one scan line's arc: across it lies the scanner's ring pattern).
+void AddResidual(const Eigen::Vector3d& x,
+                 const MapNeighbor& neighbor,
+                 double kernel,
+                 bool point_to_plane,
+                 NormalSystem* system) {
+  if (point_to_plane && neighbor.shape == VoxelShape::kLine) return;
+  Eigen::Matrix<double, 3, 6> jacobian;
+  jacobian << -Skew(x), Eigen::Matrix3d::Identity();
+  if (point_to_plane && neighbor.shape == VoxelShape::kPlane) {
+    const double r = neighbor.normal.dot(x - neighbor.point);
+    const Vector6d j = jacobian.transpose() * neighbor.normal;
+    const double w = kernel * kernel / std::pow(kernel + r * r, 2);
+    system->hessian.noalias() += w * j * j.transpose();
+    system->gradient.noalias() += w * r * j;
+    system->sum_squares += r * r;
+  } else {
+    const Eigen::Vector3d r = x - neighbor.point;
+    const double w = kernel * kernel / std::pow(kernel + r.squaredNorm(), 2);
+    system->hessian.noalias() += w * jacobian.transpose() * jacobian;
+    system->gradient.noalias() += w * jacobian.transpose() * r;
+    system->sum_squares += r.squaredNorm();
+  }
+  ++system->count;
+}
+
+// One Gauss-Newton system of the residuals at `pose` (Eq. 7-8).
+NormalSystem IcpSystem(const std::vector<Eigen::Vector3d>& points,
+                       const VoxelHashMap& map,
+                       const Eigen::Isometry3d& pose,
+                       double max_distance,
+                       double kernel,
+                       bool point_to_plane) {
   std::vector<NormalSystem> chunks(kNumChunks);
   const int n = static_cast<int>(points.size());
 #pragma omp parallel for schedule(static)
   for (int c = 0; c < kNumChunks; ++c) {
-    NormalSystem& system = chunks[c];
     for (int i = c * n / kNumChunks; i < (c + 1) * n / kNumChunks; ++i) {
       const Eigen::Vector3d x = pose * points[i];
-      Eigen::Vector3d q;
-      double distance = 0;
-      if (!map.NearestNeighbor(x, &q, &distance) || distance > max_distance) continue;
-      const Eigen::Vector3d r = x - q;
-      Eigen::Matrix<double, 3, 6> jacobian;
-      jacobian << -Skew(x), Eigen::Matrix3d::Identity();
-      const double w = kernel * kernel / std::pow(kernel + r.squaredNorm(), 2);
-      system.hessian.noalias() += w * jacobian.transpose() * jacobian;
-      system.gradient.noalias() += w * jacobian.transpose() * r;
-      system.sum_squares += r.squaredNorm();
-      ++system.count;
+      MapNeighbor neighbor;
+      if (!map.NearestNeighbor(x, &neighbor) || neighbor.distance > max_distance) continue;
+      AddResidual(x, neighbor, kernel, point_to_plane, &chunks[c]);
     }
   }
   NormalSystem total;
@@ -78,27 +97,6 @@ Eigen::Isometry3d Increment(const Vector6d& dx) {
   return increment;
 }
 
-// The normal of the map's points within `radius` of q (PCA), or
-// false where they do not form a plane.
-bool MapNormal(const VoxelHashMap& map,
-               const Eigen::Vector3d& q,
-               double radius,
-               Eigen::Vector3d* normal) {
-  const std::vector<Eigen::Vector3d> near = map.PointsNear(q, radius);
-  if (near.size() < 5) return false;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : near) mean += p / static_cast<double>(near.size());
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3d& p : near) scatter += (p - mean) * (p - mean).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
-  // A plane: thin (spread across it below 0.3 of the smaller spread within it) and two-dimensional
-  // (not the arc of one scan line, whose normal would be any direction across the line).
-  const Eigen::Vector3d& variances = solver.eigenvalues();
-  if (!(variances(0) < 0.1 * variances(1)) || !(variances(1) > 0.04 * variances(2))) return false;
-  *normal = solver.eigenvectors().col(0);
-  return true;
-}
-
 // Point-to-plane information of the converged pose in the LiDAR frame (right increment).
 void PlaneInformation(const std::vector<Eigen::Vector3d>& points,
                       const VoxelHashMap& map,
@@ -112,12 +110,13 @@ void PlaneInformation(const std::vector<Eigen::Vector3d>& points,
   for (int c = 0; c < kNumChunks; ++c) {
     for (int i = c * n / kNumChunks; i < (c + 1) * n / kNumChunks; ++i) {
       const Eigen::Vector3d x = pose * points[i];
-      Eigen::Vector3d q, normal;
-      double distance = 0;
-      if (!map.NearestNeighbor(x, &q, &distance) || distance > max_distance) continue;
-      if (!MapNormal(map, q, map.VoxelSize(), &normal)) continue;
-      const double r = normal.dot(x - q);
-      const Eigen::Vector3d m = pose.linear().transpose() * normal;
+      MapNeighbor neighbor;
+      if (!map.NearestNeighbor(x, &neighbor) || neighbor.distance > max_distance ||
+          neighbor.shape != VoxelShape::kPlane) {
+        continue;
+      }
+      const double r = neighbor.normal.dot(x - neighbor.point);
+      const Eigen::Vector3d m = pose.linear().transpose() * neighbor.normal;
       Vector6d jacobian;
       jacobian << points[i].cross(m), m;
       const double w = kernel * kernel / std::pow(kernel + r * r, 2);
@@ -154,8 +153,12 @@ FrameToMapIcpResult AlignFrameToMap(const std::vector<Eigen::Vector3d>& points_i
   FrameToMapIcpResult result;
   result.world_from_lidar = initial;
   for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
-    const NormalSystem system = PointToPointSystem(
-        points_in_lidar, map, result.world_from_lidar, max_correspondence_m, kernel_m);
+    const NormalSystem system = IcpSystem(points_in_lidar,
+                                          map,
+                                          result.world_from_lidar,
+                                          max_correspondence_m,
+                                          kernel_m,
+                                          options.point_to_plane);
     result.num_iterations = iteration;
     result.num_correspondences = system.count;
     result.rms_m = system.count ? std::sqrt(system.sum_squares / system.count) : 0.0;

@@ -3,9 +3,13 @@
 // dx = [omega, t] (world frame: x <- R(omega) x + t),
 //   min sum_i rho(|T p_i - q_i|),  rho'(e) / e = kappa^2 / (kappa + e^2)^2,   (Eq. 7-8)
 // q_i the nearest map point of T p_i within `max_correspondence_m` (tau), kappa = sigma / 3.
-// After convergence the frame's information is measured point-to-plane (the map's local planes from
-// map points within one voxel of each correspondence): a point-to-point Hessian is isotropic in translation
-// whatever the geometry and cannot show a street of facades or a tunnel; the planes can.
+// With FrameToMapIcpOptions::point_to_plane, the residual is the distance to the map voxel's plane
+// where the voxel is one, and there is none where the voxel is the arc of one scan line (on flat
+// ground the rings of a multi-beam scanner match best where they were recorded); off by default:
+// on the real KITTI sample it registered no better and slower (docs/lidar_odometry.md).
+// After convergence the frame's information is measured point-to-plane (the map voxels' planes): a
+// point-to-point Hessian is isotropic in translation whatever the geometry and cannot show a street
+// of facades or a tunnel; the planes can.
 // Sums run over fixed chunks of the points and are combined in chunk order: the result does not
 // depend on the number of threads.
 #pragma once
@@ -22,6 +26,9 @@ struct FrameToMapIcpOptions {
   int max_iterations = 500;
   // |dx| below which the iteration stops (rad and m together, as KISS-ICP).
   double convergence = 1e-4;
+  // Point-to-plane residuals where the map's voxel is a plane, none where it is one scan line's arc,
+  // point-to-point elsewhere; false: point-to-point everywhere (KISS-ICP).
+  bool point_to_plane = false;
 
   bool Check() const;
 };

@@ -28,7 +28,12 @@ std::vector<Eigen::Vector3d> Transformed(const Eigen::Isometry3d& pose,
 ConstraintAnalysis TranslationConstraints(const Eigen::Matrix<double, 6, 6>& information) {
   ConstraintAnalysis analysis;
   const Eigen::Matrix3d rotation = information.topLeftCorner<3, 3>();
-  if (!(rotation.determinant() > 0)) return analysis;
+  if (!(rotation.determinant() > 0)) {
+    // Too few planes to hold the rotation: the weakest direction of the whole information.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> solver(information);
+    analysis.weakest_direction = solver.eigenvectors().col(0);
+    return analysis;
+  }
   const Eigen::Matrix3d schur = information.bottomRightCorner<3, 3>() -
                                 information.bottomLeftCorner<3, 3>() * rotation.inverse() *
                                     information.topRightCorner<3, 3>();

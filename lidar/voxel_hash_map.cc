@@ -1,5 +1,7 @@
 #include "lidar/voxel_hash_map.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -8,7 +10,7 @@
 namespace colmap_lidar {
 namespace {
 
-Eigen::Vector3i Voxel(const Eigen::Vector3d& point, double voxel_size) {
+Eigen::Vector3i VoxelIndex(const Eigen::Vector3d& point, double voxel_size) {
   return (point / voxel_size).array().floor().cast<int>();
 }
 
@@ -37,18 +39,48 @@ VoxelHashMap::VoxelHashMap(double voxel_size, double max_distance, int max_point
 }
 
 Eigen::Vector3i VoxelHashMap::VoxelOf(const Eigen::Vector3d& point) const {
-  return Voxel(point, voxel_size_);
+  return VoxelIndex(point, voxel_size_);
+}
+
+void VoxelHashMap::ClassifyShape(Voxel* voxel) {
+  voxel->shape = VoxelShape::kScattered;
+  const std::vector<Eigen::Vector3d>& points = voxel->points;
+  if (points.size() < 5) return;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) mean += p / static_cast<double>(points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points) scatter += (p - mean) * (p - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+  const Eigen::Vector3d& variances = solver.eigenvalues();
+  // Spreads (square roots) below 0.2 of the largest: a line; else thin across (below 0.3 of the
+  // middle spread): a plane.
+  if (variances(1) < 0.04 * variances(2)) {
+    voxel->shape = VoxelShape::kLine;
+  } else if (variances(0) < 0.1 * variances(1)) {
+    voxel->shape = VoxelShape::kPlane;
+    voxel->normal = solver.eigenvectors().col(0);
+  }
 }
 
 void VoxelHashMap::Update(const std::vector<Eigen::Vector3d>& points_in_world,
                           const Eigen::Vector3d& origin) {
+  std::vector<Voxel*> changed;
   for (const Eigen::Vector3d& point : points_in_world) {
-    std::vector<Eigen::Vector3d>& voxel = voxels_[VoxelOf(point)];
-    if (voxel.size() < max_points_per_voxel_) voxel.push_back(point);
+    Voxel& voxel = voxels_[VoxelOf(point)];
+    if (voxel.points.size() >= max_points_per_voxel_) continue;
+    if (!voxel.changed) {
+      voxel.changed = true;
+      changed.push_back(&voxel);
+    }
+    voxel.points.push_back(point);
+  }
+  for (Voxel* voxel : changed) {
+    ClassifyShape(voxel);
+    voxel->changed = false;
   }
   const double max_squared = max_distance_ * max_distance_;
   for (auto it = voxels_.begin(); it != voxels_.end();) {
-    if ((it->second.front() - origin).squaredNorm() > max_squared) {
+    if ((it->second.points.front() - origin).squaredNorm() > max_squared) {
       it = voxels_.erase(it);
     } else {
       ++it;
@@ -56,54 +88,37 @@ void VoxelHashMap::Update(const std::vector<Eigen::Vector3d>& points_in_world,
   }
 }
 
-bool VoxelHashMap::NearestNeighbor(const Eigen::Vector3d& query,
-                                   Eigen::Vector3d* neighbor,
-                                   double* distance) const {
+bool VoxelHashMap::NearestNeighbor(const Eigen::Vector3d& query, MapNeighbor* neighbor) const {
   const Eigen::Vector3i centre = VoxelOf(query);
   double best = std::numeric_limits<double>::infinity();
+  const Voxel* best_voxel = nullptr;
   for (int dx = -1; dx <= 1; ++dx) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dz = -1; dz <= 1; ++dz) {
         const auto it = voxels_.find(centre + Eigen::Vector3i(dx, dy, dz));
         if (it == voxels_.end()) continue;
-        for (const Eigen::Vector3d& point : it->second) {
+        for (const Eigen::Vector3d& point : it->second.points) {
           const double squared = (point - query).squaredNorm();
           if (squared < best) {
             best = squared;
-            *neighbor = point;
+            neighbor->point = point;
+            best_voxel = &it->second;
           }
         }
       }
     }
   }
-  if (!std::isfinite(best)) return false;
-  *distance = std::sqrt(best);
+  if (best_voxel == nullptr) return false;
+  neighbor->distance = std::sqrt(best);
+  neighbor->shape = best_voxel->shape;
+  neighbor->normal = best_voxel->normal;
   return true;
-}
-
-std::vector<Eigen::Vector3d> VoxelHashMap::PointsNear(const Eigen::Vector3d& query,
-                                                      double radius) const {
-  const Eigen::Vector3i low = VoxelOf(query - Eigen::Vector3d::Constant(radius));
-  const Eigen::Vector3i high = VoxelOf(query + Eigen::Vector3d::Constant(radius));
-  std::vector<Eigen::Vector3d> near;
-  for (int x = low.x(); x <= high.x(); ++x) {
-    for (int y = low.y(); y <= high.y(); ++y) {
-      for (int z = low.z(); z <= high.z(); ++z) {
-        const auto it = voxels_.find(Eigen::Vector3i(x, y, z));
-        if (it == voxels_.end()) continue;
-        for (const Eigen::Vector3d& point : it->second) {
-          if ((point - query).squaredNorm() <= radius * radius) near.push_back(point);
-        }
-      }
-    }
-  }
-  return near;
 }
 
 std::vector<Eigen::Vector3d> VoxelHashMap::Points() const {
   std::vector<Eigen::Vector3d> points;
-  for (const auto& [voxel, voxel_points] : voxels_) {
-    points.insert(points.end(), voxel_points.begin(), voxel_points.end());
+  for (const auto& [key, voxel] : voxels_) {
+    points.insert(points.end(), voxel.points.begin(), voxel.points.end());
   }
   return points;
 }
@@ -115,7 +130,7 @@ std::vector<Eigen::Vector3d> FirstPointPerVoxel(const std::vector<Eigen::Vector3
   occupied.reserve(points.size());
   std::vector<Eigen::Vector3d> kept;
   for (const Eigen::Vector3d& point : points) {
-    if (occupied.insert(Voxel(point, voxel_size)).second) kept.push_back(point);
+    if (occupied.insert(VoxelIndex(point, voxel_size)).second) kept.push_back(point);
   }
   return kept;
 }

@@ -2,7 +2,9 @@
 // world frame, kept in a hash of voxels of edge `voxel_size` holding at most `max_points_per_voxel`
 // points each (a new point enters only a voxel with room: the map keeps its oldest points, spread
 // by construction), voxels farther than `max_distance` from the sensor dropped. The nearest map point
-// of a query is searched among the 27 voxels around it.
+// of a query is searched among the 27 voxels around it. Each voxel knows the shape of its points
+// (PCA, redone when points enter): a plane (with its normal), a line (the arc of one scan line: its
+// spread across the line is the scanner's pattern, not the surface's) or scattered.
 #pragma once
 
 #include <Eigen/Core>
@@ -12,6 +14,15 @@
 
 namespace colmap_lidar {
 
+enum class VoxelShape { kScattered, kPlane, kLine };
+
+struct MapNeighbor {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double distance = 0;
+  VoxelShape shape = VoxelShape::kScattered;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // of a plane
+};
+
 class VoxelHashMap {
  public:
   // Throws std::invalid_argument for a non-positive size, distance or count.
@@ -20,13 +31,9 @@ class VoxelHashMap {
   // Adds the points (world frame), then drops the voxels farther than max_distance from `origin`.
   void Update(const std::vector<Eigen::Vector3d>& points_in_world, const Eigen::Vector3d& origin);
 
-  // The nearest map point among the 27 voxels around `query`; false when they are empty.
-  bool NearestNeighbor(const Eigen::Vector3d& query,
-                       Eigen::Vector3d* neighbor,
-                       double* distance) const;
-
-  // The map points within `radius` of `query` (searched in the voxels the ball touches).
-  std::vector<Eigen::Vector3d> PointsNear(const Eigen::Vector3d& query, double radius) const;
+  // The nearest map point among the 27 voxels around `query`, with its voxel's shape; false when
+  // they are empty.
+  bool NearestNeighbor(const Eigen::Vector3d& query, MapNeighbor* neighbor) const;
 
   double VoxelSize() const { return voxel_size_; }
   bool Empty() const { return voxels_.empty(); }
@@ -42,7 +49,15 @@ class VoxelHashMap {
   double voxel_size_;
   double max_distance_;
   size_t max_points_per_voxel_;
-  std::unordered_map<Eigen::Vector3i, std::vector<Eigen::Vector3d>, VoxelHash> voxels_;
+  struct Voxel {
+    std::vector<Eigen::Vector3d> points;
+    VoxelShape shape = VoxelShape::kScattered;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    bool changed = false;  // within one Update
+  };
+  static void ClassifyShape(Voxel* voxel);
+
+  std::unordered_map<Eigen::Vector3i, Voxel, VoxelHash> voxels_;
 };
 
 // One point per occupied voxel of edge `voxel_size`: the first point that falls into it (in input

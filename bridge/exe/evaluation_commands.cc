@@ -27,10 +27,10 @@ std::string MillimetreLabel(double threshold_m) {
   return label.str() + "mm";
 }
 
-// "0.002,0.005,0.01" -> metres. Every token must be a positive number in full ("2mm" is rejected,
-// not read as 2 m); an empty result means the option was malformed.
-std::vector<double> ParseThresholds(const std::string& csv) {
-  std::vector<double> thresholds;
+}  // namespace
+
+std::vector<double> ParsePositiveNumbers(const std::string& csv) {
+  std::vector<double> numbers;
   for (const std::string& token : colmap::CSVToVector<std::string>(csv)) {
     size_t used = 0;
     double value = 0;
@@ -40,12 +40,10 @@ std::vector<double> ParseThresholds(const std::string& csv) {
       return {};
     }
     if (used != token.size() || !(value > 0)) return {};
-    thresholds.push_back(value);
+    numbers.push_back(value);
   }
-  return thresholds;
+  return numbers;
 }
-
-}  // namespace
 
 void AddModelEvaluationOptions(const std::string& prefix,
                                colmap::OptionManager* manager,
@@ -70,7 +68,7 @@ int RunEvaluateModel(int argc, char** argv) {
   AddModelEvaluationOptions("", &manager, &options);
   manager.AddDefaultOption("thresholds_m", &thresholds, "comma-separated, metres");
   manager.Parse(argc, argv);
-  options.thresholds_m = ParseThresholds(thresholds);
+  options.thresholds_m = ParsePositiveNumbers(thresholds);
   THROW_CHECK(!options.thresholds_m.empty())
       << "--thresholds_m must be comma-separated numbers in metres, not '" << thresholds << "'";
   RunEvaluateModelStep(model_path, ground_truth_path, truth_from_model_path, output_path, options);

@@ -392,6 +392,41 @@ LidarGraph RegisterByOdometry(const std::vector<fs::path>& files,
   return result.graph;
 }
 
+// The registration by the chosen method, then (sweeps) de-skewing with its motion: the odometry's
+// poses stand; the pairwise path registers the de-skewed sweeps again.
+LidarGraph RegisterStations(const std::vector<fs::path>& files,
+                            const std::vector<double>& clock,
+                            const LidarRegistratorStepOptions& options,
+                            const std::string& output_path,
+                            const std::chrono::steady_clock::time_point& start,
+                            std::string* method_line) {
+  // Sweeps of a moving platform: their frames in time order turn on the speed check.
+  const std::vector<double> frames =
+      options.deskew_sweeps || options.graph.sequential > 0 ? clock : std::vector<double>();
+  const bool odometry = UseOdometry(options);
+  LidarGraph graph;
+  if (odometry) {
+    graph = RegisterByOdometry(files, clock, options, output_path, method_line);
+  } else {
+    *method_line = "method pairwise (BSC + RANSAC + ICP over station pairs)\n";
+    graph = RegisterClouds(files, options, nullptr, "", frames, start);
+  }
+  if (options.deskew_sweeps) {
+    std::cout << "lidar_registrator: de-skewing every sweep with the registered motion"
+              << (odometry ? "" : " and registering again") << std::endl;
+    const std::vector<SweepMotion> motions =
+        SweepMotionsFromPoses(graph.world_from_lidar, clock, graph.component);
+    const fs::path deskewed_path = fs::path(output_path) / "deskewed";
+    fs::create_directories(deskewed_path);
+    if (odometry) {
+      WriteDeskewedSweeps(files, motions, options.sweep_timing, deskewed_path);
+    } else {
+      graph = RegisterClouds(files, options, &motions, deskewed_path.string(), frames, start);
+    }
+  }
+  return graph;
+}
+
 }  // namespace
 
 void RunLidarRegistratorStep(const std::string& lidar_path,
@@ -407,36 +442,13 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
   fs::remove_all(deskewed_path);
   fs::remove_all(static_path);  // with moving_points.ply: no stale output of an earlier run
   fs::remove(fs::path(output_path) / "moving_points.ply");
-  // Sweeps of a moving platform: their frames in time order turn on the speed check.
   THROW_CHECK(options.sweep_clock.empty() || options.sweep_clock.size() == names.size())
       << "sweep times for " << options.sweep_clock.size() << " stations, but " << names.size()
       << " clouds in " << lidar_path;
   const std::vector<double> clock =
       options.sweep_clock.empty() ? FrameIndices(names) : options.sweep_clock;
-  const std::vector<double> frames =
-      options.deskew_sweeps || options.graph.sequential > 0 ? clock : std::vector<double>();
-  const bool odometry = UseOdometry(options);
-  LidarGraph graph;
   std::string method_line;
-  if (odometry) {
-    graph = RegisterByOdometry(files, clock, options, output_path, &method_line);
-  } else {
-    method_line = "method pairwise (BSC + RANSAC + ICP over station pairs)\n";
-    graph = RegisterClouds(files, options, nullptr, "", frames, start);
-  }
-  if (options.deskew_sweeps) {
-    std::cout << "lidar_registrator: de-skewing every sweep with the registered motion"
-              << (odometry ? "" : " and registering again") << std::endl;
-    const std::vector<SweepMotion> motions =
-        SweepMotionsFromPoses(graph.world_from_lidar, clock, graph.component);
-    fs::create_directories(deskewed_path);
-    if (odometry) {
-      WriteDeskewedSweeps(files, motions, options.sweep_timing, deskewed_path);
-    } else {
-      graph = RegisterClouds(files, options, &motions, deskewed_path.string(), frames, start);
-    }
-  }
-
+  LidarGraph graph = RegisterStations(files, clock, options, output_path, start, &method_line);
   fs::create_directories(output_path);
   if (options.remove_moving_points == 1 ||
       (options.remove_moving_points == -1 && options.deskew_sweeps)) {
@@ -532,7 +544,9 @@ int RunLidarRegistrator(int argc, char** argv) {
   AddLidarRegistratorOptions("", &manager, &registrator);
   manager.Parse(argc, argv);
   THROW_CHECK(registrator.Check());  // before any file is read
-  // A dataset's lidar/ folder: the dataset's sweep times, when it has them, time the sweeps.
+  // A dataset's lidar/ folder: the dataset's sweep times, when it has them, time the sweeps. The
+  // folder's own problems are named first.
+  StationCloudFiles(lidar_path);
   const fs::path dataset_root = fs::path(lidar_path).parent_path();
   if (fs::is_regular_file(dataset_root / "rig.json")) {
     const StationDataset dataset = ReadStationDataset(dataset_root.string());

@@ -267,6 +267,10 @@ void RunEvaluateDenseDepthStep(const std::string& dense_path,
                                const std::string& dataset_path,
                                const std::string& output_path);
 
+// "0.002,0.005,0.01" -> numbers. Every token must be a positive number in full ("2mm" is refused,
+// not read as 2); an empty result means the list was malformed.
+std::vector<double> ParsePositiveNumbers(const std::string& csv);
+
 // evaluate_model's options but the thresholds (a list, parsed by the command).
 void AddModelEvaluationOptions(const std::string& prefix,
                                colmap::OptionManager* manager,

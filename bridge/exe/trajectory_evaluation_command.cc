@@ -6,33 +6,10 @@
 #include "colmap_ext/station_dataset.h"
 
 #include "colmap/controllers/option_manager.h"
-#include "colmap/util/misc.h"
 
 #include <iostream>
 
 namespace colmap_lidar {
-namespace {
-
-// "10,20,50" -> metres; "" -> none (the defaults).
-std::vector<double> ParseLengths(const std::string& csv) {
-  std::vector<double> lengths;
-  if (csv.empty()) return lengths;
-  for (const std::string& token : colmap::CSVToVector<std::string>(csv)) {
-    size_t used = 0;
-    double value = 0;
-    try {
-      value = std::stod(token, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    THROW_CHECK(used == token.size() && value > 0)
-        << "--lengths_m must be comma-separated positive lengths in metres, not '" << csv << "'";
-    lengths.push_back(value);
-  }
-  return lengths;
-}
-
-}  // namespace
 
 bool TrajectoryEvaluationStepOptions::Check() const {
   CHECK_OPTION_GT(max_time_difference_s, 0);
@@ -96,7 +73,9 @@ int RunEvaluateTrajectory(int argc, char** argv) {
   manager.AddDefaultOption("lengths_m", &lengths, "segment lengths; empty: 10, 20, ... m");
   manager.AddDefaultOption("max_time_difference_s", &options.max_time_difference_s);
   manager.Parse(argc, argv);
-  options.lengths_m = ParseLengths(lengths);
+  options.lengths_m = ParsePositiveNumbers(lengths);
+  THROW_CHECK(lengths.empty() || !options.lengths_m.empty())
+      << "--lengths_m must be comma-separated positive lengths in metres, not '" << lengths << "'";
   THROW_CHECK(alignment == "rigid" || alignment == "similarity")
       << "--alignment is rigid or similarity, not '" << alignment << "'";
   options.alignment =
