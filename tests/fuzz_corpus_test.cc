@@ -3,7 +3,9 @@
 // is read or refused with an exception naming the file; regression_* files must be refused.
 #include "bridge/lidar_registration_files.h"
 #include "colmap_ext/dense_workspace.h"
+#include "colmap_ext/kitti_oxts.h"
 #include "colmap_ext/station_dataset.h"
+#include "colmap_ext/trajectory_files.h"
 #include "lidar/cloud_io.h"
 #include "tests/testing/scoped_temp_dir.h"
 
@@ -35,6 +37,14 @@ Readers() {
           {"fuzz_cam_from_lidar_txt",
            {"cam_from_lidar.txt", [](const std::string& p) { ReadPoseFile(p); }}},
           {"fuzz_pairs_txt", {"pairs.txt", [](const std::string& p) { ReadLidarPairs(p); }}},
+          {"fuzz_trajectory_txt",
+           {"trajectory.txt",
+            [](const std::string& p) {
+              ReadTrajectoryFile(p, DetectTrajectoryFileFormat(p));
+            }}},
+          {"fuzz_oxts_txt", {"oxts.txt", [](const std::string& p) { ReadOxtsPacket(p); }}},
+          {"fuzz_timestamps_txt",
+           {"timestamps.txt", [](const std::string& p) { ReadKittiTimestamps(p); }}},
           {"fuzz_depth_map",
            {"d.geometric.bin", [](const std::string& p) { ReadColmapDepthMap(p); }}},
       };
