@@ -10,10 +10,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
-readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
-source scripts/ccache_env.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "${ccache_launcher[@]}" \
-  -DCMAKE_PREFIX_PATH="$kColmapPrefix" >/dev/null
+source scripts/configure.sh
+configure_build build
 cmake --build build --target colmap_lidar_cli >/dev/null
 readonly cli=build/bin/colmap-lidar
 readonly kSample=../shared/data/kitti_odometry_04_sample

@@ -6,8 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
-readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$kColmapPrefix" >/dev/null
+source scripts/configure.sh
+configure_build build
 cmake --build build --target registration_benchmark colmap_lidar_cli >/dev/null
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

@@ -6,10 +6,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
 readonly kWorkspace="${WORKSPACE:-workspace}"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$kColmapPrefix${CMAKE_PREFIX_PATH:+;$CMAKE_PREFIX_PATH}" >/dev/null
+source scripts/configure.sh
+configure_build build
 cmake --build build -j "$(nproc)" --target colmap_lidar_cli
 readonly cli=build/bin/colmap-lidar
 start=$SECONDS

@@ -25,14 +25,12 @@ echo "[test] $kFreeGb GB free in $kTmpDir"
 if [[ "$kFreeGb" -lt 5 ]]; then
   echo "[test] warning: less than 5 GB free in $kTmpDir; the slow tests may fail to write" >&2
 fi
-readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
 readonly kBuildDir="${BUILD_DIR:-build}"
 echo "[test] layering check"
 bash scripts/check_layering.sh
 echo "[test] configuring and building in $kBuildDir"
-source scripts/ccache_env.sh
-cmake -S . -B "$kBuildDir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${ccache_launcher[@]}" \
-  -DCMAKE_PREFIX_PATH="$kColmapPrefix${CMAKE_PREFIX_PATH:+;$CMAKE_PREFIX_PATH}" >/dev/null
+source scripts/configure.sh
+configure_build "$kBuildDir"
 cmake --build "$kBuildDir" -j "${JOBS:-$(nproc)}"
 echo "[test] running the tests"
 # In a subshell: BUILD_DIR may be nested or absolute, and the sanitizer pass runs from the root.
