@@ -39,8 +39,8 @@ std::vector<colmap::Rigid3d> Distorted(const std::vector<colmap::Rigid3d>& cam_f
     colmap::Rigid3d step = cam_from_world[k - 1] * colmap::Inverse(cam_from_world[k]);
     const double length = step.translation.norm();
     step.translation *= 1.01;
-    step.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * length * M_PI / 180,
-                                                         Eigen::Vector3d::UnitY())) *
+    step.rotation = Eigen::Quaterniond(
+                        Eigen::AngleAxisd(0.01 * length * M_PI / 180, Eigen::Vector3d::UnitY())) *
                     step.rotation;
     world_from_cam.push_back(world_from_cam.back() * step);
   }
@@ -57,8 +57,8 @@ TEST(EvaluateTrajectoryTest, AnInjectedScaleErrorAndYawDriftReadBack) {
   WriteNamedPoses(dir.File("estimate_from_world.txt"), "distorted", NamedDrive(Distorted(truth)));
   const auto run = RunCommand(kCli + " evaluate_trajectory --trajectory_path " +
                               dir.File("estimate_from_world.txt") + " --reference_path " +
-                              dir.File("cam_from_world.txt") + " --lengths_m 5,10,20 --output_path " +
-                              dir.File("evaluation"));
+                              dir.File("cam_from_world.txt") +
+                              " --lengths_m 5,10,20 --output_path " + dir.File("evaluation"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::ifstream file(dir.File("evaluation/metrics.json"));
   const nlohmann::json metrics = nlohmann::json::parse(file);

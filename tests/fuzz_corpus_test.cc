@@ -39,9 +39,7 @@ Readers() {
           {"fuzz_pairs_txt", {"pairs.txt", [](const std::string& p) { ReadLidarPairs(p); }}},
           {"fuzz_trajectory_txt",
            {"trajectory.txt",
-            [](const std::string& p) {
-              ReadTrajectoryFile(p, DetectTrajectoryFileFormat(p));
-            }}},
+            [](const std::string& p) { ReadTrajectoryFile(p, DetectTrajectoryFileFormat(p)); }}},
           {"fuzz_oxts_txt", {"oxts.txt", [](const std::string& p) { ReadOxtsPacket(p); }}},
           {"fuzz_timestamps_txt",
            {"timestamps.txt", [](const std::string& p) { ReadKittiTimestamps(p); }}},
