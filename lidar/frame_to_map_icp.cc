@@ -64,13 +64,14 @@ void AddResidual(const Eigen::Vector3d& x,
   ++system->count;
 }
 
-// One Gauss-Newton system of the residuals at `pose` (Eq. 7-8).
-NormalSystem IcpSystem(const std::vector<Eigen::Vector3d>& points,
-                       const VoxelHashMap& map,
-                       const Eigen::Isometry3d& pose,
-                       double max_distance,
-                       double kernel,
-                       bool point_to_plane) {
+// The sum over the points' correspondences (the map point nearest to pose * p within
+// max_distance) of `add(i, x, neighbor, system)`, in fixed chunks combined in order.
+template <typename Add>
+NormalSystem SumOverCorrespondences(const std::vector<Eigen::Vector3d>& points,
+                                    const VoxelHashMap& map,
+                                    const Eigen::Isometry3d& pose,
+                                    double max_distance,
+                                    const Add& add) {
   std::vector<NormalSystem> chunks(kNumChunks);
   const int n = static_cast<int>(points.size());
 #pragma omp parallel for schedule(static)
@@ -79,12 +80,29 @@ NormalSystem IcpSystem(const std::vector<Eigen::Vector3d>& points,
       const Eigen::Vector3d x = pose * points[i];
       MapNeighbor neighbor;
       if (!map.NearestNeighbor(x, &neighbor) || neighbor.distance > max_distance) continue;
-      AddResidual(x, neighbor, kernel, point_to_plane, &chunks[c]);
+      add(i, x, neighbor, &chunks[c]);
     }
   }
   NormalSystem total;
   for (const NormalSystem& chunk : chunks) total.Add(chunk);
   return total;
+}
+
+// One Gauss-Newton system of the residuals at `pose` (Eq. 7-8).
+NormalSystem IcpSystem(const std::vector<Eigen::Vector3d>& points,
+                       const VoxelHashMap& map,
+                       const Eigen::Isometry3d& pose,
+                       double max_distance,
+                       double kernel,
+                       bool point_to_plane) {
+  return SumOverCorrespondences(
+      points,
+      map,
+      pose,
+      max_distance,
+      [&](int, const Eigen::Vector3d& x, const MapNeighbor& neighbor, NormalSystem* system) {
+        AddResidual(x, neighbor, kernel, point_to_plane, system);
+      });
 }
 
 Eigen::Isometry3d Increment(const Vector6d& dx) {
@@ -104,29 +122,22 @@ void PlaneInformation(const std::vector<Eigen::Vector3d>& points,
                       double kernel,
                       FrameToMapIcpResult* result) {
   const Eigen::Isometry3d& pose = result->world_from_lidar;
-  std::vector<NormalSystem> chunks(kNumChunks);
-  const int n = static_cast<int>(points.size());
-#pragma omp parallel for schedule(static)
-  for (int c = 0; c < kNumChunks; ++c) {
-    for (int i = c * n / kNumChunks; i < (c + 1) * n / kNumChunks; ++i) {
-      const Eigen::Vector3d x = pose * points[i];
-      MapNeighbor neighbor;
-      if (!map.NearestNeighbor(x, &neighbor) || neighbor.distance > max_distance ||
-          neighbor.shape != VoxelShape::kPlane) {
-        continue;
-      }
-      const double r = neighbor.normal.dot(x - neighbor.point);
-      const Eigen::Vector3d m = pose.linear().transpose() * neighbor.normal;
-      Vector6d jacobian;
-      jacobian << points[i].cross(m), m;
-      const double w = kernel * kernel / std::pow(kernel + r * r, 2);
-      chunks[c].hessian.noalias() += w * jacobian * jacobian.transpose();
-      chunks[c].sum_squares += r * r;
-      ++chunks[c].count;
-    }
-  }
-  NormalSystem total;
-  for (const NormalSystem& chunk : chunks) total.Add(chunk);
+  const NormalSystem total = SumOverCorrespondences(
+      points,
+      map,
+      pose,
+      max_distance,
+      [&](int i, const Eigen::Vector3d& x, const MapNeighbor& neighbor, NormalSystem* system) {
+        if (neighbor.shape != VoxelShape::kPlane) return;
+        const double r = neighbor.normal.dot(x - neighbor.point);
+        const Eigen::Vector3d m = pose.linear().transpose() * neighbor.normal;
+        Vector6d jacobian;
+        jacobian << points[i].cross(m), m;
+        const double w = kernel * kernel / std::pow(kernel + r * r, 2);
+        system->hessian.noalias() += w * jacobian * jacobian.transpose();
+        system->sum_squares += r * r;
+        ++system->count;
+      });
   result->information = total.hessian;
   result->num_plane_correspondences = total.count;
   result->plane_rms_m = total.count ? std::sqrt(total.sum_squares / total.count) : 0.0;

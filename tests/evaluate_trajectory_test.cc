@@ -4,6 +4,7 @@
 #include "colmap_ext/station_dataset.h"
 #include "tests/simulator/scene.h"
 #include "tests/simulator/sensor_pod.h"
+#include "tests/testing/distorted_trajectory.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 
@@ -31,21 +32,17 @@ std::map<std::string, colmap::Rigid3d> NamedDrive(const std::vector<colmap::Rigi
   return named;
 }
 
-// The drive's camera motions recomposed with each step's translation scaled by 1.01 and a turn of
-// 0.01 deg per metre about the camera's vertical (its y axis): cam_from_world poses.
+// The drive with each step's translation scaled by 1.01 and a turn of 0.01 deg per metre about the
+// camera's vertical (its y axis), as cam_from_world poses.
 std::vector<colmap::Rigid3d> Distorted(const std::vector<colmap::Rigid3d>& cam_from_world) {
-  std::vector<colmap::Rigid3d> world_from_cam = {colmap::Inverse(cam_from_world.front())};
-  for (size_t k = 1; k < cam_from_world.size(); ++k) {
-    colmap::Rigid3d step = cam_from_world[k - 1] * colmap::Inverse(cam_from_world[k]);
-    const double length = step.translation.norm();
-    step.translation *= 1.01;
-    step.rotation = Eigen::Quaterniond(
-                        Eigen::AngleAxisd(0.01 * length * M_PI / 180, Eigen::Vector3d::UnitY())) *
-                    step.rotation;
-    world_from_cam.push_back(world_from_cam.back() * step);
-  }
+  std::vector<colmap::Rigid3d> world_from_cam;
+  for (const colmap::Rigid3d& pose : cam_from_world)
+    world_from_cam.push_back(colmap::Inverse(pose));
   std::vector<colmap::Rigid3d> distorted;
-  for (const colmap::Rigid3d& pose : world_from_cam) distorted.push_back(colmap::Inverse(pose));
+  for (const colmap::Rigid3d& pose :
+       testing::DistortedTrajectory(world_from_cam, 1.01, 0.01, Eigen::Vector3d::UnitY())) {
+    distorted.push_back(colmap::Inverse(pose));
+  }
   return distorted;
 }
 

@@ -5,6 +5,7 @@
 #include "colmap_ext/kitti_calibration.h"
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/trajectory_files.h"
+#include "tests/testing/distorted_trajectory.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 
@@ -155,21 +156,12 @@ TEST_F(KittiOdometrySampleTest, BadSequencesAreRefusedNamingFileAndLine) {
                 dir_.File("out3"));
 }
 
-// The reference drive with a 1 % scale error and a yaw drift of 0.01 deg/m, as a KITTI file.
+// The reference drive with a 1 % scale error and a yaw drift of 0.01 deg/m, as a KITTI file (the
+// camera frame's y points down: the yaw is about y).
 void WriteDistortedEstimate(const std::string& path) {
-  const std::vector<colmap::Rigid3d> reference = ReadKittiPoses(kPoses);
-  std::vector<colmap::Rigid3d> estimate = {reference.front()};
-  for (size_t k = 1; k < reference.size(); ++k) {
-    colmap::Rigid3d step = colmap::Inverse(reference[k - 1]) * reference[k];
-    const double length = step.translation.norm();
-    step.translation *= 1.01;
-    // KITTI's camera frame: y points down, so the yaw is about y.
-    step.rotation = Eigen::Quaterniond(
-                        Eigen::AngleAxisd(0.01 * length * M_PI / 180, Eigen::Vector3d::UnitY())) *
-                    step.rotation;
-    estimate.push_back(estimate.back() * step);
-  }
-  WriteKittiPoses(path, estimate);
+  WriteKittiPoses(
+      path,
+      testing::DistortedTrajectory(ReadKittiPoses(kPoses), 1.01, 0.01, Eigen::Vector3d::UnitY()));
 }
 
 nlohmann::json ReadJson(const std::string& path) {
