@@ -130,7 +130,7 @@ void WritePlots(const fs::path& folder,
     estimate.push_back(error.alignment_scale * (align.linear() * pose.translation()) +
                        align.translation());
   }
-  PlotSeries translation{"translation [cm]", {}, {}}, rotation{"rotation [0.01 deg]", {}, {}};
+  PlotSeries translation{"t [cm]", {}, {}}, rotation{"r [0.01 deg]", {}, {}};
   for (const StepError& step : error.steps) {
     step_error.push_back(step.translation_error_m);
     translation.x.push_back(step.distance_m);

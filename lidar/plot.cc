@@ -168,8 +168,11 @@ void WriteTopViewPng(const std::string& path,
   }
   const double span = std::max({box.sizes().x(), box.sizes().y(), 1e-6});
   const double scale = std::min(kWidth - 2 * kMargin - kBar, kHeight - 2 * kMargin) / span;
+  // The paths' box centred in the drawing area.
+  const Eigen::Vector2d area(kWidth - 2 * kMargin - kBar, kHeight - 2 * kMargin);
+  const Eigen::Vector2d offset = 0.5 * (area - box.sizes() * scale);
   const auto pixel = [&](const Eigen::Vector3d& p) {
-    const Eigen::Vector2d q = (plane(p) - box.min()) * scale;
+    const Eigen::Vector2d q = (plane(p) - box.min()) * scale + offset;
     return cv::Point(kMargin + static_cast<int>(q.x()),
                      kHeight - kMargin - static_cast<int>(q.y()));
   };

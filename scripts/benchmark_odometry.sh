@@ -85,7 +85,8 @@ mkdir -p docs/benchmarks
   cat "$work/rows"
   echo
   echo "Wall time: the whole \`lidar_registrator\` (reading, registration, de-skewing, moving points,"
-  echo "outputs); frames/s: the odometry's registration alone."
+  echo "outputs); frames/s: the odometry's registration alone, the bootstrap's pairwise registration of"
+  echo "the first two sweeps included."
 } > "$kPage.tmp"
 mv "$kPage.tmp" "$kPage"
 cat "$kPage"
