@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -58,17 +59,22 @@ std::vector<int> MatchByName(const Trajectory& estimate, const Trajectory& refer
 std::vector<int> MatchByTime(const Trajectory& estimate,
                              const Trajectory& reference,
                              double max_dt) {
+  // The estimate's times in increasing order with their indices (a station order need not be one).
+  std::vector<std::pair<double, int>> times;
+  for (size_t k = 0; k < estimate.times.size(); ++k) {
+    times.emplace_back(estimate.times[k], static_cast<int>(k));
+  }
+  std::sort(times.begin(), times.end());
   std::vector<int> match;
   for (const double time : reference.times) {
-    const auto it = std::lower_bound(estimate.times.begin(), estimate.times.end(), time);
+    const auto after = std::lower_bound(
+        times.begin(), times.end(), std::make_pair(time, std::numeric_limits<int>::min()));
     int best = -1;
     double best_dt = max_dt;
-    for (auto candidate : {it, it == estimate.times.begin() ? it : it - 1}) {
-      if (candidate == estimate.times.end()) continue;
-      if (std::abs(*candidate - time) <= best_dt) {
-        best_dt = std::abs(*candidate - time);
-        best = static_cast<int>(candidate - estimate.times.begin());
-      }
+    for (auto candidate : {after, after == times.begin() ? after : after - 1}) {
+      if (candidate == times.end() || std::abs(candidate->first - time) > best_dt) continue;
+      best_dt = std::abs(candidate->first - time);
+      best = candidate->second;
     }
     match.push_back(best);
   }

@@ -294,19 +294,17 @@ std::vector<std::vector<double>> ReadStationTable(const StationDataset& dataset,
   return table;
 }
 
-// timestamps.txt and sweep_times.txt: increasing in station order, sweeps ending after they start.
+// timestamps.txt and sweep_times.txt. Sweeps end after they start and start later in station order
+// (the de-skewing takes a station's neighbours in name order as its neighbours in time).
 void ReadOptionalTimes(StationDataset* dataset) {
   for (const std::vector<double>& row : ReadStationTable(*dataset, "timestamps.txt", 1)) {
-    if (!dataset->frame_times.empty() && !(row[0] > dataset->frame_times.back())) {
-      Fail(dataset->root + "/timestamps.txt", "times do not increase in station order");
-    }
     dataset->frame_times.push_back(row[0]);
   }
   for (const std::vector<double>& row : ReadStationTable(*dataset, "sweep_times.txt", 2)) {
     if (!(row[1] > row[0]) ||
         (!dataset->sweep_times.empty() && !(row[0] > dataset->sweep_times.back().first))) {
       Fail(dataset->root + "/sweep_times.txt",
-           "sweeps must end after they start and start later in station order");
+           "sweeps must end after they start and start later in station (name) order");
     }
     dataset->sweep_times.emplace_back(row[0], row[1]);
   }

@@ -47,7 +47,7 @@ LidarOdometryOptions StreetOptions() {
   return options;
 }
 
-TEST(LidarOdometry, FollowsARawDriveWithinAPercent) {
+TEST(LidarOdometry, FollowsARawDrive) {
   const Drive drive = SimulateDrive(60, 12.0);
   TrajectoryErrorOptions metric;
   metric.lengths_m = {10, 20, 40};
@@ -61,8 +61,9 @@ TEST(LidarOdometry, FollowsARawDriveWithinAPercent) {
             << " % / " << deskewed.rotation_deg_per_m << " deg/m, without de-skewing "
             << skewed.translation_percent << " % / " << skewed.rotation_deg_per_m << " deg/m"
             << std::endl;
-  EXPECT_LT(deskewed.translation_percent, 1.0);
-  EXPECT_LT(deskewed.rotation_deg_per_m, 0.01);
+  // Measured 0.12 % / 0.0068 deg/m: bounds about 3x.
+  EXPECT_LT(deskewed.translation_percent, 0.4);
+  EXPECT_LT(deskewed.rotation_deg_per_m, 0.02);
   EXPECT_LT(deskewed.translation_percent, skewed.translation_percent);
 }
 
