@@ -2,6 +2,7 @@
 
 #include "colmap_ext/text_lines.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -98,12 +99,7 @@ std::vector<double> ReadKittiTimestamps(const std::string& path, size_t min_coun
     times.push_back(time);
     last_line = number;
   });
-  if (times.size() < std::max<size_t>(min_count, 1)) {
-    FailAtLine(path,
-               last_line,
-               "the file ends after " + std::to_string(times.size()) + " timestamps, but frame " +
-                   std::to_string(std::max<size_t>(min_count, 1) - 1) + " needs one");
-  }
+  CheckEnoughLines(path, last_line, times.size(), std::max<size_t>(min_count, 1), "timestamps");
   return times;
 }
 

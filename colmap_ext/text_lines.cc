@@ -11,6 +11,18 @@ void FailAtLine(const std::string& path, size_t line_number, const std::string& 
   throw std::runtime_error(path + ":" + std::to_string(line_number) + ": " + problem);
 }
 
+void CheckEnoughLines(const std::string& path,
+                      size_t last_line,
+                      size_t count,
+                      size_t min_count,
+                      const std::string& what) {
+  if (count >= min_count) return;
+  FailAtLine(path,
+             last_line,
+             "the file ends after " + std::to_string(count) + " " + what + ", but frame " +
+                 std::to_string(min_count - 1) + " needs one");
+}
+
 void ForEachDataLine(
     const std::string& path,
     const std::function<void(const std::string& line, size_t line_number)>& visit) {

@@ -21,6 +21,14 @@ std::vector<double> ParseNumberLine(const std::string& text,
                                     size_t line_number,
                                     size_t expected_count);
 
+// For files whose line k serves frame k: throws "PATH:LAST_LINE: the file ends after COUNT WHAT, but
+// frame MIN_COUNT-1 needs one" when COUNT < MIN_COUNT.
+void CheckEnoughLines(const std::string& path,
+                      size_t last_line,
+                      size_t count,
+                      size_t min_count,
+                      const std::string& what);
+
 // "PATH:LINE: problem" as a std::runtime_error.
 [[noreturn]] void FailAtLine(const std::string& path,
                              size_t line_number,

@@ -151,12 +151,7 @@ std::vector<colmap::Rigid3d> ReadKittiPoses(const std::string& path, size_t min_
     last_line = number;
   });
   if (poses.empty()) throw std::runtime_error(path + ": no pose line");
-  if (poses.size() < min_count) {
-    FailAtLine(path,
-               last_line,
-               "the file ends after " + std::to_string(poses.size()) + " poses, but frame " +
-                   std::to_string(min_count - 1) + " needs one");
-  }
+  CheckEnoughLines(path, last_line, poses.size(), min_count, "poses");
   return poses;
 }
 
@@ -213,12 +208,7 @@ std::vector<double> ReadKittiTimes(const std::string& path, size_t min_count) {
     last_line = number;
   });
   if (times.empty()) throw std::runtime_error(path + ": no time line");
-  if (times.size() < min_count) {
-    FailAtLine(path,
-               last_line,
-               "the file ends after " + std::to_string(times.size()) + " times, but frame " +
-                   std::to_string(min_count - 1) + " needs one");
-  }
+  CheckEnoughLines(path, last_line, times.size(), min_count, "times");
   return times;
 }
 

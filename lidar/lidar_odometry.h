@@ -88,14 +88,7 @@ class LidarOdometry {
   // increase and std::runtime_error for a frame with no point in range.
   const OdometryFrame& RegisterFrame(const std::vector<Eigen::Vector3d>& points, double clock);
 
-  // Replaces the motion per sweep duration used for the next prediction (a start from rest: the
-  // motion of the first two frames found otherwise).
-  void SetVelocity(const Eigen::Isometry3d& velocity) { velocity_ = velocity; }
-
   const std::vector<OdometryFrame>& Frames() const { return frames_; }
-  // The motion of the last registered frame per sweep duration (identity before two frames).
-  const Eigen::Isometry3d& Velocity() const { return velocity_; }
-  const VoxelHashMap& Map() const { return map_; }
 
  private:
   std::vector<Eigen::Vector3d> Preprocess(const std::vector<Eigen::Vector3d>& points) const;

@@ -115,14 +115,6 @@ bool VoxelHashMap::NearestNeighbor(const Eigen::Vector3d& query, MapNeighbor* ne
   return true;
 }
 
-std::vector<Eigen::Vector3d> VoxelHashMap::Points() const {
-  std::vector<Eigen::Vector3d> points;
-  for (const auto& [key, voxel] : voxels_) {
-    points.insert(points.end(), voxel.points.begin(), voxel.points.end());
-  }
-  return points;
-}
-
 std::vector<Eigen::Vector3d> FirstPointPerVoxel(const std::vector<Eigen::Vector3d>& points,
                                                 double voxel_size) {
   if (!(voxel_size > 0)) throw std::invalid_argument("FirstPointPerVoxel: voxel size must be > 0");

@@ -37,8 +37,6 @@ class VoxelHashMap {
 
   double VoxelSize() const { return voxel_size_; }
   bool Empty() const { return voxels_.empty(); }
-  size_t NumVoxels() const { return voxels_.size(); }
-  std::vector<Eigen::Vector3d> Points() const;
 
  private:
   struct VoxelHash {
