@@ -94,6 +94,9 @@ const DepthPrior* FindDepthPrior(const JointProblemData& data,
 
 // The joint problem of one solve: COLMAP's bundle adjuster with our blocks injected.
 struct JointProblem {
+  // The reprojection residuals' loss (the robust loss scaled by the group's weight); declared before
+  // the problem that uses it.
+  std::unique_ptr<ceres::LossFunction> reprojection_loss;
   std::unique_ptr<colmap::BundleAdjuster> adjuster;
   std::shared_ptr<ceres::Problem> problem;
   colmap::BundleAdjustmentOptions ba_options;
@@ -146,6 +149,7 @@ struct RunState {
   const bool use_lidar;
   const bool use_landmark_lidar;
   const bool refine_extrinsic;
+  VarianceFactors factors;
   std::set<ImagePoint> depth_outliers;
   size_t num_reprojection_outliers = 0;
   size_t num_lidar_outliers = 0;
@@ -213,7 +217,7 @@ std::pair<double*, double*> PoseBlocks(const RunState& state,
 void AddDepthPriorBlocks(const RunState& state, JointProblem* joint) {
   if (state.options.depth_weight <= 0 || !state.depth_priors_in_force) return;
   ceres::Problem* problem = joint->problem.get();
-  const double weight_scale = 1.0 / std::sqrt(state.options.depth_weight);
+  const double weight_scale = std::sqrt(state.factors.depth / state.options.depth_weight);
   for (const auto& [point3D_id, point3D] : state.reconstruction->Points3D()) {
     double* xyz = state.reconstruction->Point3D(point3D_id).xyz.data();
     for (const colmap::TrackElement& element : point3D.track.Elements()) {
@@ -300,7 +304,8 @@ void AddLidarBlocks(const RunState& state,
                     const std::vector<LidarObservation>& observations,
                     JointProblem* joint) {
   ceres::Problem* problem = joint->problem.get();
-  const double sigma = state.options.sigma_lidar_m / std::sqrt(state.options.lidar_weight);
+  const double sigma =
+      state.options.sigma_lidar_m * std::sqrt(state.factors.lidar / state.options.lidar_weight);
   const bool block_per_observation = state.loss != nullptr;
   std::vector<PointToPlaneObservation> group;
   for (size_t k = 0; k < observations.size(); ++k) {
@@ -346,8 +351,8 @@ void AddLandmarkLidarBlocks(const RunState& state,
                             const std::vector<LandmarkPlaneObservation>& observations,
                             JointProblem* joint) {
   ceres::Problem* problem = joint->problem.get();
-  const double sigma =
-      state.options.sigma_landmark_lidar_m / std::sqrt(state.options.landmark_lidar_weight);
+  const double sigma = state.options.sigma_landmark_lidar_m *
+                       std::sqrt(state.factors.landmark_lidar / state.options.landmark_lidar_weight);
   for (const LandmarkPlaneObservation& observation : observations) {
     if (observation.outlier || !state.reconstruction->ExistsPoint3D(observation.point3D_id)) {
       continue;
@@ -370,7 +375,13 @@ std::unique_ptr<JointProblem> BuildProblem(const RunState& state,
   auto joint = std::make_unique<JointProblem>();
   joint->ba_options = JointBundleAdjustmentOptions(state.options);
   joint->adjuster = std::make_unique<colmap::BundleAdjuster>(joint->ba_options, state.config);
-  joint->adjuster->SetUpProblem(state.reconstruction, state.loss.get());
+  ceres::LossFunction* reprojection_loss = state.loss.get();
+  if (state.factors.reprojection != 1) {
+    joint->reprojection_loss = std::make_unique<ceres::ScaledLoss>(
+        state.loss.get(), 1.0 / state.factors.reprojection, ceres::DO_NOT_TAKE_OWNERSHIP);
+    reprojection_loss = joint->reprojection_loss.get();
+  }
+  joint->adjuster->SetUpProblem(state.reconstruction, reprojection_loss);
   joint->problem = joint->adjuster->Problem();
   std::vector<ceres::ResidualBlockId> all_ids;
   joint->problem->GetResidualBlocks(&all_ids);
@@ -469,8 +480,12 @@ size_t UpdateDepthOutliers(RunState* state, DepthOutlierStats* stats) {
     }
   }
   stats->residual_scale = RobustScale(std::move(normalised));
-  const double gate_sigmas = options.max_depth_error_sigmas *
-                             (options.depth_gate_from_residual_scale ? stats->residual_scale : 1.0);
+  // The gate in units of the priors' estimated sigma (their variance factor), or of their robust
+  // residual scale without variance components.
+  const double scale = options.estimate_variance_components ? std::sqrt(state->factors.depth)
+                       : options.depth_gate_from_residual_scale ? stats->residual_scale
+                                                                : 1.0;
+  const double gate_sigmas = options.max_depth_error_sigmas * scale;
   std::set<ImagePoint> outliers;
   size_t changed = 0;
   for (const Check& check : checks) {
@@ -517,7 +532,8 @@ size_t FlagLandmarkOutliers(RunState* state, std::vector<LandmarkPlaneObservatio
   const double gate = std::max(
       state->round_gate_m,
       std::min(state->options.max_landmark_plane_m,
-               state->options.max_landmark_plane_sigmas * state->options.sigma_landmark_lidar_m));
+               state->options.max_landmark_plane_sigmas * state->options.sigma_landmark_lidar_m *
+                   std::sqrt(state->factors.landmark_lidar)));
   size_t flagged = 0;
   for (LandmarkPlaneObservation& observation : *observations) {
     if (observation.outlier) continue;
@@ -592,7 +608,7 @@ void Reassociate(int round, int num_rounds, RunState* state, Associations* assoc
   state->num_lidar_outliers = 0;
   state->num_landmark_outliers = 0;
   std::cout << "Round " << round + 1 << "/"
-            << (round < num_rounds ? std::to_string(num_rounds) : "+ (T_e still moving)") << ": "
+            << (round < num_rounds ? std::to_string(num_rounds) : "+ (T_e or the weights still moving)") << ": "
             << associations->lidar.size() << " LiDAR point-to-plane observations, "
             << associations->landmarks.size() << " landmark-to-LiDAR-plane observations (gate "
             << gate << " m, " << SecondsSince(start) << " s)" << std::endl;
@@ -642,6 +658,49 @@ void SolveWithOutliers(int round,
     summary->solves.push_back(stats);
     if (changes == 0) break;
   }
+}
+
+size_t NumResiduals(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& ids) {
+  size_t count = 0;
+  for (const ceres::ResidualBlockId id : ids) {
+    count += problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+  }
+  return count;
+}
+
+// The variance components at the current state (on a problem built for them); each group's factor is
+// multiplied by its estimate (a group without residuals or redundancy keeps its factor). Returns the
+// components; `changed`: whether a factor moved by more than kFactorTolerance.
+std::vector<VarianceComponent> UpdateVarianceFactors(RunState* state,
+                                                     const Associations& associations,
+                                                     bool* changed) {
+  constexpr double kFactorTolerance = 0.1;
+  const std::unique_ptr<JointProblem> joint = BuildProblem(*state, associations);
+  ceres::Problem* problem = joint->problem.get();
+  const std::vector<VarianceGroup> groups = {
+      {"reprojection", joint->reprojection_ids, NumResiduals(problem, joint->reprojection_ids)},
+      {"depth_prior", joint->depth_ids, joint->depth_ids.size()},
+      {"lidar", joint->lidar_ids, joint->num_lidar_residuals},
+      {"landmark_lidar", joint->landmark_ids, joint->landmark_ids.size()}};
+  std::vector<ceres::ResidualBlockId> fixed = joint->prior_ids;
+  fixed.insert(fixed.end(), joint->measurement_ids.begin(), joint->measurement_ids.end());
+  const std::vector<VarianceComponent> components =
+      EstimateVarianceComponents(problem, groups, fixed);
+  double* factors[4] = {&state->factors.reprojection,
+                        &state->factors.depth,
+                        &state->factors.lidar,
+                        &state->factors.landmark_lidar};
+  *changed = false;
+  std::cout << "  variance components (sigma / nominal sigma):";
+  for (size_t g = 0; g < groups.size(); ++g) {
+    if (components[g].num_observations == 0 || components[g].redundancy <= 0.5) continue;
+    *factors[g] *= components[g].factor;
+    *changed = *changed || std::abs(components[g].factor - 1) > kFactorTolerance;
+    std::cout << " " << components[g].name << " " << std::sqrt(*factors[g]) << " (redundancy "
+              << std::llround(components[g].redundancy) << ")";
+  }
+  std::cout << std::endl;
+  return components;
 }
 
 // Clusters of residuals that share errors: a landmark's reprojections and landmark-to-plane residuals,
@@ -899,7 +958,10 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
   JointAdjustmentSummary summary;
   Associations associations;
   const int num_rounds = state.UsesExtrinsic() ? options_.num_association_rounds : 1;
-  for (int round = 0; round < num_rounds || RoundMovedExtrinsic(options_, summary); ++round) {
+  bool factors_changed = false;
+  for (int round = 0;
+       round < num_rounds || RoundMovedExtrinsic(options_, summary) || factors_changed;
+       ++round) {
     if (round >= options_.max_association_rounds) break;
     const colmap::Rigid3d before = *cam_from_lidar;
     state.depth_priors_in_force = !state.UsesExtrinsic() ||
@@ -911,6 +973,9 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
     }
     if (state.UsesExtrinsic()) Reassociate(round, num_rounds, &state, &associations);
     SolveWithOutliers(round, &state, &associations, &summary);
+    if (options_.estimate_variance_components) {
+      summary.variance_components = UpdateVarianceFactors(&state, associations, &factors_changed);
+    }
     summary.extrinsic_change_per_round.push_back(ExtrinsicChange(before, *cam_from_lidar));
     if (state.UsesExtrinsic()) {
       std::cout << "  round " << round + 1 << " moved cam_from_lidar by "
@@ -929,6 +994,7 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
     std::cout << "E_l's own rotation about the driving direction: " << summary.lidar_free_angle_deg
               << " deg from cam_from_lidar" << std::endl;
   }
+  summary.variance_factors = state.factors;
   const std::unique_ptr<JointProblem> final_problem = BuildProblem(state, associations);
   summary.final_reprojection_residuals = final_problem->reprojection_ids.size();
   summary.final_depth_residuals = final_problem->depth_ids.size();

@@ -28,6 +28,7 @@
 #pragma once
 
 #include "bridge/extrinsic_observability.h"
+#include "bridge/variance_components.h"
 #include "colmap_ext/extension_database.h"
 #include "lidar/point_to_plane_association.h"
 #include "lidar/station_cloud.h"
@@ -61,6 +62,10 @@ struct JointAdjusterOptions {
   // Standard deviation of a LiDAR point-to-plane distance (the paper uses 0.02 - 0.1 m). sigma_p = 1 px
   // is COLMAP's reprojection weight; sigma_d comes with each depth prior.
   double sigma_lidar_m = 0.02;
+  // Estimate each data group's variance factor (reprojection, depth priors, E_l, E_m) with the solve
+  // (bridge/variance_components.h) and weight the group by it: the nominal sigmas (1 px, sigma_d,
+  // sigma_lidar_m, sigma_landmark_lidar_m) and weights below are then only the start.
+  bool estimate_variance_components = true;
   // w_c of E_d (E_f keeps weight 1).
   double depth_weight = 1.0;
   // With LiDAR terms, E_d joins from this round on (1: from the start, as in the paper). The start's
@@ -188,6 +193,12 @@ struct DepthOutlierStats {
   size_t restored = 0;
 };
 
+// Each data group's variance factor: its residuals are whitened by its nominal sigma times
+// sqrt(factor) (bridge/variance_components.h).
+struct VarianceFactors {
+  double reprojection = 1, depth = 1, lidar = 1, landmark_lidar = 1;
+};
+
 struct SolveStats {
   int round = 0;
   int outlier_iteration = 0;
@@ -232,6 +243,10 @@ struct JointAdjustmentSummary {
   double lidar_free_angle_deg = 0;
   // Per association round of the (last) pass: how far it moved T_e, {deg, mm}.
   std::vector<std::array<double, 2>> extrinsic_change_per_round;
+  // The variance factors in force at the end, and the last estimate's components (empty without
+  // estimate_variance_components).
+  VarianceFactors variance_factors;
+  std::vector<VarianceComponent> variance_components;
 };
 
 // Ceres' mean time per iteration (iteration 0, the initial evaluation, left out); 0 without iterations.

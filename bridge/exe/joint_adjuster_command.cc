@@ -125,6 +125,29 @@ nlohmann::json UncertaintyJson(const ExtrinsicUncertainty& u,
   return uncertainty;
 }
 
+// Each data group's estimated sigma in units of its nominal one (sqrt of the factor in force), and
+// the last estimate's observations, redundancy and factor.
+nlohmann::json VarianceComponentsJson(const JointAdjusterOptions& options,
+                                      const JointAdjustmentSummary& summary) {
+  nlohmann::json json = {{"estimated", options.estimate_variance_components}};
+  const VarianceFactors& f = summary.variance_factors;
+  json["sigma_over_nominal"] = {{"reprojection", std::sqrt(f.reprojection)},
+                                {"depth_prior", std::sqrt(f.depth)},
+                                {"lidar", std::sqrt(f.lidar)},
+                                {"landmark_lidar", std::sqrt(f.landmark_lidar)}};
+  json["sigma_lidar_m"] = options.sigma_lidar_m * std::sqrt(f.lidar / options.lidar_weight);
+  nlohmann::json groups = nlohmann::json::array();
+  for (const VarianceComponent& c : summary.variance_components) {
+    groups.push_back({{"group", c.name},
+                      {"observations", c.num_observations},
+                      {"parameter_share", c.parameter_share},
+                      {"redundancy", c.redundancy},
+                      {"last_factor", c.factor}});
+  }
+  json["groups"] = groups;
+  return json;
+}
+
 nlohmann::json MotionJson(const MotionAnalysis& motion) {
   return {{"stations", motion.num_stations},
           {"rotating_pairs", motion.num_rotating_pairs},
@@ -177,6 +200,7 @@ void WriteReport(const std::string& directory,
                              {"lidar_residuals", summary.final_lidar_residuals},
                              {"landmark_lidar_residuals", summary.final_landmark_lidar_residuals}};
   report["landmark_lidar_weight"] = options.landmark_lidar_weight;
+  report["variance_components"] = VarianceComponentsJson(options, summary);
   if (!summary.lidar_free_axis_in_cam.isZero()) {
     const Eigen::Vector3d& axis = summary.lidar_free_axis_in_cam;
     report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
@@ -308,6 +332,9 @@ void AddJointAdjusterOptions(const std::string& prefix,
   PrefixedOptions add(manager, prefix);
   JointAdjusterOptions& adjuster = options->adjuster;
   add.Add("sigma_lidar_m", &adjuster.sigma_lidar_m);
+  add.Add("estimate_variance_components",
+          &adjuster.estimate_variance_components,
+          "weight each data group by its variance factor estimated with the solve");
   add.Add("depth_weight", &adjuster.depth_weight);
   add.Add("first_depth_prior_round",
           &adjuster.first_depth_prior_round,
