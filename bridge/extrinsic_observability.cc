@@ -432,6 +432,24 @@ std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform
          "them as lower bounds";
 }
 
+void RestrictToFreeDirections(const Eigen::Matrix3d& held_rotation,
+                              const Eigen::Matrix3d& held_translation,
+                              ExtrinsicUncertainty* uncertainty) {
+  Matrix6 held = Matrix6::Zero();
+  held.topLeftCorner<3, 3>() = held_rotation;
+  held.bottomRightCorner<3, 3>() = held_translation;
+  if (held.isZero()) return;
+  const Matrix6 free = Matrix6::Identity() - held;
+  uncertainty->covariance = free * uncertainty->covariance * free.transpose();
+  uncertainty->formal_covariance = free * uncertainty->formal_covariance * free.transpose();
+  Eigen::SelfAdjointEigenSolver<Matrix6> eigen(uncertainty->covariance);
+  for (int k = 0; k < 6; ++k) {
+    uncertainty->eigenvalues[k] = std::sqrt(std::max(eigen.eigenvalues()[k], 0.0));
+    uncertainty->eigenvectors.col(k) = eigen.eigenvectors().col(k);
+    uncertainty->undetermined[k] = held(k, k) > 0.5;
+  }
+}
+
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(
     ceres::Problem* problem,
     double* cam_from_lidar_rotation,

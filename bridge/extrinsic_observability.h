@@ -64,7 +64,17 @@ struct ExtrinsicUncertainty {
       Eigen::Matrix<double, 6, 1>::Zero();  // std devs, ascending
   Eigen::Matrix<double, 6, 6> eigenvectors = Eigen::Matrix<double, 6, 6>::Zero();  // columns
   std::vector<std::string> unobservable;  // one sentence per unobservable direction
+  // Axes (rx ry rz tx ty tz about/along the camera axes) that lie mostly in directions held at
+  // their start: they have no sigma (the covariance is zero in the held directions).
+  std::array<bool, 6> undetermined = {false, false, false, false, false, false};
 };
+
+// Restricts the covariances of `uncertainty` to the complement of the held directions (projections
+// in the camera frame, rotation then translation): held directions get no variance, and the axes
+// lying mostly in them are marked undetermined.
+void RestrictToFreeDirections(const Eigen::Matrix3d& held_rotation,
+                              const Eigen::Matrix3d& held_translation,
+                              ExtrinsicUncertainty* uncertainty);
 
 struct MotionAnalysis {
   int num_stations = 0;

@@ -163,6 +163,8 @@ struct RunState {
   // a parameter block that lives across rounds.
   Eigen::Vector3d lidar_free_axis = Eigen::Vector3d::Zero();
   std::unique_ptr<double> lidar_free_angle = std::make_unique<double>(0.0);
+  // JointAdjusterOptions::estimate_time_offset: dt, a parameter block that lives across rounds.
+  std::unique_ptr<double> time_offset = std::make_unique<double>(0.0);
 
   bool UsesExtrinsic() const { return use_lidar || use_landmark_lidar; }
 
@@ -346,11 +348,41 @@ void AddLidarBlocks(const RunState& state,
   }
 }
 
+// Each registered image's camera velocity in its own frame, by central differences of the camera
+// centres over the neighbouring images in time (image_id order, one unit apart, without times).
+std::map<colmap::image_t, Eigen::Vector3d> CameraVelocities(
+    const colmap::Reconstruction& reconstruction, const std::map<colmap::image_t, double>& times) {
+  std::vector<std::pair<double, colmap::image_t>> order;
+  for (const colmap::image_t image_id : reconstruction.RegImageIds()) {
+    const auto time = times.find(image_id);
+    if (!times.empty() && time == times.end()) continue;
+    order.emplace_back(times.empty() ? static_cast<double>(image_id) : time->second, image_id);
+  }
+  std::sort(order.begin(), order.end());
+  std::map<colmap::image_t, Eigen::Vector3d> velocities;
+  if (order.size() < 2) return velocities;
+  for (size_t k = 0; k < order.size(); ++k) {
+    const size_t previous = k == 0 ? 0 : k - 1, next = std::min(k + 1, order.size() - 1);
+    const colmap::Image& image = reconstruction.Image(order[k].second);
+    const Eigen::Vector3d displacement =
+        reconstruction.Image(order[next].second).ProjectionCenter() -
+        reconstruction.Image(order[previous].second).ProjectionCenter();
+    const double duration = order[next].first - order[previous].first;
+    if (duration <= 0) continue;
+    velocities[order[k].second] = image.CamFromWorld().rotation * displacement / duration;
+  }
+  return velocities;
+}
+
 // E_m for every associated landmark observation in force (the landmark and image still there).
 void AddLandmarkLidarBlocks(const RunState& state,
                             const std::vector<LandmarkPlaneObservation>& observations,
                             JointProblem* joint) {
   ceres::Problem* problem = joint->problem.get();
+  const std::map<colmap::image_t, Eigen::Vector3d> velocities =
+      state.options.estimate_time_offset
+          ? CameraVelocities(*state.reconstruction, state.data.image_times)
+          : std::map<colmap::image_t, Eigen::Vector3d>();
   const double sigma = state.options.sigma_landmark_lidar_m *
                        std::sqrt(state.factors.landmark_lidar / state.options.landmark_lidar_weight);
   for (const LandmarkPlaneObservation& observation : observations) {
@@ -358,6 +390,20 @@ void AddLandmarkLidarBlocks(const RunState& state,
       continue;
     }
     const auto [rotation, translation] = PoseBlocks(state, problem, observation.image_id);
+    const auto velocity = velocities.find(observation.image_id);
+    if (velocity != velocities.end()) {
+      joint->landmark_ids.push_back(problem->AddResidualBlock(
+          TimedLandmarkLidarPlaneCostFunctor::Create(
+              observation.point_in_lidar, observation.normal_in_lidar, velocity->second, sigma),
+          state.loss.get(),
+          {rotation,
+           translation,
+           state.reconstruction->Point3D(observation.point3D_id).xyz.data(),
+           state.ExtrinsicRotation(),
+           state.ExtrinsicTranslation(),
+           state.time_offset.get()}));
+      continue;
+    }
     joint->landmark_ids.push_back(problem->AddResidualBlock(
         LandmarkLidarPlaneCostFunctor::Create(
             observation.point_in_lidar, observation.normal_in_lidar, sigma),
@@ -534,11 +580,20 @@ size_t FlagLandmarkOutliers(RunState* state, std::vector<LandmarkPlaneObservatio
       std::min(state->options.max_landmark_plane_m,
                state->options.max_landmark_plane_sigmas * state->options.sigma_landmark_lidar_m *
                    std::sqrt(state->factors.landmark_lidar)));
+  const std::map<colmap::image_t, Eigen::Vector3d> velocities =
+      state->options.estimate_time_offset
+          ? CameraVelocities(*state->reconstruction, state->data.image_times)
+          : std::map<colmap::image_t, Eigen::Vector3d>();
   size_t flagged = 0;
   for (LandmarkPlaneObservation& observation : *observations) {
     if (observation.outlier) continue;
+    colmap::Rigid3d cam_from_lidar = *state->cam_from_lidar;  // station i's, with dt
+    const auto velocity = velocities.find(observation.image_id);
+    if (velocity != velocities.end()) {
+      cam_from_lidar.translation += *state->time_offset * velocity->second;
+    }
     const double distance =
-        LandmarkPlaneDistance(observation, *state->reconstruction, *state->cam_from_lidar);
+        LandmarkPlaneDistance(observation, *state->reconstruction, cam_from_lidar);
     if (std::isnan(distance) || std::abs(distance) > gate) {
       observation.outlier = true;
       ++flagged;
@@ -778,6 +833,7 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
       depth_scale_derivative,
       motion,
       state.options.observability);
+  RestrictToFreeDirections(state.held_rotation, state.held_translation, &uncertainty);
   if (joint.reprojection_ids.empty() && joint.depth_ids.empty()) {
     uncertainty.unobservable.insert(
         uncertainty.unobservable.begin(),
@@ -995,6 +1051,11 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
               << " deg from cam_from_lidar" << std::endl;
   }
   summary.variance_factors = state.factors;
+  if (options_.estimate_time_offset) {
+    summary.time_offset = *state.time_offset;
+    std::cout << "LiDAR clock offset from the cameras (E_m): " << *state.time_offset
+              << (data.image_times.empty() ? " frames" : " s") << std::endl;
+  }
   const std::unique_ptr<JointProblem> final_problem = BuildProblem(state, associations);
   summary.final_reprojection_residuals = final_problem->reprojection_ids.size();
   summary.final_depth_residuals = final_problem->depth_ids.size();

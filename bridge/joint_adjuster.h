@@ -85,6 +85,12 @@ struct JointAdjusterOptions {
   // w_m of E_m, the landmark-to-LiDAR-plane term; 0 = off (the paper's cost). The pipeline turns it on
   // for a monocular rig, where it gives the landmarks their metric depth.
   double landmark_lidar_weight = 0.0;
+  // A moving platform: E_m carries the offset dt of the LiDAR's clock from the cameras' as a
+  // parameter (bridge/landmark_lidar_plane_cost.h, TimedLandmarkLidarPlaneCostFunctor), with each
+  // station's camera velocity from its neighbours (JointProblemData::image_times). Where the velocity
+  // in the camera frame does not change (a straight drive at constant speed), dt and T_e's translation
+  // along the travel are one direction, which the covariance then reports as undetermined.
+  bool estimate_time_offset = false;
   // sigma_m of E_m: the landmark's triangulation and the LiDAR surface together.
   double sigma_landmark_lidar_m = 0.02;
   // E_m outliers: beyond this distance or beyond max_landmark_plane_sigmas * sigma_m (absolute and in
@@ -169,6 +175,9 @@ struct JointProblemData {
   std::map<colmap::image_t, const StationCloud*> clouds;
   // The pose graph A_c v A_l as unordered image pairs; LiDAR observations are drawn in both directions.
   std::vector<std::pair<colmap::image_t, colmap::image_t>> pairs;
+  // Capture time of each image [s] (empty: the images are frames in image_id order, one unit apart);
+  // for the camera velocities of estimate_time_offset.
+  std::map<colmap::image_t, double> image_times;
   // Joins the cost as E_x (bridge/extrinsic_deviation_cost.h) in joint mode; absent: not used.
   std::optional<ExtrinsicMeasurement> extrinsic_measurement;
 };
@@ -246,6 +255,9 @@ struct JointAdjustmentSummary {
   // The variance factors in force at the end, and the last estimate's components (empty without
   // estimate_variance_components).
   VarianceFactors variance_factors;
+  // With estimate_time_offset: the LiDAR clock's offset from the cameras' [s, or frames without
+  // image times].
+  std::optional<double> time_offset;
   std::vector<VarianceComponent> variance_components;
 };
 

@@ -42,22 +42,85 @@ class LandmarkLidarPlaneCostFunctor {
                   const T* const cam_from_lidar_rotation,
                   const T* const cam_from_lidar_translation,
                   T* residual) const {
+    residual[0] = Residual(cam_i_from_world_rotation,
+                           cam_i_from_world_translation,
+                           landmark_in_world,
+                           cam_from_lidar_rotation,
+                           Eigen::Matrix<T, 3, 1>(
+                               colmap::EigenVector3Map<T>(cam_from_lidar_translation)));
+    return true;
+  }
+
+  // E_m with station i's camera-from-LiDAR translation `cam_from_lidar_translation_i`.
+  template <typename T>
+  T Residual(const T* const cam_i_from_world_rotation,
+             const T* const cam_i_from_world_translation,
+             const T* const landmark_in_world,
+             const T* const cam_from_lidar_rotation,
+             const Eigen::Matrix<T, 3, 1>& cam_from_lidar_translation_i) const {
     using Vector3 = Eigen::Matrix<T, 3, 1>;
     const auto cam_from_lidar_q = colmap::EigenQuaternionMap<T>(cam_from_lidar_rotation);
     const Vector3 landmark_in_cam_i = colmap::EigenQuaternionMap<T>(cam_i_from_world_rotation) *
                                           colmap::EigenVector3Map<T>(landmark_in_world) +
                                       colmap::EigenVector3Map<T>(cam_i_from_world_translation);
-    const Vector3 target_in_cam_i = cam_from_lidar_q * point_in_lidar_i_.cast<T>() +
-                                    colmap::EigenVector3Map<T>(cam_from_lidar_translation);
+    const Vector3 target_in_cam_i =
+        cam_from_lidar_q * point_in_lidar_i_.cast<T>() + cam_from_lidar_translation_i;
     const Vector3 normal_in_cam_i = cam_from_lidar_q * normal_in_lidar_i_.cast<T>();
-    residual[0] = normal_in_cam_i.dot(landmark_in_cam_i - target_in_cam_i) * T(inverse_sigma_);
-    return true;
+    return normal_in_cam_i.dot(landmark_in_cam_i - target_in_cam_i) * T(inverse_sigma_);
   }
 
  private:
   const Eigen::Vector3d point_in_lidar_i_;
   const Eigen::Vector3d normal_in_lidar_i_;
   const double inverse_sigma_;
+};
+
+// E_m of a moving platform whose LiDAR clock is offset from the cameras' by dt (a parameter): station
+// i's LiDAR pose is that of the camera at t_i + dt, so the LiDAR sample sits where the camera is dt
+// later, t_e + dt v_i with v_i the camera's velocity in its own frame at station i:
+//   E_m = (R_e n)^T (cam_i_from_world X - R_e q - t_e - dt v_i) / sigma_m.
+// On a drive of constant velocity in the camera frame, dt and t_e along v are one direction (the
+// covariance says so); turns and speed changes separate them.
+// Parameter blocks: those of LandmarkLidarPlaneCostFunctor, then dt [1].
+class TimedLandmarkLidarPlaneCostFunctor {
+ public:
+  TimedLandmarkLidarPlaneCostFunctor(const Eigen::Vector3d& point_in_lidar_i,
+                                     const Eigen::Vector3d& normal_in_lidar_i,
+                                     const Eigen::Vector3d& velocity_in_cam_i,
+                                     double sigma)
+      : plane_(point_in_lidar_i, normal_in_lidar_i, sigma), velocity_in_cam_i_(velocity_in_cam_i) {}
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& point_in_lidar_i,
+                                     const Eigen::Vector3d& normal_in_lidar_i,
+                                     const Eigen::Vector3d& velocity_in_cam_i,
+                                     double sigma) {
+    return new ceres::AutoDiffCostFunction<TimedLandmarkLidarPlaneCostFunctor, 1, 4, 3, 3, 4, 3, 1>(
+        new TimedLandmarkLidarPlaneCostFunctor(
+            point_in_lidar_i, normal_in_lidar_i, velocity_in_cam_i, sigma));
+  }
+
+  template <typename T>
+  bool operator()(const T* const cam_i_from_world_rotation,
+                  const T* const cam_i_from_world_translation,
+                  const T* const landmark_in_world,
+                  const T* const cam_from_lidar_rotation,
+                  const T* const cam_from_lidar_translation,
+                  const T* const time_offset,
+                  T* residual) const {
+    const Eigen::Matrix<T, 3, 1> translation_i =
+        colmap::EigenVector3Map<T>(cam_from_lidar_translation) +
+        time_offset[0] * velocity_in_cam_i_.cast<T>();
+    residual[0] = plane_.Residual(cam_i_from_world_rotation,
+                                  cam_i_from_world_translation,
+                                  landmark_in_world,
+                                  cam_from_lidar_rotation,
+                                  translation_i);
+    return true;
+  }
+
+ private:
+  const LandmarkLidarPlaneCostFunctor plane_;
+  const Eigen::Vector3d velocity_in_cam_i_;
 };
 
 }  // namespace colmap_lidar

@@ -95,6 +95,16 @@ nlohmann::json MatrixJson(const Eigen::MatrixXd& matrix) {
   return rows;
 }
 
+// Names of the axes held at their start (no sigma).
+std::vector<std::string> UndeterminedAxes(const ExtrinsicUncertainty& u) {
+  static const char* kAxes[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
+  std::vector<std::string> axes;
+  for (int k = 0; k < 6; ++k) {
+    if (u.undetermined[k]) axes.push_back(kAxes[k]);
+  }
+  return axes;
+}
+
 // report.json's "uncertainty": the cluster-robust and formal covariances of cam_from_lidar.
 // `caveat`: UncertaintyCaveat's sentence (empty: validated for this kind of capture).
 nlohmann::json UncertaintyJson(const ExtrinsicUncertainty& u,
@@ -116,9 +126,16 @@ nlohmann::json UncertaintyJson(const ExtrinsicUncertainty& u,
     uncertainty["formal_sigma_rotation_deg"] = {formal_sigma[0], formal_sigma[1], formal_sigma[2]};
     uncertainty["formal_sigma_translation_mm"] = {
         formal_sigma[3], formal_sigma[4], formal_sigma[5]};
+    // Axes held at their start have no sigma (null).
     const Eigen::VectorXd sigma = u.covariance.diagonal().cwiseSqrt();
-    uncertainty["sigma_rotation_deg"] = {sigma[0], sigma[1], sigma[2]};
-    uncertainty["sigma_translation_mm"] = {sigma[3], sigma[4], sigma[5]};
+    nlohmann::json sigmas = nlohmann::json::array();
+    for (int k = 0; k < 6; ++k) {
+      sigmas.push_back(u.undetermined[k] ? nlohmann::json(nullptr) : nlohmann::json(sigma[k]));
+    }
+    uncertainty["sigma_deg_mm"] = sigmas;
+    uncertainty["sigma_rotation_deg"] = {sigmas[0], sigmas[1], sigmas[2]};
+    uncertainty["sigma_translation_mm"] = {sigmas[3], sigmas[4], sigmas[5]};
+    uncertainty["undetermined_axes"] = UndeterminedAxes(u);
     uncertainty["eigen_std_devs"] = MatrixJson(u.eigenvalues.transpose());
     uncertainty["eigenvectors_columns"] = MatrixJson(u.eigenvectors);
   }
@@ -201,6 +218,10 @@ void WriteReport(const std::string& directory,
                              {"landmark_lidar_residuals", summary.final_landmark_lidar_residuals}};
   report["landmark_lidar_weight"] = options.landmark_lidar_weight;
   report["variance_components"] = VarianceComponentsJson(options, summary);
+  if (summary.time_offset) {
+    report["time_offset"] = {{"lidar_minus_camera_s", *summary.time_offset},
+                             {"unit", loaded.data.image_times.empty() ? "frames" : "s"}};
+  }
   if (!summary.lidar_free_axis_in_cam.isZero()) {
     const Eigen::Vector3d& axis = summary.lidar_free_axis_in_cam;
     report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
@@ -300,9 +321,18 @@ void PrintUncertainty(const JointAdjustmentSummary& summary, const std::string& 
   std::cout << "Motion: " << summary.motion.verdict << std::endl;
   if (summary.uncertainty.computed) {
     const Eigen::VectorXd sigma = summary.uncertainty.covariance.diagonal().cwiseSqrt();
-    std::cout << std::setprecision(3) << "cam_from_lidar sigma: rotation "
-              << sigma.head<3>().transpose() << " deg, translation " << sigma.tail<3>().transpose()
-              << " mm" << std::endl;
+    std::ostringstream line;
+    line << std::setprecision(3) << "cam_from_lidar sigma (deg about, mm along the camera axes):";
+    static const char* kAxes[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
+    for (int k = 0; k < 6; ++k) {
+      line << " " << kAxes[k] << " ";
+      if (summary.uncertainty.undetermined[k]) {
+        line << "undetermined";
+      } else {
+        line << sigma[k];
+      }
+    }
+    std::cout << line.str() << std::endl;
     if (!caveat.empty()) std::cout << "cam_from_lidar sigma " << caveat << std::endl;
   }
   for (const std::string& sentence : summary.uncertainty.unobservable) {
@@ -335,6 +365,9 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("estimate_variance_components",
           &adjuster.estimate_variance_components,
           "weight each data group by its variance factor estimated with the solve");
+  add.Add("estimate_time_offset",
+          &options->estimate_time_offset,
+          "on a moving platform, estimate the LiDAR clock's offset from the cameras");
   add.Add("depth_weight", &adjuster.depth_weight);
   add.Add("first_depth_prior_round",
           &adjuster.first_depth_prior_round,
@@ -432,6 +465,17 @@ InitialisationFacts ReadInitialisationFacts(const std::string& input_path) {
   return facts;
 }
 
+// Each registered image's capture time (DATASET/timestamps.txt); empty without times.
+std::map<colmap::image_t, double> ImageTimes(const StationDataset& dataset,
+                                             const LoadedJointData& loaded) {
+  std::map<colmap::image_t, double> times;
+  if (dataset.frame_times.size() != dataset.stations.size()) return times;
+  for (const auto& [image_id, station] : loaded.station_of_image) {
+    times[image_id] = dataset.frame_times[station];
+  }
+  return times;
+}
+
 void PrintMeasurement(const ExtrinsicMeasurement& measurement) {
   const Eigen::Matrix<double, 6, 1> sigmas = measurement.covariance.diagonal().cwiseSqrt();
   std::cout << "cam_from_lidar measured by the " << measurement.source
@@ -515,6 +559,11 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                            options.data);
   std::cout << "Loaded depth priors, clouds and the pose graph (" << SecondsSince(start) << " s)"
             << std::endl;
+  options.adjuster.estimate_time_offset =
+      options.estimate_time_offset && IsMovingPlatform(dataset, facts);
+  if (options.adjuster.estimate_time_offset) {
+    loaded->data.image_times = ImageTimes(dataset, *loaded);
+  }
   if (options.use_stereo_alignment && facts.stereo_alignment &&
       options.adjuster.mode == JointMode::kJoint) {
     loaded->data.extrinsic_measurement = facts.stereo_alignment;

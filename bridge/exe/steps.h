@@ -178,6 +178,9 @@ struct JointAdjusterStepOptions {
   // stereo-LiDAR alignment is one: 1 on, 0 off, -1 on for a moving platform whose stations do not
   // rotate about two axes (decided by RunJointAdjusterStep, as for landmark_lidar_weight).
   int vertical_alignment = -1;
+  // On a moving platform (rig.json), estimate the LiDAR clock's offset from the cameras in E_m
+  // (JointAdjusterOptions::estimate_time_offset).
+  bool estimate_time_offset = true;
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
   bool write_text = false;
 
