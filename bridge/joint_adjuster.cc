@@ -18,7 +18,6 @@
 #include "colmap/scene/projection.h"
 
 #include <ceres/ceres.h>
-#include <omp.h>
 
 #include <chrono>
 #include <cmath>
@@ -51,7 +50,6 @@ double TermCost(ceres::Problem* problem, const std::vector<ceres::ResidualBlockI
   if (ids.empty()) return 0;
   ceres::Problem::EvaluateOptions options;
   options.residual_blocks = ids;
-  options.num_threads = omp_get_max_threads();
   double cost = 0;
   problem->Evaluate(options, &cost, nullptr, nullptr, nullptr);
   return cost;
@@ -191,7 +189,9 @@ colmap::BundleAdjustmentOptions JointBundleAdjustmentOptions(const JointAdjuster
   ba.solver_options.function_tolerance = 1e-12;
   ba.solver_options.gradient_tolerance = 1e-14;
   ba.solver_options.parameter_tolerance = 1e-12;
-  ba.solver_options.num_threads = omp_get_max_threads();
+  // One thread: Ceres' threaded evaluation and Schur elimination sum in the order threads finish,
+  // which would make the result depend on the thread count.
+  ba.solver_options.num_threads = 1;
   return ba;
 }
 
@@ -281,12 +281,12 @@ void AddExtrinsicBlocks(const RunState& state, JointProblem* joint) {
         rotation,
         translation));
   }
-  const std::optional<ExtrinsicMeasurement>& measurement = state.data.extrinsic_measurement;
-  if (state.refine_extrinsic && measurement) {
+  for (const ExtrinsicMeasurement& measurement : state.data.extrinsic_measurements) {
+    if (!state.refine_extrinsic) break;
     joint->measurement_ids.push_back(problem->AddResidualBlock(
-        ExtrinsicDeviationCostFunctor::Create(measurement->cam_from_lidar.rotation,
-                                              measurement->cam_from_lidar.translation,
-                                              WhiteningOfCovariance(measurement->covariance)),
+        ExtrinsicDeviationCostFunctor::Create(measurement.cam_from_lidar.rotation,
+                                              measurement.cam_from_lidar.translation,
+                                              WhiteningOfCovariance(measurement.covariance)),
         nullptr,
         rotation,
         translation));
@@ -573,13 +573,15 @@ size_t FlagLidarOutliers(RunState* state, std::vector<LidarObservation>* observa
   return flagged;
 }
 
-// E_m observations beyond the absolute or the sigma gate get zero weight; returns how many new.
+// E_m observations beyond the absolute or the sigma gate get zero weight; returns how many new. The
+// gate is in units of the nominal sigma_m, not of its estimate: E_m's residuals are heavy-tailed (a
+// landmark near a plane's edge), and a gate that follows the estimate would clip the tails round
+// after round, each round's smaller estimate narrowing the next gate.
 size_t FlagLandmarkOutliers(RunState* state, std::vector<LandmarkPlaneObservation>* observations) {
   const double gate = std::max(
       state->round_gate_m,
       std::min(state->options.max_landmark_plane_m,
-               state->options.max_landmark_plane_sigmas * state->options.sigma_landmark_lidar_m *
-                   std::sqrt(state->factors.landmark_lidar)));
+               state->options.max_landmark_plane_sigmas * state->options.sigma_landmark_lidar_m));
   const std::map<colmap::image_t, Eigen::Vector3d> velocities =
       state->options.estimate_time_offset
           ? CameraVelocities(*state->reconstruction, state->data.image_times)
@@ -944,6 +946,12 @@ HeldDirections UnobservableDirections(const ExtrinsicUncertainty& uncertainty,
 
 }  // namespace
 
+bool JointProblemData::HasExtrinsicPrior() const {
+  return std::any_of(extrinsic_measurements.begin(),
+                     extrinsic_measurements.end(),
+                     [](const ExtrinsicMeasurement& measurement) { return measurement.prior; });
+}
+
 JointMode JointModeFromName(const std::string& name) {
   if (name == "joint") return JointMode::kJoint;
   if (name == "precalibrated") return JointMode::kPrecalibrated;
@@ -1078,7 +1086,9 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
   THROW_CHECK_NOTNULL(cam_from_lidar);
   THROW_CHECK_GE(reconstruction->NumRegImages(), 2)
       << "the joint problem needs at least 2 registered images";
-  const bool may_hold = options_.hold_unobservable && options_.mode == JointMode::kJoint;
+  // With a prior, weak directions keep the prior's sigma instead of being held.
+  const bool may_hold = options_.hold_unobservable && options_.mode == JointMode::kJoint &&
+                        !data.HasExtrinsicPrior();
   const colmap::Reconstruction initial_reconstruction =
       may_hold ? *reconstruction : colmap::Reconstruction();
   const colmap::Rigid3d initial_extrinsic = *cam_from_lidar;

@@ -16,7 +16,8 @@
 //   residual E_m = n^T (lidar_i_from_world X - q) / sigma_m with w_m (bridge/landmark_lidar_plane_cost.h).
 // - Optional (not in the paper): a measurement of T_e made outside the problem (the pose initialiser's
 //   stereo-LiDAR alignment), E_x = W [rotvec(R_e R_x^-1); t_e - t_x] with W^T W its inverse covariance
-//   (bridge/extrinsic_deviation_cost.h; JointProblemData::extrinsic_measurement).
+//   (bridge/extrinsic_deviation_cost.h; JointProblemData::extrinsic_measurements), and rig.json's
+//   guess when it carries a sigma (a prior).
 // - E_f = COLMAP's reprojection residual in pixels (sigma_p = 1 px); E_d = the depth-prior residual
 //   (colmap_ext/depth_prior_cost.h), z-depth with sigma_d = d^2/(b f) sigma_p.
 // - Gauge: the first station's (smallest image_id's) pose is constant. Metric scale comes from the depth
@@ -163,6 +164,9 @@ struct ExtrinsicMeasurement {
   colmap::Rigid3d cam_from_lidar;
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();
   std::string source;  // for reports, e.g. "stereo-LiDAR alignment"
+  // Outside knowledge (rig.json's guess with its sigma), not a fit to the data of this problem: the
+  // directions it determines are not held at their start.
+  bool prior = false;
 };
 
 // What the joint problem needs besides COLMAP's reconstruction. Borrowed by JointAdjuster::Run for the
@@ -178,8 +182,10 @@ struct JointProblemData {
   // Capture time of each image [s] (empty: the images are frames in image_id order, one unit apart);
   // for the camera velocities of estimate_time_offset.
   std::map<colmap::image_t, double> image_times;
-  // Joins the cost as E_x (bridge/extrinsic_deviation_cost.h) in joint mode; absent: not used.
-  std::optional<ExtrinsicMeasurement> extrinsic_measurement;
+  // Each joins the cost as E_x (bridge/extrinsic_deviation_cost.h) in joint mode.
+  std::vector<ExtrinsicMeasurement> extrinsic_measurements;
+
+  bool HasExtrinsicPrior() const;
 };
 
 struct TermStats {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -94,6 +95,29 @@ colmap::Rigid3d ParseRigid(const json& value, const std::string& path, const std
   return colmap::Rigid3d(rotation.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
 }
 
+// The guess's optional sigma_rotation_deg and sigma_translation_m (both or neither, positive).
+std::optional<StationRig::GuessSigma> ParseGuessSigma(const json& guess, const std::string& path) {
+  const bool rotation = guess.contains("sigma_rotation_deg");
+  const bool translation = guess.contains("sigma_translation_m");
+  if (!rotation && !translation) return std::nullopt;
+  if (rotation != translation) {
+    Fail(path,
+         "'cam_from_lidar_guess' needs both 'sigma_rotation_deg' and 'sigma_translation_m' (or "
+         "neither)");
+  }
+  StationRig::GuessSigma sigma;
+  for (const auto& [key, value] : {std::pair<const char*, double*>{"sigma_rotation_deg",
+                                                                   &sigma.rotation_deg},
+                                   {"sigma_translation_m", &sigma.translation_m}}) {
+    const json& number = guess[key];
+    if (!number.is_number() || !std::isfinite(number.get<double>()) || number.get<double>() <= 0) {
+      Fail(path, std::string("'cam_from_lidar_guess.") + key + "' must be a positive number");
+    }
+    *value = number.get<double>();
+  }
+  return sigma;
+}
+
 StationRig::LidarSweep ParseSweep(const json& value, const std::string& path) {
   StationRig::LidarSweep sweep;
   if (!value.is_object()) Fail(path, "'lidar.sweep' must be an object");
@@ -177,6 +201,7 @@ StationRig ReadRigJson(const std::string& path) {
   if (root.contains("cam_from_lidar_guess") && !root["cam_from_lidar_guess"].is_null()) {
     rig.cam_from_lidar_guess =
         ParseRigid(root["cam_from_lidar_guess"], path, "cam_from_lidar_guess");
+    rig.cam_from_lidar_guess_sigma = ParseGuessSigma(root["cam_from_lidar_guess"], path);
   }
   if (root.contains("lidar")) {
     const json& lidar = root["lidar"];
@@ -209,6 +234,12 @@ void WriteRigJson(const std::string& path, const StationRig& rig) {
   }
   if (rig.cam_from_lidar_guess) {
     root["cam_from_lidar_guess"] = RigidToJson(*rig.cam_from_lidar_guess);
+    if (rig.cam_from_lidar_guess_sigma) {
+      root["cam_from_lidar_guess"]["sigma_rotation_deg"] =
+          rig.cam_from_lidar_guess_sigma->rotation_deg;
+      root["cam_from_lidar_guess"]["sigma_translation_m"] =
+          rig.cam_from_lidar_guess_sigma->translation_m;
+    }
   }
   if (!rig.lidar_model.empty()) {
     root["lidar"] = {{"model", rig.lidar_model}, {"range_noise_m", rig.lidar_range_noise_m}};

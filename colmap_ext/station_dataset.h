@@ -31,6 +31,14 @@ struct StationRig {
   // Meaningful only with `right`.
   colmap::Rigid3d right_from_left;
   std::optional<colmap::Rigid3d> cam_from_lidar_guess;
+  // "cam_from_lidar_guess": {..., "sigma_rotation_deg": r, "sigma_translation_m": t}: how well the
+  // guess is known (one standard deviation per camera axis); the joint adjuster then takes the guess
+  // as a Gaussian prior. Absent: the guess is only a start.
+  struct GuessSigma {
+    double rotation_deg = 0;
+    double translation_m = 0;
+  };
+  std::optional<GuessSigma> cam_from_lidar_guess_sigma;
   std::string lidar_model;         // e.g. "VLP-16"; empty if not given
   double lidar_range_noise_m = 0;  // 0 if not given
   // "lidar": {"sweep": {"start_azimuth_deg": a, "counter_clockwise": b}}: each cloud is one revolution

@@ -93,6 +93,27 @@ TEST_F(StationDatasetTest, LidarSweepRoundTrips) {
   EXPECT_FALSE(copy.lidar_sweep->counter_clockwise);
 }
 
+// A guess with its sigma (a prior for the joint adjuster) round-trips; a half-given or
+// non-positive sigma is refused naming the key.
+TEST_F(StationDatasetTest, GuessSigmaRoundTripsAndBadOnesAreRefused) {
+  EXPECT_FALSE(ReadRigJson(dir_.File("rig.json")).cam_from_lidar_guess_sigma);
+  json rig = ValidRig();
+  rig["cam_from_lidar_guess"]["sigma_rotation_deg"] = 0.5;
+  rig["cam_from_lidar_guess"]["sigma_translation_m"] = 0.02;
+  WriteRig(rig);
+  WriteRigJson(dir_.File("copy.json"), ReadRigJson(dir_.File("rig.json")));
+  const StationRig copy = ReadRigJson(dir_.File("copy.json"));
+  ASSERT_TRUE(copy.cam_from_lidar_guess_sigma);
+  EXPECT_EQ(copy.cam_from_lidar_guess_sigma->rotation_deg, 0.5);
+  EXPECT_EQ(copy.cam_from_lidar_guess_sigma->translation_m, 0.02);
+  rig["cam_from_lidar_guess"]["sigma_translation_m"] = 0;
+  WriteRig(rig);
+  ExpectError("rig.json", "'cam_from_lidar_guess.sigma_translation_m' must be a positive number");
+  rig["cam_from_lidar_guess"].erase("sigma_translation_m");
+  WriteRig(rig);
+  ExpectError("rig.json", "needs both 'sigma_rotation_deg' and 'sigma_translation_m'");
+}
+
 TEST_F(StationDatasetTest, BadRigJsonNamesTheFileAndTheKey) {
   json rig = ValidRig();
   rig.erase("right_from_left");

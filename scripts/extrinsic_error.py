@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 # Per-axis error of an estimated cam_from_lidar against a reference, in units of the reported sigma:
 #   extrinsic_error.py TRUTH ESTIMATE REPORT_JSON [LABEL...]
-# TRUTH, ESTIMATE: pose files (qw qx qy qz tx ty tz, '#' comments). Prints one tab-separated line:
+# TRUTH, ESTIMATE: pose files (qw qx qy qz tx ty tz, '#' comments), or a rig.json as ESTIMATE (its
+# cam_from_lidar_guess); REPORT_JSON may be '' (no sigmas). Prints one tab-separated line:
 # the labels, the errors (rotation vector of estimate * inverse(truth) about the camera axes [deg],
 # translation [mm]), the reported sigmas and z = error / sigma ('nan' for an axis reported without a
 # sigma: undetermined or held).
@@ -9,6 +10,9 @@ import json, math, sys
 
 
 def read_pose(path):
+    if path.endswith('.json'):
+        guess = json.load(open(path))['cam_from_lidar_guess']
+        return guess['rotation'], guess['translation']
     values = [float(v) for line in open(path) if line.strip() and not line.startswith('#')
               for v in line.split()]
     return values[:4], values[4:7]
@@ -33,6 +37,8 @@ def errors(truth_path, estimate_path):
 
 
 def sigmas(report_path):
+    if not report_path:
+        return [float('nan')] * 6
     u = json.load(open(report_path))['uncertainty']
     if 'sigma_deg_mm' in u:
         return [float('nan') if v is None else v for v in u['sigma_deg_mm']]
@@ -43,7 +49,7 @@ def sigmas(report_path):
 def main():
     truth, estimate, report = sys.argv[1:4]
     e, s = errors(truth, estimate), sigmas(report)
-    z = [ek / sk if sk > 0 else float('nan') for ek, sk in zip(e, s)]
+    z = [ek / sk if sk > 0 else float('nan') for ek, sk in zip(e, s)]  # nan > 0 is False
     print('\t'.join(sys.argv[4:] + ['%.4f' % v for v in e] + ['%.4f' % v for v in s] +
                     ['%.3f' % v for v in z]))
 

@@ -16,6 +16,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 
 namespace colmap_lidar {
@@ -180,6 +181,31 @@ TEST(JointAdjusterTest, DefaultSceneWithNoise) {
   EXPECT_LT(joint.evaluation.mean_position_error_mm, stereo_only.evaluation.mean_position_error_mm);
   EXPECT_TRUE(fs::exists(dir.File("joint/perturbation_rotation.png")));
   EXPECT_TRUE(fs::exists(dir.File("joint/cost.png")));
+}
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+}
+
+// Results do not depend on the thread count: OpenMP's (associations) and Ceres' (the solves).
+TEST(JointAdjusterTest, SameOutputWithOneAndFourThreads) {
+  testing::ScopedTempDir dir;
+  sim::SimulationOptions options = Stations(4, "two_axes");
+  options.image_scale = 0.5;
+  options.lidar_points = 100000;
+  const Workspace ws = Prepare(dir, options, 0.3, 0.01);
+  for (const char* threads : {"1", "4"}) {
+    RunStep(std::string("OMP_NUM_THREADS=") + threads + " " + kCli +
+            " joint_adjuster --database_path " + ws.database + " --input_path " +
+            ws.initial_model + " --dataset_path " + ws.dataset + " --output_path " +
+            dir.File(std::string("joint") + threads) + " --cam_from_lidar " + ws.guess);
+  }
+  for (const char* file : {"cam_from_lidar.txt", "images.bin", "points3D.bin"}) {
+    const std::string one = FileBytes(dir.File("joint1/") + file);
+    EXPECT_FALSE(one.empty()) << file;
+    EXPECT_TRUE(one == FileBytes(dir.File("joint4/") + file)) << file << " differs";
+  }
 }
 
 // Degenerate motion: the report names what cannot be observed.

@@ -29,6 +29,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// cam_from_lidar's axes in report order: rotation about, then translation along the camera axes.
+constexpr const char* kExtrinsicAxes[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
+
 std::array<bool, 3> ParseHeldAxes(const std::string& text) {
   std::array<bool, 3> held = {false, false, false};
   std::stringstream stream(text);
@@ -77,6 +80,7 @@ nlohmann::json MeasurementJson(const ExtrinsicMeasurement& measurement,
       refined.translation - measurement.cam_from_lidar.translation;
   const Eigen::Matrix<double, 6, 1> sigmas = measurement.covariance.diagonal().cwiseSqrt();
   return {{"source", measurement.source},
+          {"prior", measurement.prior},
           {"cam_from_lidar", PoseJson(measurement.cam_from_lidar)},
           {"sigma_rotation_deg_in_cam",
            {sigmas(0) * 180 / M_PI, sigmas(1) * 180 / M_PI, sigmas(2) * 180 / M_PI}},
@@ -97,10 +101,26 @@ nlohmann::json MatrixJson(const Eigen::MatrixXd& matrix) {
 
 // Names of the axes held at their start (no sigma).
 std::vector<std::string> UndeterminedAxes(const ExtrinsicUncertainty& u) {
-  static const char* kAxes[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
   std::vector<std::string> axes;
   for (int k = 0; k < 6; ++k) {
-    if (u.undetermined[k]) axes.push_back(kAxes[k]);
+    if (u.undetermined[k]) axes.push_back(kExtrinsicAxes[k]);
+  }
+  return axes;
+}
+
+// Axes whose reported sigma is at least 1/sqrt(2) of a prior's: the data know them no better than
+// the prior does (posterior variance 1 / (1/data + 1/prior) >= prior / 2 <=> data >= prior).
+std::vector<std::string> PriorDeterminedAxes(const ExtrinsicUncertainty& u,
+                                             const std::vector<ExtrinsicMeasurement>& measurements) {
+  std::vector<std::string> axes;
+  if (!u.computed) return axes;
+  for (const ExtrinsicMeasurement& measurement : measurements) {
+    if (!measurement.prior) continue;
+    for (int k = 0; k < 6; ++k) {
+      const double prior_variance =
+          measurement.covariance(k, k) * std::pow(k < 3 ? 180 / M_PI : 1000.0, 2);
+      if (u.covariance(k, k) >= 0.5 * prior_variance) axes.push_back(kExtrinsicAxes[k]);
+    }
   }
   return axes;
 }
@@ -227,11 +247,14 @@ void WriteReport(const std::string& directory,
     report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
                                      {"lidar_term_angle_deg", summary.lidar_free_angle_deg}};
   }
-  if (loaded.data.extrinsic_measurement) {
-    report["extrinsic_measurement"] = MeasurementJson(*loaded.data.extrinsic_measurement, refined);
+  report["extrinsic_measurements"] = nlohmann::json::array();
+  for (const ExtrinsicMeasurement& measurement : loaded.data.extrinsic_measurements) {
+    report["extrinsic_measurements"].push_back(MeasurementJson(measurement, refined));
   }
   const ExtrinsicUncertainty& u = summary.uncertainty;
   report["uncertainty"] = UncertaintyJson(u, options.observability, caveat);
+  report["uncertainty"]["prior_determined_axes"] =
+      PriorDeterminedAxes(u, loaded.data.extrinsic_measurements);
   report["unobservable"] = u.unobservable;
   report["held_at_initial"] = summary.held_at_initial;
   report["hold_thresholds"] = {{"enabled", options.hold_unobservable},
@@ -323,9 +346,8 @@ void PrintUncertainty(const JointAdjustmentSummary& summary, const std::string& 
     const Eigen::VectorXd sigma = summary.uncertainty.covariance.diagonal().cwiseSqrt();
     std::ostringstream line;
     line << std::setprecision(3) << "cam_from_lidar sigma (deg about, mm along the camera axes):";
-    static const char* kAxes[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
-    for (int k = 0; k < 6; ++k) {
-      line << " " << kAxes[k] << " ";
+      for (int k = 0; k < 6; ++k) {
+      line << " " << kExtrinsicAxes[k] << " ";
       if (summary.uncertainty.undetermined[k]) {
         line << "undetermined";
       } else {
@@ -484,6 +506,19 @@ void PrintMeasurement(const ExtrinsicMeasurement& measurement) {
             << 1000 * sigmas.tail<3>().transpose() << " mm" << std::endl;
 }
 
+// rig.json's guess with its sigma, as a prior (isotropic per block about/along the camera axes).
+ExtrinsicMeasurement GuessPrior(const StationRig& rig) {
+  ExtrinsicMeasurement prior;
+  prior.cam_from_lidar = *rig.cam_from_lidar_guess;
+  const double rotation = rig.cam_from_lidar_guess_sigma->rotation_deg * M_PI / 180;
+  const double translation = rig.cam_from_lidar_guess_sigma->translation_m;
+  prior.covariance.diagonal() << rotation * rotation, rotation * rotation, rotation * rotation,
+      translation * translation, translation * translation, translation * translation;
+  prior.source = "rig.json guess (prior)";
+  prior.prior = true;
+  return prior;
+}
+
 // A moving platform: rig.json's clouds are sweeps, or initialization.json reports a one-axis
 // hand-eye.
 bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& facts) {
@@ -505,6 +540,38 @@ bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& 
 // the roll about the driving direction went from 0.153 to 0.088 deg mean absolute error (6 better,
 // 2 unchanged); on the drives of seeds 1-3, 0.217 to 0.211 deg (no clear difference).
 constexpr double kMovingPlatformLandmarkWeight = 0.25;
+
+// In joint mode: rig.json's guess with a sigma as a prior; the pose initialiser's stereo-LiDAR
+// alignment, or else the vertical alignment (which the cameras' start then takes). Returns the
+// vertical alignment if it ran.
+std::optional<VerticalAlignment> AddExtrinsicMeasurements(const StationDataset& dataset,
+                                                          const InitialisationFacts& facts,
+                                                          const colmap::Reconstruction& reconstruction,
+                                                          const JointAdjusterStepOptions& options,
+                                                          LoadedJointData* loaded,
+                                                          colmap::Rigid3d* cam_from_lidar) {
+  if (options.adjuster.mode != JointMode::kJoint) return std::nullopt;
+  std::vector<ExtrinsicMeasurement>& measurements = loaded->data.extrinsic_measurements;
+  if (dataset.rig.cam_from_lidar_guess && dataset.rig.cam_from_lidar_guess_sigma) {
+    measurements.push_back(GuessPrior(dataset.rig));
+    PrintMeasurement(measurements.back());
+  }
+  if (options.use_stereo_alignment && facts.stereo_alignment) {
+    measurements.push_back(*facts.stereo_alignment);
+    PrintMeasurement(measurements.back());
+    return std::nullopt;
+  }
+  if (options.vertical_alignment != 1) return std::nullopt;
+  std::optional<VerticalAlignment> vertical = MeasureStationVerticals(
+      dataset, reconstruction, *loaded, *cam_from_lidar, options.adjuster.observability);
+  if (vertical->valid) {
+    measurements.push_back(VerticalAlignmentMeasurement(*vertical, *cam_from_lidar));
+    // Start from it: a drive's hand-eye can leave the roll degrees off, and the first round's wide
+    // associations then settle the height wrongly.
+    cam_from_lidar->rotation = measurements.back().cam_from_lidar.rotation;
+  }
+  return vertical;
+}
 
 void ResolveAutomaticOptions(const StationDataset& dataset,
                              const InitialisationFacts& facts,
@@ -564,23 +631,8 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   if (options.adjuster.estimate_time_offset) {
     loaded->data.image_times = ImageTimes(dataset, *loaded);
   }
-  if (options.use_stereo_alignment && facts.stereo_alignment &&
-      options.adjuster.mode == JointMode::kJoint) {
-    loaded->data.extrinsic_measurement = facts.stereo_alignment;
-    PrintMeasurement(*facts.stereo_alignment);
-  }
-  std::optional<VerticalAlignment> vertical;
-  if (options.vertical_alignment == 1 && !loaded->data.extrinsic_measurement &&
-      options.adjuster.mode == JointMode::kJoint) {
-    vertical = MeasureStationVerticals(
-        dataset, reconstruction, *loaded, cam_from_lidar, options.adjuster.observability);
-    if (vertical->valid) {
-      loaded->data.extrinsic_measurement = VerticalAlignmentMeasurement(*vertical, cam_from_lidar);
-      // Start from it: a drive's hand-eye can leave the roll degrees off, and the first round's wide
-      // associations then settle the height wrongly.
-      cam_from_lidar.rotation = loaded->data.extrinsic_measurement->cam_from_lidar.rotation;
-    }
-  }
+  const std::optional<VerticalAlignment> vertical =
+      AddExtrinsicMeasurements(dataset, facts, reconstruction, options, loaded.get(), &cam_from_lidar);
   const JointAdjustmentSummary summary =
       JointAdjuster(options.adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);
 

@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# cam_from_lidar on the real KITTI odometry sample (../shared/data/kitti_odometry_04_sample: 20 frames
+# of a straight drive, HDL-64, KITTI's calibration as the reference), stereo and mono, started from
+# KITTI's calibration perturbed by GUESS_DEG (default 2) / GUESS_M (default 0.05) with SEEDS (default
+# "0"). The pipeline runs once per rig and seed up to the joint adjuster; the joint adjuster then runs
+# in each estimator variant on the same front end. Per run and camera axis: the error, the reported
+# sigma and z = error / sigma ("undetermined": held at the start, no sigma). Writes
+# docs/benchmarks/kitti_extrinsic.md.
+#   WORK_DIR  keep the workspaces there (steps already done are not run again); default: temporary
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh >/dev/null
+source scripts/configure.sh
+configure_build build
+cmake --build build --target colmap_lidar_cli >/dev/null
+readonly cli="$PWD/build/bin/colmap-lidar"
+readonly kSample="$PWD/../shared/data/kitti_odometry_04_sample"
+if [ -n "${WORK_DIR:-}" ]; then
+  work="$WORK_DIR"
+  mkdir -p "$work"
+else
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+fi
+results="$work/results.tsv"
+: > "$results"
+# The estimator variants: a label and the joint adjuster's options.
+variants=(
+  "default|"
+  "fixed weights, no clock offset|--estimate_variance_components 0 --estimate_time_offset 0"
+)
+
+# Import and the pipeline's front end for one rig (stereo: USE_RIGHT 1) and seed.
+front_end() {
+  local run=$1 use_right=$2 seed=$3
+  [ -f "$run/ws/steps/pose_initializer.done" ] && return 0
+  rm -rf "$run"
+  "$cli" import_kitti --format odometry --sequence_path "$kSample" \
+    --poses_path "$kSample/poses/04.txt" --output_path "$run/ds" --use_right "$use_right" \
+    --write_guess 1 --guess_rotation_deg "${GUESS_DEG:-2}" --guess_translation_m "${GUESS_M:-0.05}" \
+    --seed "$seed" > "$run/import.log" 2>&1
+  "$cli" pipeline --dataset_path "$run/ds" --workspace_path "$run/ws" --Import.matcher sequential \
+    > "$run/pipeline.log" 2>&1
+}
+
+for seed in ${SEEDS:-0}; do
+  for rig in stereo mono; do
+    run="$work/$rig-$seed"
+    use_right=1
+    [ "$rig" = mono ] && use_right=0
+    echo "[$rig, seed $seed] front end"
+    front_end "$run" "$use_right" "$seed"
+    python3 scripts/extrinsic_error.py "$run/ds/ground_truth/cam_from_lidar.txt" "$run/ds/rig.json" \
+      "" "$rig" "$seed" "start (the guess)" >> "$results"
+    for variant in "${variants[@]}"; do
+      label=${variant%%|*}
+      options=${variant#*|}
+      out="$run/joint-$(echo "$label" | tr -c 'a-z' '_')"
+      echo "[$rig, seed $seed] joint adjuster: $label"
+      # shellcheck disable=SC2086
+      "$cli" joint_adjuster --database_path "$run/ws/database.db" --input_path "$run/ws/sparse/initial" \
+        --dataset_path "$run/ds" --output_path "$out" $options > "$out.log" 2>&1
+      python3 scripts/extrinsic_error.py "$run/ds/ground_truth/cam_from_lidar.txt" \
+        "$out/cam_from_lidar.txt" "$out/report.json" "$rig" "$seed" "$label" >> "$results"
+      tail -1 "$results"
+    done
+  done
+done
+mkdir -p docs/benchmarks
+python3 scripts/kitti_extrinsic_table.py "$results" "${GUESS_DEG:-2}" "${GUESS_M:-0.05}" \
+  > docs/benchmarks/kitti_extrinsic.md
+echo "Wrote docs/benchmarks/kitti_extrinsic.md"

@@ -1,0 +1,40 @@
+#!/usr/bin/env python3
+# Writes docs/benchmarks/kitti_extrinsic.md (to stdout) from benchmark_kitti_extrinsic.sh's results:
+#   kitti_extrinsic_table.py RESULTS_TSV GUESS_DEG GUESS_M
+import datetime, math, os, subprocess, sys
+
+path, guess_deg, guess_m = sys.argv[1:]
+axes = ['rx', 'ry', 'rz', 'tx', 'ty', 'tz']
+rows = [line.rstrip('\n').split('\t') for line in open(path) if line.strip()]
+commit = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], capture_output=True,
+                        text=True).stdout.strip()
+print('# cam_from_lidar on the real KITTI odometry sample\n')
+print('Written by `scripts/benchmark_kitti_extrinsic.sh` on %s, commit %s (%d cores).\n' %
+      (datetime.date.today().isoformat(), commit, os.cpu_count()))
+print('Data: `../shared/data/kitti_odometry_04_sample`, 20 frames of a straight drive at ~13 m/s '
+      '(HDL-64, rectified colour cameras), KITTI\'s calibration of 2011_09_30 as the reference. '
+      'Each rig is started from that calibration perturbed by %s deg / %s m (`import_kitti '
+      '--write_guess 1`); the whole `pipeline` runs once, then `joint_adjuster` in each variant on the '
+      'same front end.\n' % (guess_deg, guess_m))
+print('Errors: rotation vector of estimate * inverse(reference) about the camera axes [deg], '
+      'translation [mm]; z = error / reported sigma; "undet." = held at the start and reported '
+      'without a sigma.\n')
+print('| rig | seed | estimator | ' + ' | '.join('err ' + a for a in axes) + ' | ' +
+      ' | '.join('z ' + a for a in axes) + ' |')
+print('|---|---|---|' + '---|' * 12)
+
+
+def cell(value, digits):
+    v = float(value)
+    return '' if math.isnan(v) else ('%.' + str(digits) + 'f') % v
+
+
+for r in rows:
+    errors, sigmas, z = r[3:9], r[9:15], r[15:21]
+    is_start = all(math.isnan(float(s)) for s in sigmas)
+    zs = ['' if is_start else ('undet.' if math.isnan(float(zk)) else cell(zk, 1)) for zk in z]
+    print('| ' + ' | '.join(r[:3] + [cell(e, 3 if k < 3 else 1) for k, e in enumerate(errors)] +
+                            zs) + ' |')
+print('\nEstimators: "default" = variance components estimated with the solve and, on this moving '
+      'platform, the LiDAR clock offset as a parameter of E_m; "fixed weights, no clock offset" = '
+      'the nominal weights (1 px, sigma_d, 2 cm) and one cam_from_lidar for every station.')
