@@ -64,7 +64,6 @@ TEST(PipelineStereoDriveTest, FortyFrameStereoDriveCalibratesFromItsStereoDepthW
   EXPECT_LT(start_mm, 25.0);
   EXPECT_LT(joint_deg, 0.12);
   EXPECT_LT(joint_mm, 12.0);
-  // The alignment joined the joint cost with a covariance clustered over the 40 stations.
   EXPECT_TRUE(init["stereo_alignment"]["covariance_clustered_by_station"].get<bool>());
   // The dense depth maps against the true ones: the LiDAR surface of the sweeps grows its
   // neighbourhoods on a moving platform and corrects the stereo, decimetres off at 10-30 m. Measured
@@ -75,8 +74,11 @@ TEST(PipelineStereoDriveTest, FortyFrameStereoDriveCalibratesFromItsStereoDepthW
   EXPECT_LT(depth["median_abs_error_m"].get<double>(), 0.033);
   EXPECT_GT(depth["within_5cm"].get<double>(), 0.6);
   const nlohmann::json report = ReadJson(ws + "/sparse/joint/report.json");
-  ASSERT_EQ(report["extrinsic_measurements"].size(), 1u) << report.dump(2).substr(0, 2000);
-  EXPECT_EQ(report["extrinsic_measurements"][0]["source"], "stereo-LiDAR alignment");
+  // The alignment is the start, not a measurement: it fits the same stereo depth and LiDAR that the
+  // depth priors and E_l bring into the cost.
+  for (const nlohmann::json& measurement : report["extrinsic_measurements"]) {
+    EXPECT_NE(measurement["source"], "stereo-LiDAR alignment");
+  }
 }
 
 }  // namespace

@@ -452,7 +452,7 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("unobservable_rotation_deg", &adjuster.observability.unobservable_rotation_deg);
   add.Add("use_stereo_alignment",
           &options->use_stereo_alignment,
-          "take INPUT/initialization.json's stereo-LiDAR alignment as a measurement of "
+          "also take INPUT/initialization.json's stereo-LiDAR alignment as a measurement of "
           "cam_from_lidar");
   add.Add("vertical_alignment",
           &options->vertical_alignment,

@@ -169,10 +169,11 @@ struct JointAdjusterStepOptions {
   double landmark_lidar_weight = -1;
   // LiDAR samples per pair (int for the OptionManager); into `adjuster.association` by Check().
   int num_samples_per_pair = static_cast<int>(JointAdjusterOptions().association.num_samples);
-  // Take the pose initialiser's stereo-LiDAR alignment (INPUT/initialization.json) as a measurement
-  // of cam_from_lidar in joint mode, when it was used and its covariance is clustered by station
-  // (StereoLidarAlignment's min_station_clusters stations with associations).
-  bool use_stereo_alignment = true;
+  // Also take the pose initialiser's stereo-LiDAR alignment (INPUT/initialization.json) as a
+  // measurement of cam_from_lidar in joint mode (it is always the start). Off: the alignment fits
+  // the same stereo depth and LiDAR that the depth priors and E_l bring into the cost, so its
+  // information would count twice.
+  bool use_stereo_alignment = false;
   // Measure cam_from_lidar's tilt from the vertical structure both sensors see
   // (bridge/vertical_alignment.h), start from it and take it as a measurement, in joint mode when no
   // stereo-LiDAR alignment is one: 1 on, 0 off, -1 on for a moving platform whose stations do not
