@@ -191,9 +191,8 @@ std::string FileBytes(const std::string& path) {
 // Results do not depend on the thread count: OpenMP's (associations) and Ceres' (the solves).
 TEST(JointAdjusterTest, SameOutputWithOneAndFourThreads) {
   testing::ScopedTempDir dir;
-  sim::SimulationOptions options = Stations(4, "two_axes");
-  options.image_scale = 0.5;
-  options.lidar_points = 100000;
+  sim::SimulationOptions options = Stations(10, "one_axis");
+  options.image_scale = 0.6;
   const Workspace ws = Prepare(dir, options, 0.3, 0.01);
   for (const char* threads : {"1", "4"}) {
     RunStep(std::string("OMP_NUM_THREADS=") + threads + " " + kCli +
