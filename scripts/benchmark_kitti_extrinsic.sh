@@ -35,6 +35,7 @@ front_end() {
   local run=$1 use_right=$2 seed=$3
   [ -f "$run/ws/steps/pose_initializer.done" ] && return 0
   rm -rf "$run"
+  mkdir -p "$run"
   "$cli" import_kitti --format odometry --sequence_path "$kSample" \
     --poses_path "$kSample/poses/04.txt" --output_path "$run/ds" --use_right "$use_right" \
     --write_guess 1 --guess_rotation_deg "${GUESS_DEG:-2}" --guess_translation_m "${GUESS_M:-0.05}" \
