@@ -81,32 +81,8 @@ for scene in ${SCENES:-t_specimen bridge_pier}; do
       printf '%s\t%s\tFAILED\n' "$scene" "$seed" >> "$results"
       continue
     fi
-    python3 - "$scene" "$seed" "$run/dataset/ground_truth/cam_from_lidar.txt" \
-      "$joint/cam_from_lidar.txt" "$joint/report.json" >> "$results" <<'PY'
-import json, math, sys
-scene, seed, truth_path, estimate_path, report_path = sys.argv[1:]
-def read_pose(path):
-    values = [float(v) for line in open(path) if line.strip() and not line.startswith('#')
-              for v in line.split()]
-    return values[:4], values[4:7]
-def multiply(a, b):
-    aw, ax, ay, az = a; bw, bx, by, bz = b
-    return [aw*bw - ax*bx - ay*by - az*bz, aw*bx + ax*bw + ay*bz - az*by,
-            aw*by - ax*bz + ay*bw + az*bx, aw*bz + ax*by - ay*bx + az*bw]
-(qt, tt), (qe, te) = read_pose(truth_path), read_pose(estimate_path)
-# Rotation vector of estimate * inverse(truth), in degrees about the camera axes (w first in files).
-d = multiply(qe, [qt[0], -qt[1], -qt[2], -qt[3]])
-if d[0] < 0: d = [-v for v in d]
-s = math.sqrt(d[1]**2 + d[2]**2 + d[3]**2)
-angle = 2 * math.atan2(s, d[0])
-rotation = [math.degrees(angle) * v / s if s > 0 else 0.0 for v in d[1:]]
-translation = [1000 * (e - t) for e, t in zip(te, tt)]
-covariance = json.load(open(report_path))['uncertainty']['covariance_deg_mm']
-errors = rotation + translation
-z = [errors[k] / math.sqrt(covariance[k][k]) for k in range(6)]
-print('\t'.join([scene, seed] + ['%.4f' % v for v in errors] +
-                ['%.4f' % math.sqrt(covariance[k][k]) for k in range(6)] + ['%.3f' % v for v in z]))
-PY
+    python3 scripts/extrinsic_error.py "$run/dataset/ground_truth/cam_from_lidar.txt" \
+      "$joint/cam_from_lidar.txt" "$joint/report.json" "$scene" "$seed" >> "$results"
     tail -1 "$results"
   done
 done
