@@ -89,6 +89,37 @@ nlohmann::json MeasurementJson(const ExtrinsicMeasurement& measurement,
            std::sqrt(difference.dot(measurement.covariance.ldlt().solve(difference)))}};
 }
 
+// Per solve: the terms' costs and outliers, the depth priors' outlier rules, iterations and time.
+nlohmann::json SolvesJson(const std::vector<SolveStats>& stats) {
+  nlohmann::json solves = nlohmann::json::array();
+  for (const SolveStats& solve : stats) {
+    solves.push_back({{"round", solve.round},
+                      {"outlier_iteration", solve.outlier_iteration},
+                      {"reprojection", TermJson(solve.reprojection)},
+                      {"depth", TermJson(solve.depth)},
+                      {"lidar", TermJson(solve.lidar)},
+                      {"landmark_lidar", TermJson(solve.landmark_lidar)},
+                      {"depth_outliers",
+                       {{"residual_scale", solve.depth_outliers.residual_scale},
+                        {"beyond_sigma", solve.depth_outliers.beyond_sigma},
+                        {"beyond_absolute", solve.depth_outliers.beyond_absolute},
+                        {"restored", solve.depth_outliers.restored}}},
+                      {"iterations", solve.num_iterations},
+                      {"termination", solve.termination},
+                      {"seconds", solve.seconds}});
+  }
+  return solves;
+}
+
+nlohmann::json MeasurementsJson(const std::vector<ExtrinsicMeasurement>& measurements,
+                                const colmap::Rigid3d& refined) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const ExtrinsicMeasurement& measurement : measurements) {
+    json.push_back(MeasurementJson(measurement, refined));
+  }
+  return json;
+}
+
 nlohmann::json MatrixJson(const Eigen::MatrixXd& matrix) {
   nlohmann::json rows = nlohmann::json::array();
   for (int r = 0; r < matrix.rows(); ++r) {
@@ -214,24 +245,7 @@ void WriteReport(const std::string& directory,
   report["pose_graph"] = {{"image_pairs", loaded.num_image_pairs},
                           {"lidar_pairs", loaded.num_lidar_pairs},
                           {"pairs", loaded.data.pairs.size()}};
-  nlohmann::json solves = nlohmann::json::array();
-  for (const SolveStats& solve : summary.solves) {
-    solves.push_back({{"round", solve.round},
-                      {"outlier_iteration", solve.outlier_iteration},
-                      {"reprojection", TermJson(solve.reprojection)},
-                      {"depth", TermJson(solve.depth)},
-                      {"lidar", TermJson(solve.lidar)},
-                      {"landmark_lidar", TermJson(solve.landmark_lidar)},
-                      {"depth_outliers",
-                       {{"residual_scale", solve.depth_outliers.residual_scale},
-                        {"beyond_sigma", solve.depth_outliers.beyond_sigma},
-                        {"beyond_absolute", solve.depth_outliers.beyond_absolute},
-                        {"restored", solve.depth_outliers.restored}}},
-                      {"iterations", solve.num_iterations},
-                      {"termination", solve.termination},
-                      {"seconds", solve.seconds}});
-  }
-  report["solves"] = solves;
+  report["solves"] = SolvesJson(summary.solves);
   report["final_problem"] = {{"reprojection_residuals", summary.final_reprojection_residuals},
                              {"depth_residuals", summary.final_depth_residuals},
                              {"lidar_residuals", summary.final_lidar_residuals},
@@ -239,17 +253,14 @@ void WriteReport(const std::string& directory,
   report["landmark_lidar_weight"] = options.landmark_lidar_weight;
   report["variance_components"] = VarianceComponentsJson(options, summary);
   if (summary.time_offset) {
-    report["time_offset"] = {{"lidar_minus_camera_s", *summary.time_offset},
+    report["time_offset"] = {{"lidar_minus_camera", *summary.time_offset},
                              {"unit", loaded.data.image_times.empty() ? "frames" : "s"}};
   }
+  report["extrinsic_measurements"] = MeasurementsJson(loaded.data.extrinsic_measurements, refined);
   if (!summary.lidar_free_axis_in_cam.isZero()) {
     const Eigen::Vector3d& axis = summary.lidar_free_axis_in_cam;
     report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
                                      {"lidar_term_angle_deg", summary.lidar_free_angle_deg}};
-  }
-  report["extrinsic_measurements"] = nlohmann::json::array();
-  for (const ExtrinsicMeasurement& measurement : loaded.data.extrinsic_measurements) {
-    report["extrinsic_measurements"].push_back(MeasurementJson(measurement, refined));
   }
   const ExtrinsicUncertainty& u = summary.uncertainty;
   report["uncertainty"] = UncertaintyJson(u, options.observability, caveat);
