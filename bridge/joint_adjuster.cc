@@ -383,8 +383,9 @@ void AddLandmarkLidarBlocks(const RunState& state,
       state.options.estimate_time_offset
           ? CameraVelocities(*state.reconstruction, state.data.image_times)
           : std::map<colmap::image_t, Eigen::Vector3d>();
-  const double sigma = state.options.sigma_landmark_lidar_m *
-                       std::sqrt(state.factors.landmark_lidar / state.options.landmark_lidar_weight);
+  const double sigma =
+      state.options.sigma_landmark_lidar_m *
+      std::sqrt(state.factors.landmark_lidar / state.options.landmark_lidar_weight);
   for (const LandmarkPlaneObservation& observation : observations) {
     if (observation.outlier || !state.reconstruction->ExistsPoint3D(observation.point3D_id)) {
       continue;
@@ -528,7 +529,7 @@ size_t UpdateDepthOutliers(RunState* state, DepthOutlierStats* stats) {
   stats->residual_scale = RobustScale(std::move(normalised));
   // The gate in units of the priors' estimated sigma (their variance factor), or of their robust
   // residual scale without variance components.
-  const double scale = options.estimate_variance_components ? std::sqrt(state->factors.depth)
+  const double scale = options.estimate_variance_components     ? std::sqrt(state->factors.depth)
                        : options.depth_gate_from_residual_scale ? stats->residual_scale
                                                                 : 1.0;
   const double gate_sigmas = options.max_depth_error_sigmas * scale;
@@ -665,8 +666,9 @@ void Reassociate(int round, int num_rounds, RunState* state, Associations* assoc
   state->num_lidar_outliers = 0;
   state->num_landmark_outliers = 0;
   std::cout << "Round " << round + 1 << "/"
-            << (round < num_rounds ? std::to_string(num_rounds) : "+ (T_e or the weights still moving)") << ": "
-            << associations->lidar.size() << " LiDAR point-to-plane observations, "
+            << (round < num_rounds ? std::to_string(num_rounds)
+                                   : "+ (T_e or the weights still moving)")
+            << ": " << associations->lidar.size() << " LiDAR point-to-plane observations, "
             << associations->landmarks.size() << " landmark-to-LiDAR-plane observations (gate "
             << gate << " m, " << SecondsSince(start) << " s)" << std::endl;
 }
@@ -1087,8 +1089,8 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
   THROW_CHECK_GE(reconstruction->NumRegImages(), 2)
       << "the joint problem needs at least 2 registered images";
   // With a prior, weak directions keep the prior's sigma instead of being held.
-  const bool may_hold = options_.hold_unobservable && options_.mode == JointMode::kJoint &&
-                        !data.HasExtrinsicPrior();
+  const bool may_hold =
+      options_.hold_unobservable && options_.mode == JointMode::kJoint && !data.HasExtrinsicPrior();
   const colmap::Reconstruction initial_reconstruction =
       may_hold ? *reconstruction : colmap::Reconstruction();
   const colmap::Rigid3d initial_extrinsic = *cam_from_lidar;

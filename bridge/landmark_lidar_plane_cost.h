@@ -42,12 +42,12 @@ class LandmarkLidarPlaneCostFunctor {
                   const T* const cam_from_lidar_rotation,
                   const T* const cam_from_lidar_translation,
                   T* residual) const {
-    residual[0] = Residual(cam_i_from_world_rotation,
-                           cam_i_from_world_translation,
-                           landmark_in_world,
-                           cam_from_lidar_rotation,
-                           Eigen::Matrix<T, 3, 1>(
-                               colmap::EigenVector3Map<T>(cam_from_lidar_translation)));
+    residual[0] =
+        Residual(cam_i_from_world_rotation,
+                 cam_i_from_world_translation,
+                 landmark_in_world,
+                 cam_from_lidar_rotation,
+                 Eigen::Matrix<T, 3, 1>(colmap::EigenVector3Map<T>(cam_from_lidar_translation)));
     return true;
   }
 

@@ -48,7 +48,8 @@ void AddRow(const ceres::CRSMatrix& jacobian,
   for (int a = begin; a < end; ++a) {
     const int block = columns.block_of_column[jacobian.cols[a]];
     Eigen::MatrixXd& target = (*information)[block][group];
-    if (target.size() == 0) target = Eigen::MatrixXd::Zero(columns.size[block], columns.size[block]);
+    if (target.size() == 0)
+      target = Eigen::MatrixXd::Zero(columns.size[block], columns.size[block]);
     const int i = jacobian.cols[a] - columns.first_column[block];
     for (int b = begin; b < end; ++b) {
       if (columns.block_of_column[jacobian.cols[b]] != block) continue;
@@ -128,7 +129,8 @@ std::vector<VarianceComponent> EstimateVarianceComponents(
     VarianceComponent& component = components[g];
     component.parameter_share = shares[g];
     component.redundancy = static_cast<double>(component.num_observations) - shares[g];
-    if (component.redundancy > 0.5) component.factor = component.squared_norm / component.redundancy;
+    if (component.redundancy > 0.5)
+      component.factor = component.squared_norm / component.redundancy;
   }
   return components;
 }

@@ -1,9 +1,8 @@
 #include "bridge/variance_components.h"
 
+#include <Eigen/Core>
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
-
-#include <Eigen/Core>
 
 #include <random>
 

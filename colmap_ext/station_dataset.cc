@@ -106,9 +106,9 @@ std::optional<StationRig::GuessSigma> ParseGuessSigma(const json& guess, const s
          "neither)");
   }
   StationRig::GuessSigma sigma;
-  for (const auto& [key, value] : {std::pair<const char*, double*>{"sigma_rotation_deg",
-                                                                   &sigma.rotation_deg},
-                                   {"sigma_translation_m", &sigma.translation_m}}) {
+  for (const auto& [key, value] :
+       {std::pair<const char*, double*>{"sigma_rotation_deg", &sigma.rotation_deg},
+        {"sigma_translation_m", &sigma.translation_m}}) {
     const json& number = guess[key];
     if (!number.is_number() || !std::isfinite(number.get<double>()) || number.get<double>() <= 0) {
       Fail(path, std::string("'cam_from_lidar_guess.") + key + "' must be a positive number");

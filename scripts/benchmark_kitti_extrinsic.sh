@@ -11,17 +11,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
 source scripts/configure.sh
-configure_build build
-cmake --build build --target colmap_lidar_cli >/dev/null
+build_cli build
 readonly cli="$PWD/build/bin/colmap-lidar"
 readonly kSample="$PWD/../shared/data/kitti_odometry_04_sample"
-if [ -n "${WORK_DIR:-}" ]; then
-  work="$WORK_DIR"
-  mkdir -p "$work"
-else
-  work=$(mktemp -d)
-  trap 'rm -rf "$work"' EXIT
-fi
+use_work_dir
 results="$work/results.tsv"
 : > "$results"
 # The estimator variants: a label and the joint adjuster's options.

@@ -16,18 +16,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
-readonly kColmapPrefix="${COLMAP_LIDAR_COLMAP_PREFIX:-$HOME/.cache/colmap-lidar/colmap-3.10}"
+source scripts/configure.sh
 readonly kBuild="${BUILD_DIR:-build}"
-cmake -S . -B "$kBuild" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$kColmapPrefix" >/dev/null
-cmake --build "$kBuild" --target colmap_lidar_cli >/dev/null
+build_cli "$kBuild"
 cli="$kBuild/bin/colmap-lidar"
-if [ -n "${WORK_DIR:-}" ]; then
-  work="$WORK_DIR"
-  mkdir -p "$work"
-else
-  work=$(mktemp -d)
-  trap 'rm -rf "$work"' EXIT
-fi
+use_work_dir
 results="$work/results.tsv"
 : > "$results"
 # One seed of tripod stations: the steps one by one (uses scene, seed, run, ws, joint, step).

@@ -10,3 +10,18 @@ configure_build() {
   cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${ccache_launcher[@]}" \
     -DCMAKE_PREFIX_PATH="$kColmapPrefix${CMAKE_PREFIX_PATH:+;$CMAKE_PREFIX_PATH}" "$@" >/dev/null
 }
+# Configures DIR as above and builds the colmap-lidar executable in it.
+build_cli() {
+  configure_build "$1"
+  cmake --build "$1" --target colmap_lidar_cli >/dev/null
+}
+# Sets `work` to $WORK_DIR (created, kept) or else to a temporary folder removed on exit.
+use_work_dir() {
+  if [ -n "${WORK_DIR:-}" ]; then
+    work="$WORK_DIR"
+    mkdir -p "$work"
+  else
+    work=$(mktemp -d)
+    trap 'rm -rf "$work"' EXIT
+  fi
+}

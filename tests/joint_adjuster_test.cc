@@ -196,8 +196,8 @@ TEST(JointAdjusterTest, SameOutputWithOneAndFourThreads) {
   const Workspace ws = Prepare(dir, options, 0.3, 0.01);
   for (const char* threads : {"1", "4"}) {
     RunStep(std::string("OMP_NUM_THREADS=") + threads + " " + kCli +
-            " joint_adjuster --database_path " + ws.database + " --input_path " +
-            ws.initial_model + " --dataset_path " + ws.dataset + " --output_path " +
+            " joint_adjuster --database_path " + ws.database + " --input_path " + ws.initial_model +
+            " --dataset_path " + ws.dataset + " --output_path " +
             dir.File(std::string("joint") + threads) + " --cam_from_lidar " + ws.guess);
   }
   for (const char* file : {"cam_from_lidar.txt", "images.bin", "points3D.bin"}) {

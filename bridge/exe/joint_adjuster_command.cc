@@ -141,8 +141,8 @@ std::vector<std::string> UndeterminedAxes(const ExtrinsicUncertainty& u) {
 
 // Axes whose reported sigma is at least 1/sqrt(2) of a prior's: the data know them no better than
 // the prior does (posterior variance 1 / (1/data + 1/prior) >= prior / 2 <=> data >= prior).
-std::vector<std::string> PriorDeterminedAxes(const ExtrinsicUncertainty& u,
-                                             const std::vector<ExtrinsicMeasurement>& measurements) {
+std::vector<std::string> PriorDeterminedAxes(
+    const ExtrinsicUncertainty& u, const std::vector<ExtrinsicMeasurement>& measurements) {
   std::vector<std::string> axes;
   if (!u.computed) return axes;
   for (const ExtrinsicMeasurement& measurement : measurements) {
@@ -357,7 +357,7 @@ void PrintUncertainty(const JointAdjustmentSummary& summary, const std::string& 
     const Eigen::VectorXd sigma = summary.uncertainty.covariance.diagonal().cwiseSqrt();
     std::ostringstream line;
     line << std::setprecision(3) << "cam_from_lidar sigma (deg about, mm along the camera axes):";
-      for (int k = 0; k < 6; ++k) {
+    for (int k = 0; k < 6; ++k) {
       line << " " << kExtrinsicAxes[k] << " ";
       if (summary.uncertainty.undetermined[k]) {
         line << "undetermined";
@@ -555,12 +555,13 @@ constexpr double kMovingPlatformLandmarkWeight = 0.25;
 // In joint mode: rig.json's guess with a sigma as a prior; the pose initialiser's stereo-LiDAR
 // alignment, or else the vertical alignment (which the cameras' start then takes). Returns the
 // vertical alignment if it ran.
-std::optional<VerticalAlignment> AddExtrinsicMeasurements(const StationDataset& dataset,
-                                                          const InitialisationFacts& facts,
-                                                          const colmap::Reconstruction& reconstruction,
-                                                          const JointAdjusterStepOptions& options,
-                                                          LoadedJointData* loaded,
-                                                          colmap::Rigid3d* cam_from_lidar) {
+std::optional<VerticalAlignment> AddExtrinsicMeasurements(
+    const StationDataset& dataset,
+    const InitialisationFacts& facts,
+    const colmap::Reconstruction& reconstruction,
+    const JointAdjusterStepOptions& options,
+    LoadedJointData* loaded,
+    colmap::Rigid3d* cam_from_lidar) {
   if (options.adjuster.mode != JointMode::kJoint) return std::nullopt;
   std::vector<ExtrinsicMeasurement>& measurements = loaded->data.extrinsic_measurements;
   if (dataset.rig.cam_from_lidar_guess && dataset.rig.cam_from_lidar_guess_sigma) {
@@ -642,8 +643,8 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   if (options.adjuster.estimate_time_offset) {
     loaded->data.image_times = ImageTimes(dataset, *loaded);
   }
-  const std::optional<VerticalAlignment> vertical =
-      AddExtrinsicMeasurements(dataset, facts, reconstruction, options, loaded.get(), &cam_from_lidar);
+  const std::optional<VerticalAlignment> vertical = AddExtrinsicMeasurements(
+      dataset, facts, reconstruction, options, loaded.get(), &cam_from_lidar);
   const JointAdjustmentSummary summary =
       JointAdjuster(options.adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);
 
