@@ -147,8 +147,9 @@ std::vector<ImagePairPose> EstimateImagePairPoses(const colmap::Database& databa
   return poses;
 }
 
-std::vector<ImagePairPose> EstimateImagePairDirections(const colmap::Database& database,
-                                                       int min_inliers) {
+void ForEachTwoViewPose(const colmap::Database& database,
+                        int min_inliers,
+                        const std::function<void(const TwoViewPose&)>& visit) {
   std::vector<colmap::image_pair_t> pair_ids;
   std::vector<colmap::TwoViewGeometry> geometries;
   database.ReadTwoViewGeometries(&pair_ids, &geometries);
@@ -163,30 +164,40 @@ std::vector<ImagePairPose> EstimateImagePairDirections(const colmap::Database& d
     }
     return it->second;
   };
-  std::vector<ImagePairPose> poses;
   for (size_t k = 0; k < pair_ids.size(); ++k) {
     colmap::TwoViewGeometry& geometry = geometries[k];
     if (static_cast<int>(geometry.inlier_matches.size()) < min_inliers) continue;
     const auto [image_id1, image_id2] = colmap::Database::PairIdToImagePair(pair_ids[k]);
-    const colmap::Image image1 = database.ReadImage(image_id1);
-    const colmap::Image image2 = database.ReadImage(image_id2);
-    if (!colmap::EstimateTwoViewGeometryPose(database.ReadCamera(image1.CameraId()),
-                                             keypoints_of(image_id1),
-                                             database.ReadCamera(image2.CameraId()),
-                                             keypoints_of(image_id2),
-                                             &geometry) ||
+    const colmap::Camera camera1 = database.ReadCamera(database.ReadImage(image_id1).CameraId());
+    const colmap::Camera camera2 = database.ReadCamera(database.ReadImage(image_id2).CameraId());
+    if (!colmap::EstimateTwoViewGeometryPose(
+            camera1, keypoints_of(image_id1), camera2, keypoints_of(image_id2), &geometry) ||
         !(geometry.cam2_from_cam1.translation.norm() > 0)) {
       continue;
     }
+    geometry.cam2_from_cam1.translation.normalize();
+    visit({image_id1,
+           image_id2,
+           camera1,
+           camera2,
+           keypoints_of(image_id1),
+           keypoints_of(image_id2),
+           geometry});
+  }
+}
+
+std::vector<ImagePairPose> EstimateImagePairDirections(const colmap::Database& database,
+                                                       int min_inliers) {
+  std::vector<ImagePairPose> poses;
+  ForEachTwoViewPose(database, min_inliers, [&](const TwoViewPose& pair) {
     ImagePairPose pose;
     // cam2_from_cam1 = cam_{image 2}_from_cam_{image 1}: image_i = image 2, image_j = image 1.
-    pose.image_i = image_id2;
-    pose.image_j = image_id1;
-    pose.cam_i_from_cam_j = geometry.cam2_from_cam1;
-    pose.cam_i_from_cam_j.translation.normalize();
-    pose.num_inliers = static_cast<int>(geometry.inlier_matches.size());
+    pose.image_i = pair.image_id2;
+    pose.image_j = pair.image_id1;
+    pose.cam_i_from_cam_j = pair.geometry.cam2_from_cam1;
+    pose.num_inliers = static_cast<int>(pair.geometry.inlier_matches.size());
     poses.push_back(pose);
-  }
+  });
   return poses;
 }
 

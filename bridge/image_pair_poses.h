@@ -10,6 +10,7 @@
 #include "colmap/scene/database.h"
 
 #include <cstdint>
+#include <functional>
 #include <unordered_map>
 #include <vector>
 
@@ -40,6 +41,23 @@ using DepthPriorsByImage =
 std::vector<ImagePairPose> EstimateImagePairPoses(const colmap::Database& database,
                                                   const DepthPriorsByImage& depth_priors,
                                                   const ImagePairPoseOptions& options);
+
+// COLMAP's two-view pose of a verified pair (EstimateTwoViewGeometryPose on its inlier matches):
+// geometry.cam2_from_cam1 with a unit translation; the keypoints in pixels. Borrowed for the visit.
+struct TwoViewPose {
+  colmap::image_t image_id1, image_id2;
+  const colmap::Camera& camera1;
+  const colmap::Camera& camera2;
+  const std::vector<Eigen::Vector2d>& keypoints1;
+  const std::vector<Eigen::Vector2d>& keypoints2;
+  const colmap::TwoViewGeometry& geometry;
+};
+
+// Visits every pair COLMAP verified with at least `min_inliers` inlier matches whose pose COLMAP can
+// estimate, in the database's order.
+void ForEachTwoViewPose(const colmap::Database& database,
+                        int min_inliers,
+                        const std::function<void(const TwoViewPose&)>& visit);
 
 // Monocular image edges: for each image pair COLMAP verified with at least `min_inliers` inlier
 // matches, the relative rotation and the translation *direction* (unit norm: one camera has no scale)

@@ -103,14 +103,47 @@ bool PlanarHandEye(const std::vector<HandEyeMotion>& motions,
   return true;
 }
 
+// A drive that does not turn, without a guess: cam_from_lidar from the travel direction and the
+// structure (bridge/travel_structure_extrinsic.h). Throws with the hand-eye's and its own reason when
+// that fails too.
+void InitializeFromTravel(const std::string& database_path,
+                          const StationDataset& dataset,
+                          const std::string& registration_path,
+                          const PoseInitializerOptions& options,
+                          PoseInitialization* init) {
+  const std::string why_not_hand_eye = init->hand_eye.message;
+  std::cout << "No rotation for a hand-eye (" << why_not_hand_eye
+            << "): cam_from_lidar from the travel direction and the structure" << std::endl;
+  if (registration_path.empty()) {
+    throw std::runtime_error("cannot initialise cam_from_lidar: " + why_not_hand_eye +
+                             "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
+  }
+  init->travel_structure = EstimateExtrinsicFromTravelAndStructure(
+      colmap::Database(database_path),
+      dataset,
+      LargestComponentLidarPoses(registration_path),
+      ReadStationImages(database_path, dataset).image_of_station,
+      options.travel_structure);
+  std::cout << "  " << init->travel_structure->message << std::endl;
+  if (!init->travel_structure->valid) {
+    throw std::runtime_error(
+        "cannot initialise cam_from_lidar: " + why_not_hand_eye +
+        "; travel direction and structure: " + init->travel_structure->message +
+        "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
+  }
+  init->cam_from_lidar = init->travel_structure->cam_from_lidar;
+  init->extrinsic_source = "travel direction and structure (hand-eye: " + why_not_hand_eye + ")";
+}
+
 // cam_from_lidar: rig.json's guess if allowed and present, else hand-eye, else (no guess) the planar
-// hand-eye, else the guess anyway (with the hand-eye failure recorded), else an error saying why.
-// `planar_motions`: the motions for the planar fallback (COLMAP's two-view geometry), computed only
-// when needed.
+// hand-eye, else the guess anyway (with the hand-eye failure recorded), else `travel` (the travel
+// direction and the structure, which throws when it fails). `planar_motions`: the motions for the
+// planar fallback (COLMAP's two-view geometry), computed only when needed.
 void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
                      const StationDataset& dataset,
                      const PoseInitializerOptions& options,
                      const std::function<std::vector<HandEyeMotion>()>& planar_motions,
+                     const std::function<void()>& travel,
                      PoseInitialization* init) {
   init->hand_eye = SolveHandEye(motions, options.hand_eye);
   if (options.use_guess && dataset.rig.cam_from_lidar_guess) {
@@ -125,8 +158,7 @@ void ChooseExtrinsic(const std::vector<HandEyeMotion>& motions,
     init->cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
     init->extrinsic_source = "rig.json guess (hand-eye: " + init->hand_eye.message + ")";
   } else {
-    throw std::runtime_error("cannot initialise cam_from_lidar: " + init->hand_eye.message +
-                             "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
+    travel();
   }
 }
 
@@ -223,6 +255,7 @@ bool PoseInitializerOptions::Check() const {
   CHECK_OPTION(similarity_hand_eye.Check());
   CHECK_OPTION_GT(max_lidar_image_angle_deg, 0);
   CHECK_OPTION(stereo_alignment.Check());
+  CHECK_OPTION(travel_structure.Check());
   CHECK_OPTION_GT(sigma_rotation_deg, 0);
   CHECK_OPTION_GT(sigma_translation_m, 0);
   return true;
@@ -292,6 +325,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
                    ? std::vector<HandEyeMotion>()
                    : PairDirectionMotions(database_path, dataset, registration_path);
       },
+      [&] { InitializeFromTravel(database_path, dataset, registration_path, options, &init); },
       &init);
   if (!depth_path.empty() && options.align_stereo_with_lidar)
     RefineWithStereo(dataset, depth_path, options, &init);
@@ -361,10 +395,11 @@ std::vector<HandEyeMotion> ModelMotions(const colmap::Reconstruction& model,
 
 // Monocular: the scale and cam_from_lidar from the similarity hand-eye, or from rig.json's guess with
 // the scale fitted to the LiDAR motions through it; planar motion keeps the guess's (or zero)
-// translation along the unobservable axis.
+// translation along the unobservable axis; no rotation and no guess: `travel` (scale 1: metric).
 double ChooseSimilarityExtrinsic(const std::vector<HandEyeMotion>& motions,
                                  const StationDataset& dataset,
                                  const PoseInitializerOptions& options,
+                                 const std::function<void()>& travel,
                                  PoseInitialization* init,
                                  bool per_motion_scale = false) {
   const std::optional<colmap::Rigid3d>& guess = dataset.rig.cam_from_lidar_guess;
@@ -384,9 +419,8 @@ double ChooseSimilarityExtrinsic(const std::vector<HandEyeMotion>& motions,
     return HandEyeScale(motions, *guess);
   }
   if (!init->hand_eye.rotation_unique) {
-    throw std::runtime_error(
-        "cannot initialise the scale and cam_from_lidar: " + init->hand_eye.message +
-        "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
+    travel();
+    return per_motion_scale ? 1.0 : HandEyeScale(motions, init->cam_from_lidar);
   }
   init->cam_from_lidar = init->hand_eye.cam_from_lidar;
   init->extrinsic_source = "similarity hand-eye";
@@ -430,6 +464,11 @@ void ChooseModelScalesAndExtrinsic(const std::string& database_path,
                                    std::vector<double>* scales,
                                    PoseInitialization* init) {
   scales->clear();
+  // An existing model of a drive that does not turn needs a guess.
+  const auto travel = [&] {
+    throw std::runtime_error("cannot initialise cam_from_lidar: " + init->hand_eye.message +
+                             "; add cam_from_lidar_guess to " + dataset.root + "/rig.json");
+  };
   std::vector<HandEyeMotion> motions;
   for (size_t k = 0; k < models->size(); ++k) {
     colmap::Reconstruction& model = (*models)[k];
@@ -437,7 +476,8 @@ void ChooseModelScalesAndExtrinsic(const std::string& database_path,
     if (dataset.rig.IsStereo()) {
       scale = DepthPriorScale(database_path, model);
     } else if (k == 0) {
-      scale = ChooseSimilarityExtrinsic(ModelMotions(model, lidar_pairs), dataset, options, init);
+      scale = ChooseSimilarityExtrinsic(
+          ModelMotions(model, lidar_pairs), dataset, options, travel, init);
     } else {
       scale = HandEyeScale(ModelMotions(model, lidar_pairs), init->cam_from_lidar);
     }
@@ -448,7 +488,7 @@ void ChooseModelScalesAndExtrinsic(const std::string& database_path,
   }
   if (dataset.rig.IsStereo()) {
     ChooseExtrinsic(
-        motions, dataset, options, [&] { return motions; }, init);
+        motions, dataset, options, [&] { return motions; }, travel, init);
   }
 }
 
@@ -511,11 +551,13 @@ PoseInitialization InitializeMonocular(const std::string& database_path,
     init.cam_from_lidar = *dataset.rig.cam_from_lidar_guess;
     init.extrinsic_source = "rig.json guess";
   } else {
-    ChooseSimilarityExtrinsic(PairDirectionMotions(database_path, dataset, registration_path),
-                              dataset,
-                              options,
-                              &init,
-                              true);
+    ChooseSimilarityExtrinsic(
+        PairDirectionMotions(database_path, dataset, registration_path),
+        dataset,
+        options,
+        [&] { InitializeFromTravel(database_path, dataset, registration_path, options, &init); },
+        &init,
+        true);
   }
   const colmap::Database database(database_path);
   for (const colmap::Image& image : database.ReadAllImages()) {

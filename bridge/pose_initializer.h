@@ -3,8 +3,9 @@
 // 2. LiDAR edges A_l: lidar_registrator's pairs.txt;
 // 3. cam_from_lidar: rig.json's guess if present, else hand-eye over the pairs with both an image and a
 //    LiDAR edge (bridge/hand_eye.h); rotation about one axis only (a car) without a guess: the planar
-//    hand-eye on COLMAP's two-view geometry (rotation; translation 0, the axis named); other degenerate
-//    motion without a guess is an error saying why;
+//    hand-eye on COLMAP's two-view geometry (rotation; translation 0, the axis named); no rotation at
+//    all (a straight drive) without a guess: the travel direction and the structure
+//    (bridge/travel_structure_extrinsic.h); when that fails too, an error saying why;
 // 4. LiDAR edges become camera edges through cam_from_lidar; a maximum-weight spanning tree from the
 //    first station gives initial poses; a pose graph over all edges (Ceres) refines them. Stations that
 //    no edge reaches are reported and left out.
@@ -19,6 +20,7 @@
 #include "bridge/image_pair_poses.h"
 #include "bridge/lidar_registration_files.h"
 #include "bridge/stereo_lidar_alignment.h"
+#include "bridge/travel_structure_extrinsic.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cycle_consistency.h"
 
@@ -44,6 +46,9 @@ struct PoseInitializerOptions {
     options.max_axis_residual_deg = 0.5;
     return options;
   }();
+  // A drive that does not turn, without a guess: cam_from_lidar from the travel direction and the
+  // structure both sensors see.
+  TravelStructureOptions travel_structure;
   // false: hand-eye even when rig.json has a guess
   bool use_guess = true;
   // With stereo depth: the start (guess or hand-eye) refined by aligning each station's stereo depth
@@ -94,6 +99,8 @@ struct PoseInitialization {
   colmap::Rigid3d cam_from_lidar;
   std::string extrinsic_source;  // "rig.json guess" or "hand-eye", "+ stereo-LiDAR alignment"
   HandEyeResult hand_eye;
+  // Ran when the hand-eye could not recover the rotation and rig.json has no guess.
+  std::optional<TravelStructureExtrinsic> travel_structure;
   // Ran when stereo depth was given and PoseInitializerOptions::align_stereo_with_lidar.
   std::optional<StereoLidarAlignment> stereo_alignment;
   std::vector<PoseGraphEdge> edges;

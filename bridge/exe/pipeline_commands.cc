@@ -57,6 +57,28 @@ void AddPoseInitializerOptions(const std::string& prefix,
 
 namespace {
 
+std::vector<double> ToVector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// initialization.json's account of the travel-direction-and-structure start.
+nlohmann::json TravelStructureJson(const TravelStructureExtrinsic& estimate) {
+  const ExtrinsicAlignmentResult& alignment = estimate.alignment;
+  return {{"valid", estimate.valid},
+          {"message", estimate.message},
+          {"travel_in_cam", ToVector(estimate.travel_in_cam)},
+          {"travel_in_lidar", ToVector(estimate.travel_in_lidar)},
+          {"direction_pairs", estimate.num_direction_pairs},
+          {"direction_rms_deg", estimate.direction_rms_deg},
+          {"stations", estimate.num_stations},
+          {"roll_deg", estimate.roll.best_roll_deg},
+          {"roll_rms_m", estimate.roll.best_rms_m},
+          {"runner_up_roll_deg", estimate.roll.runner_up_roll_deg},
+          {"runner_up_rms_m", estimate.roll.runner_up_rms_m},
+          {"associations", alignment.num_associations},
+          {"rms_m", alignment.rms_m},
+          {"sigma_rotation_deg", ToVector(alignment.sigma_rotation_deg)},
+          {"sigma_translation_m", ToVector(alignment.sigma_translation_m)}};
+}
+
 void WriteInitializationReport(const std::string& path,
                                const PoseInitialization& init,
                                const std::string& input_path,
@@ -84,6 +106,8 @@ void WriteInitializationReport(const std::string& path,
   report["unreachable_reasons"] = init.unreachable_reason;
   if (init.stereo_alignment)
     report["stereo_alignment"] = StereoAlignmentJson(*init.stereo_alignment);
+  if (init.travel_structure)
+    report["travel_structure"] = TravelStructureJson(*init.travel_structure);
   if (init.hand_eye.unobservable_axis_in_cam.squaredNorm() > 0) {
     const Eigen::Vector3d& axis = init.hand_eye.unobservable_axis_in_cam;
     report["hand_eye"]["unobservable_translation_axis_in_cam"] = {axis.x(), axis.y(), axis.z()};
