@@ -1,7 +1,8 @@
 // The real KITTI odometry sample in ../shared/data (sequence 04, frames 0-19; not part of the
 // repository; the tests skip without it): import_kitti --format odometry in stereo and mono with the
 // benchmark's reference poses, its bad inputs, and evaluate_trajectory against an independent
-// computation (scripts/kitti_relative_error.py, plain Python).
+// computation (scripts/kitti_relative_error.py, plain Python), LiDAR odometry, and the pose initialiser
+// on a straight drive without a guess.
 #include "colmap_ext/kitti_calibration.h"
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/trajectory_files.h"
@@ -254,6 +255,41 @@ TEST_F(KittiOdometrySampleTest, OdometryFollowsTheRealDrive) {
   size_t lines = 0;
   for (std::string line; std::getline(table, line);) lines += line[0] != '#';
   EXPECT_EQ(lines, 20u);
+}
+
+// A straight drive (yaw changes < 0.5 deg) gives a hand-eye no rotation; without a guess the pose
+// initialiser takes cam_from_lidar's rotation from the direction of travel and the roll about it from
+// the structure both sensors see, and the translation across the drive from the structure.
+TEST_F(KittiOdometrySampleTest, StraightDriveInitialisesWithoutAGuess) {
+  ASSERT_EQ(Import(kSequence, dir_.File("dataset"), "--use_right 0 --write_guess 0").exit_code, 0);
+  const std::string dataset = dir_.File("dataset"), database = dir_.File("database.db");
+  for (const std::string& step :
+       {" import_dataset --matcher sequential --dataset_path " + dataset + " --database_path " +
+            database,
+        " lidar_registrator --method odometry --lidar_path " + dataset + "/lidar --output_path " +
+            dir_.File("lidar"),
+        " pose_initializer --database_path " + database + " --dataset_path " + dataset +
+            " --registration_path " + dir_.File("lidar") + " --output_path " +
+            dir_.File("initial")}) {
+    const auto run = RunCommand(kCli + step);
+    ASSERT_EQ(run.exit_code, 0) << step << "\n" << run.output;
+  }
+  const nlohmann::json travel =
+      ReadJson(dir_.File("initial/initialization.json"))["travel_structure"];
+  std::cout << travel.dump(2) << std::endl;
+  EXPECT_TRUE(travel["valid"].get<bool>());
+  EXPECT_GT(travel["runner_up_rms_m"].get<double>(), 1.2 * travel["roll_rms_m"].get<double>());
+  const colmap::Rigid3d estimate = ReadPoseFile(dir_.File("initial/cam_from_lidar.txt"));
+  const colmap::Rigid3d truth = ReadPoseFile(dir_.File("dataset/ground_truth/cam_from_lidar.txt"));
+  const double rotation_deg = estimate.rotation.angularDistance(truth.rotation) * 180 / M_PI;
+  const Eigen::Vector3d translation_m = estimate.translation - truth.translation;
+  std::cout << "start: " << rotation_deg << " deg, " << 1000 * translation_m.transpose() << " mm"
+            << std::endl;
+  EXPECT_LT(rotation_deg, 0.9);
+  // Across the drive (camera x and y); along it (z) the structure of noisy triangulated points
+  // fixes the translation least.
+  EXPECT_LT(translation_m.head<2>().norm(), 0.22);
+  EXPECT_LT(std::abs(translation_m.z()), 0.6);
 }
 
 TEST_F(KittiOdometrySampleTest, OdometryNamesAnUnreadableScan) {
