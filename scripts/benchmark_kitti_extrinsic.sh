@@ -4,8 +4,9 @@
 # KITTI's calibration perturbed by GUESS_DEG (default 2) / GUESS_M (default 0.05) with SEEDS (default
 # "0"). The pipeline runs once per rig and seed up to the joint adjuster; the joint adjuster then runs
 # in each estimator variant on the same front end. Per run and camera axis: the error, the reported
-# sigma and z = error / sigma ("undetermined": held at the start, no sigma). Writes
-# docs/benchmarks/kitti_extrinsic.md.
+# sigma and z = error / sigma ("undetermined": held at the start, no sigma). Then each rig once
+# without a guess: the pose initialiser's start (the travel direction and the structure) and the
+# default joint adjuster from it. Writes docs/benchmarks/kitti_extrinsic.md.
 #   WORK_DIR  keep the workspaces there (steps already done are not run again); default: temporary
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,15 +24,16 @@ variants=(
   "fixed weights, no clock offset|--estimate_variance_components 0 --estimate_time_offset 0"
 )
 
-# Import and the pipeline's front end for one rig (stereo: USE_RIGHT 1) and seed.
+# Import and the pipeline's front end for one rig (stereo: USE_RIGHT 1) and seed; WRITE_GUESS 0: no
+# guess in rig.json.
 front_end() {
-  local run=$1 use_right=$2 seed=$3
+  local run=$1 use_right=$2 seed=$3 write_guess=${4:-1}
   [ -f "$run/ws/steps/pose_initializer.done" ] && return 0
   rm -rf "$run"
   mkdir -p "$run"
   "$cli" import_kitti --format odometry --sequence_path "$kSample" \
     --poses_path "$kSample/poses/04.txt" --output_path "$run/ds" --use_right "$use_right" \
-    --write_guess 1 --guess_rotation_deg "${GUESS_DEG:-2}" --guess_translation_m "${GUESS_M:-0.05}" \
+    --write_guess "$write_guess" --guess_rotation_deg "${GUESS_DEG:-2}" --guess_translation_m "${GUESS_M:-0.05}" \
     --seed "$seed" > "$run/import.log" 2>&1
   "$cli" pipeline --dataset_path "$run/ds" --workspace_path "$run/ws" --Import.matcher sequential \
     > "$run/pipeline.log" 2>&1
@@ -59,6 +61,23 @@ for seed in ${SEEDS:-0}; do
       tail -1 "$results"
     done
   done
+done
+for rig in stereo mono; do
+  run="$work/$rig-noguess"
+  use_right=1
+  [ "$rig" = mono ] && use_right=0
+  echo "[$rig, no guess] front end"
+  front_end "$run" "$use_right" 0 0
+  python3 scripts/extrinsic_error.py "$run/ds/ground_truth/cam_from_lidar.txt" \
+    "$run/ws/sparse/initial/cam_from_lidar.txt" "" "$rig" "no guess" \
+    "start (travel direction and structure)" >> "$results"
+  out="$run/joint-default"
+  echo "[$rig, no guess] joint adjuster: default"
+  "$cli" joint_adjuster --database_path "$run/ws/database.db" --input_path "$run/ws/sparse/initial" \
+    --dataset_path "$run/ds" --output_path "$out" > "$out.log" 2>&1
+  python3 scripts/extrinsic_error.py "$run/ds/ground_truth/cam_from_lidar.txt" \
+    "$out/cam_from_lidar.txt" "$out/report.json" "$rig" "no guess" "default" >> "$results"
+  tail -1 "$results"
 done
 mkdir -p docs/benchmarks
 python3 scripts/kitti_extrinsic_table.py "$results" "${GUESS_DEG:-2}" "${GUESS_M:-0.05}" \

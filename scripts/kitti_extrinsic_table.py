@@ -15,7 +15,9 @@ print('Data: `../shared/data/kitti_odometry_04_sample`, 20 frames of a straight 
       '(HDL-64, rectified colour cameras), KITTI\'s calibration of 2011_09_30 as the reference. '
       'Each rig is started from that calibration perturbed by %s deg / %s m (`import_kitti '
       '--write_guess 1`); the whole `pipeline` runs once, then `joint_adjuster` in each variant on the '
-      'same front end.\n' % (guess_deg, guess_m))
+      'same front end. Rows "no guess": rig.json without a guess; the start is the pose '
+      'initialiser\'s (a straight drive: the travel direction and the structure).\n'
+      % (guess_deg, guess_m))
 print('Errors: rotation vector of estimate * inverse(reference) about the camera axes [deg], '
       'translation [mm]; z = error / reported sigma; "undet." = held at the start and reported '
       'without a sigma.\n')
