@@ -128,6 +128,40 @@ double StationVariance(const std::vector<StationEquation>& equations,
   return std::exp(high);
 }
 
+// Lag-1 autocorrelation of the used stations' residuals (in their order), the larger over the two
+// axes, clamped to [0, 0.99].
+double SerialCorrelation(const std::vector<StationVertical>& stations) {
+  std::vector<Eigen::Vector2d> residuals;
+  for (const StationVertical& station : stations) {
+    if (station.used) residuals.push_back(station.residual_deg);
+  }
+  if (residuals.size() < 3) return 0.0;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& r : residuals) mean += r / residuals.size();
+  Eigen::Vector2d lagged = Eigen::Vector2d::Zero(), squared = Eigen::Vector2d::Zero();
+  for (size_t k = 0; k < residuals.size(); ++k) {
+    squared += (residuals[k] - mean).cwiseAbs2();
+    if (k + 1 < residuals.size()) {
+      lagged += (residuals[k] - mean).cwiseProduct(residuals[k + 1] - mean);
+    }
+  }
+  double rho = 0;
+  for (int axis = 0; axis < 2; ++axis) {
+    if (squared(axis) > 0) rho = std::max(rho, lagged(axis) / squared(axis));
+  }
+  return std::min(rho, 0.99);
+}
+
+// Inflates the covariance for serially correlated stations (VerticalAlignment::serial_correlation).
+void InflateForSerialCorrelation(size_t num_used, VerticalAlignment* result) {
+  result->serial_correlation = SerialCorrelation(result->stations);
+  const double rho = result->serial_correlation;
+  const double inflation =
+      std::min(static_cast<double>(std::max<size_t>(num_used, 1)), (1 + rho) / (1 - rho));
+  result->covariance *= inflation;
+  result->effective_stations = num_used / inflation;
+}
+
 void MeasureStations(const std::vector<VerticalStationInput>& inputs,
                      const Eigen::Matrix3d& cam_from_lidar,
                      const Eigen::Vector3d& up_in_lidar_guess,
@@ -171,9 +205,12 @@ void FitAndReject(const std::vector<StationEquation>& equations,
           kRadToDeg * result->axes.transpose() * station.up_in_cam.tangent * residual;
     }
   }
+  InflateForSerialCorrelation(fit.num_used, result);
   std::ostringstream message;
   message << fit.num_used << " of " << equations.size() << " stations, structure scatter "
-          << kRadToDeg * std::sqrt(variance) << " deg per station";
+          << kRadToDeg * std::sqrt(variance) << " deg per station, serial correlation "
+          << result->serial_correlation << " (" << result->effective_stations
+          << " independent stations)";
   result->message = message.str();
   result->valid = fit.num_used >= options.min_num_stations;
 }
@@ -188,6 +225,11 @@ bool VerticalAlignmentOptions::Check() const {
   CHECK_OPTION_GT(max_station_chi2, 0);
   CHECK_OPTION_GE(min_num_stations, 2);
   return true;
+}
+
+bool VerticalAlignment::Significant() const {
+  constexpr double kChi2TwoDof95 = 5.991;
+  return valid && correction.dot(covariance.ldlt().solve(correction)) > kChi2TwoDof95;
 }
 
 Eigen::Quaterniond VerticalAlignment::Corrected(

@@ -6,7 +6,8 @@
 // perpendicular to the vertical: for a forward-looking camera on a car, the roll about the driving
 // direction (which a drive turning about one axis hardly shows to the motion-based terms) and the
 // pitch. Assumes walls and vertical edges are plumb; structure that leans shows as station scatter,
-// which enters the reported covariance (a random effect per station).
+// which enters the reported covariance (a random effect per station, inflated for the serial
+// correlation of neighbouring stations).
 #pragma once
 
 #include "colmap_ext/image_line_segments.h"
@@ -78,7 +79,16 @@ struct VerticalAlignment {
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();  // of alpha [rad^2]
   // per-station structure variance added to each station's own (random effect) [rad^2]
   double station_variance = 0;
+  // Lag-1 autocorrelation of the station residuals in capture order (the larger of the two axes,
+  // at least 0): neighbouring stations see the same walls and edges, so a structure that is not
+  // plumb shifts a run of stations alike. `covariance` is inflated by (1 + rho) / (1 - rho), the
+  // variance of a mean of AR(1) errors, at most to that of a single station.
+  double serial_correlation = 0;
+  double effective_stations = 0;  // stations used / that inflation
   std::vector<StationVertical> stations;
+
+  // Whether the correction differs from zero at 95 % (alpha^T covariance^-1 alpha > chi2_2).
+  bool Significant() const;
 
   // exp(axes * correction) * cam_from_lidar_rotation
   Eigen::Quaterniond Corrected(const Eigen::Quaterniond& cam_from_lidar_rotation) const;

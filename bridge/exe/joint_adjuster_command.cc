@@ -6,6 +6,7 @@
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
 #include "bridge/lidar_registration_files.h"
+#include "bridge/start_departure.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/plot.h"
@@ -257,6 +258,10 @@ void WriteReport(const std::string& directory,
                              {"unit", loaded.data.image_times.empty() ? "frames" : "s"}};
   }
   report["extrinsic_measurements"] = MeasurementsJson(loaded.data.extrinsic_measurements, refined);
+  const StartDeparture departure = CheckStartDeparture(initial, refined, loaded.data, summary);
+  report["start_departure"] = {{"move_deg_mm", departure.move},
+                               {"allowed_deg_mm", departure.allowed},
+                               {"warnings", departure.warnings}};
   if (!summary.lidar_free_axis_in_cam.isZero()) {
     const Eigen::Vector3d& axis = summary.lidar_free_axis_in_cam;
     report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
@@ -578,9 +583,16 @@ std::optional<VerticalAlignment> AddExtrinsicMeasurements(
       dataset, reconstruction, *loaded, *cam_from_lidar, options.adjuster.observability);
   if (vertical->valid) {
     measurements.push_back(VerticalAlignmentMeasurement(*vertical, *cam_from_lidar));
-    // Start from it: a drive's hand-eye can leave the roll degrees off, and the first round's wide
-    // associations then settle the height wrongly.
-    cam_from_lidar->rotation = measurements.back().cam_from_lidar.rotation;
+    // Start from it when it differs from the start significantly: a drive's hand-eye can leave the
+    // roll degrees off, and the first round's wide associations then settle the height wrongly.
+    if (vertical->Significant()) {
+      cam_from_lidar->rotation = measurements.back().cam_from_lidar.rotation;
+    } else {
+      std::cout
+          << "The vertical alignment's correction is within its uncertainty (95 %): the start "
+             "is kept"
+          << std::endl;
+    }
   }
   return vertical;
 }
@@ -673,6 +685,10 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   }
   partial.Commit();
   PrintUncertainty(summary, caveat);
+  for (const std::string& warning :
+       CheckStartDeparture(initial, cam_from_lidar, loaded->data, summary).warnings) {
+    std::cout << "WARNING: cam_from_lidar " << warning << std::endl;
+  }
   std::cout << "Wrote " << paths.output_path << " (" << SecondsSince(start) << " s)" << std::endl;
 }
 

@@ -89,6 +89,9 @@ nlohmann::json VerticalAlignmentJson(const VerticalAlignment& alignment) {
   json["correction_deg"] = Degrees(alignment.correction);
   json["sigma_deg"] = Degrees(alignment.covariance.diagonal().cwiseSqrt());
   json["station_scatter_deg"] = std::sqrt(alignment.station_variance) * kRadToDeg;
+  json["serial_correlation"] = alignment.serial_correlation;
+  json["effective_stations"] = alignment.effective_stations;
+  json["significant"] = alignment.Significant();
   nlohmann::json stations = nlohmann::json::array();
   for (const StationVertical& station : alignment.stations) {
     stations.push_back({{"name", station.name},
