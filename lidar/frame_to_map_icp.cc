@@ -66,11 +66,14 @@ void AddResidual(const Eigen::Vector3d& x,
 
 // The sum over the points' correspondences (the map point nearest to pose * p within
 // max_distance) of `add(i, x, neighbor, system)`, in fixed chunks combined in order.
+// With `neighbourhood_shape`, the neighbour's shape is that of the map around it
+// (VoxelHashMap::ClassifyNeighbourhood), else that of its voxel.
 template <typename Add>
 NormalSystem SumOverCorrespondences(const std::vector<Eigen::Vector3d>& points,
                                     const VoxelHashMap& map,
                                     const Eigen::Isometry3d& pose,
                                     double max_distance,
+                                    bool neighbourhood_shape,
                                     const Add& add) {
   std::vector<NormalSystem> chunks(kNumChunks);
   const int n = static_cast<int>(points.size());
@@ -80,6 +83,7 @@ NormalSystem SumOverCorrespondences(const std::vector<Eigen::Vector3d>& points,
       const Eigen::Vector3d x = pose * points[i];
       MapNeighbor neighbor;
       if (!map.NearestNeighbor(x, &neighbor) || neighbor.distance > max_distance) continue;
+      if (neighbourhood_shape) map.ClassifyNeighbourhood(&neighbor);
       add(i, x, neighbor, &chunks[c]);
     }
   }
@@ -100,6 +104,7 @@ NormalSystem IcpSystem(const std::vector<Eigen::Vector3d>& points,
       map,
       pose,
       max_distance,
+      point_to_plane,
       [&](int, const Eigen::Vector3d& x, const MapNeighbor& neighbor, NormalSystem* system) {
         AddResidual(x, neighbor, kernel, point_to_plane, system);
       });
@@ -127,6 +132,7 @@ void PlaneInformation(const std::vector<Eigen::Vector3d>& points,
       map,
       pose,
       max_distance,
+      true,
       [&](int i, const Eigen::Vector3d& x, const MapNeighbor& neighbor, NormalSystem* system) {
         if (neighbor.shape != VoxelShape::kPlane) return;
         const double r = neighbor.normal.dot(x - neighbor.point);

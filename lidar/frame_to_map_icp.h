@@ -3,10 +3,11 @@
 // dx = [omega, t] (world frame: x <- R(omega) x + t),
 //   min sum_i rho(|T p_i - q_i|),  rho'(e) / e = kappa^2 / (kappa + e^2)^2,   (Eq. 7-8)
 // q_i the nearest map point of T p_i within `max_correspondence_m` (tau), kappa = sigma / 3.
-// With FrameToMapIcpOptions::point_to_plane, the residual is the distance to the map voxel's plane
-// where the voxel is one, and there is none where the voxel is the arc of one scan line (on flat
-// ground the rings of a multi-beam scanner match best where they were recorded); off by default:
-// on the real KITTI sample it registered no better and slower (docs/lidar_odometry.md).
+// With FrameToMapIcpOptions::point_to_plane (the default), the residual is the distance to the
+// map's local plane (the map points within one voxel size of the nearest one, spanning several
+// scan lines) where that neighbourhood is a plane, and there is none where it is the arc of one
+// scan line: on flat ground and along facades the rings and scan lines of a multi-beam scanner
+// match best where they were recorded, which holds a point-to-point ICP at the previous pose.
 // After convergence the frame's information is measured point-to-plane (the map voxels' planes): a
 // point-to-point Hessian is isotropic in translation whatever the geometry and cannot show a street
 // of facades or a tunnel; the planes can.
@@ -26,9 +27,9 @@ struct FrameToMapIcpOptions {
   int max_iterations = 500;
   // |dx| below which the iteration stops (rad and m together, as KISS-ICP).
   double convergence = 1e-4;
-  // Point-to-plane residuals where the map's voxel is a plane, none where it is one scan line's arc,
-  // point-to-point elsewhere; false: point-to-point everywhere (KISS-ICP).
-  bool point_to_plane = false;
+  // Point-to-plane residuals where the map around the nearest point is a plane, none where it is
+  // one scan line's arc, point-to-point elsewhere; false: point-to-point everywhere (KISS-ICP).
+  bool point_to_plane = true;
 
   bool Check() const;
 };

@@ -5,7 +5,8 @@
 //      sweep model's azimuth), unless the scans are already motion-compensated;
 //   3. subsampling: one point per voxel of alpha v for the map, of beta v for the registration
 //      (alpha = 0.5, beta = 1.5; v = voxel size);
-//   4. robust point-to-point ICP against the local voxel-hash map (lidar/frame_to_map_icp.h) with
+//   4. robust ICP against the local voxel-hash map (lidar/frame_to_map_icp.h: point-to-plane where
+//      the map is locally a plane, point-to-point elsewhere) with
 //      the adaptive threshold (lidar/adaptive_threshold.h);
 //   5. the map updated with the registered frame, far voxels dropped.
 // The first motion has no velocity to predict it: it is found by the pairwise registration of the

@@ -73,6 +73,10 @@ TEST(LidarOdometry, NamesTheDegenerateDirectionOfAStreetOfBareWalls) {
   int along_the_street = 0;
   for (size_t k = 0; k < drive.sweeps.size(); ++k) {
     const OdometryFrame& frame = odometry.RegisterFrame(drive.sweeps[k], static_cast<double>(k));
+    std::cout << "frame " << k << ": degenerate " << frame.degenerate << ", ratio "
+              << frame.constraints.weakest_ratio << ", weakest "
+              << frame.constraints.WeakestAxisName() << ", x "
+              << frame.world_from_lidar.translation().x() << std::endl;
     if (k == 0 || !frame.degenerate) continue;
     EXPECT_FALSE(frame.covariance.has_value()) << k;
     // The weakest direction: the translation along the street (x).

@@ -42,9 +42,10 @@ Eigen::Vector3i VoxelHashMap::VoxelOf(const Eigen::Vector3d& point) const {
   return VoxelIndex(point, voxel_size_);
 }
 
-void VoxelHashMap::ClassifyShape(Voxel* voxel) {
-  voxel->shape = VoxelShape::kScattered;
-  const std::vector<Eigen::Vector3d>& points = voxel->points;
+void VoxelHashMap::ClassifyShape(const std::vector<Eigen::Vector3d>& points,
+                                 VoxelShape* shape,
+                                 Eigen::Vector3d* normal) {
+  *shape = VoxelShape::kScattered;
   if (points.size() < 5) return;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& p : points) mean += p / static_cast<double>(points.size());
@@ -55,11 +56,29 @@ void VoxelHashMap::ClassifyShape(Voxel* voxel) {
   // Spreads (square roots) below 0.2 of the largest: a line; else thin across (below 0.3 of the
   // middle spread): a plane.
   if (variances(1) < 0.04 * variances(2)) {
-    voxel->shape = VoxelShape::kLine;
+    *shape = VoxelShape::kLine;
   } else if (variances(0) < 0.1 * variances(1)) {
-    voxel->shape = VoxelShape::kPlane;
-    voxel->normal = solver.eigenvectors().col(0);
+    *shape = VoxelShape::kPlane;
+    *normal = solver.eigenvectors().col(0);
   }
+}
+
+void VoxelHashMap::ClassifyNeighbourhood(MapNeighbor* neighbor) const {
+  const Eigen::Vector3i centre = VoxelOf(neighbor->point);
+  const double squared_radius = voxel_size_ * voxel_size_;
+  std::vector<Eigen::Vector3d> points;
+  for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dz = -1; dz <= 1; ++dz) {
+        const auto it = voxels_.find(centre + Eigen::Vector3i(dx, dy, dz));
+        if (it == voxels_.end()) continue;
+        for (const Eigen::Vector3d& point : it->second.points) {
+          if ((point - neighbor->point).squaredNorm() <= squared_radius) points.push_back(point);
+        }
+      }
+    }
+  }
+  ClassifyShape(points, &neighbor->shape, &neighbor->normal);
 }
 
 void VoxelHashMap::Update(const std::vector<Eigen::Vector3d>& points_in_world,
@@ -75,7 +94,7 @@ void VoxelHashMap::Update(const std::vector<Eigen::Vector3d>& points_in_world,
     voxel.points.push_back(point);
   }
   for (Voxel* voxel : changed) {
-    ClassifyShape(voxel);
+    ClassifyShape(voxel->points, &voxel->shape, &voxel->normal);
     voxel->changed = false;
   }
   const double max_squared = max_distance_ * max_distance_;

@@ -35,6 +35,11 @@ class VoxelHashMap {
   // they are empty.
   bool NearestNeighbor(const Eigen::Vector3d& query, MapNeighbor* neighbor) const;
 
+  // The shape of the map around `neighbor->point` (a point of the map): the points within one voxel
+  // size of it among the 27 voxels around, which span several scan lines where one voxel holds the
+  // arc of one. Sets neighbor->shape and ->normal.
+  void ClassifyNeighbourhood(MapNeighbor* neighbor) const;
+
   double VoxelSize() const { return voxel_size_; }
   bool Empty() const { return voxels_.empty(); }
 
@@ -53,7 +58,9 @@ class VoxelHashMap {
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     bool changed = false;  // within one Update
   };
-  static void ClassifyShape(Voxel* voxel);
+  static void ClassifyShape(const std::vector<Eigen::Vector3d>& points,
+                            VoxelShape* shape,
+                            Eigen::Vector3d* normal);
 
   std::unordered_map<Eigen::Vector3i, Voxel, VoxelHash> voxels_;
 };

@@ -19,9 +19,10 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 rows=()
 
-# One registration of DATASET by METHOD, evaluated: a table row.
+# One registration of DATASET by METHOD with OPTIONS, evaluated: a table row (method column: NAME,
+# default METHOD).
 run() {
-  local label=$1 dataset=$2 method=$3 out="$work/$RANDOM"
+  local label=$1 dataset=$2 method=$3 out="$work/$RANDOM" name=${5:-$3}
   local start end
   start=$(date +%s.%N)
   "$cli" lidar_registrator --lidar_path "$dataset/lidar" --output_path "$out/lidar" \
@@ -31,7 +32,7 @@ run() {
     --reference_path "$dataset/ground_truth/cam_from_world.txt" \
     --reference_sensor_from_sensor_path "$dataset/ground_truth/cam_from_lidar.txt" \
     --output_path "$out/evaluation" >/dev/null
-  python3 - "$out/evaluation/metrics.json" "$out/lidar/summary.txt" "$label" "$method" \
+  python3 - "$out/evaluation/metrics.json" "$out/lidar/summary.txt" "$label" "$name" \
     "$start" "$end" <<'PY' >> "$work/rows"
 import json, sys
 m = json.load(open(sys.argv[1]))
@@ -52,6 +53,8 @@ if [[ -d "$kSample" ]]; then
   "$cli" import_kitti --format odometry --sequence_path "$kSample" \
     --poses_path "$kSample/poses/04.txt" --use_right 0 --output_path "$work/kitti04" >/dev/null
   run "KITTI 04, 20 scans (real)" "$work/kitti04" odometry ""
+  run "KITTI 04, 20 scans (real)" "$work/kitti04" odometry "--odometry_point_to_plane 0" \
+    "odometry, point-to-point"
   [[ "${PAIRWISE:-1}" == 1 ]] && run "KITTI 04, 20 scans (real)" "$work/kitti04" pairwise "--sequential 1"
 fi
 for frames in ${FRAMES:-40 200}; do
@@ -61,6 +64,8 @@ for frames in ${FRAMES:-40 200}; do
       --output_path "$work/street_${frames}_$seed" >/dev/null
     run "street seed $seed, $frames sweeps" "$work/street_${frames}_$seed" odometry \
       "--deskew_sweeps 1"
+    run "street seed $seed, $frames sweeps" "$work/street_${frames}_$seed" odometry \
+      "--deskew_sweeps 1 --odometry_point_to_plane 0" "odometry, point-to-point"
     if [[ "${PAIRWISE:-1}" == 1 && "$frames" -le 40 ]]; then
       run "street seed $seed, $frames sweeps" "$work/street_${frames}_$seed" pairwise \
         "--deskew_sweeps 1 --sequential 2"
@@ -75,7 +80,9 @@ mkdir -p docs/benchmarks
   echo
   echo "Written by \`scripts/benchmark_odometry.sh\` on $(date -u +%Y-%m-%d), commit"
   echo "$(git rev-parse --short HEAD), $(nproc) cores. Settings: the defaults of \`lidar_registrator\`"
-  echo "(odometry: max range 100 m, voxel 1 m; pairwise: \`--sequential\` as listed), simulated"
+  echo "(odometry: max range 100 m, voxel 1 m, point-to-plane where the map is locally a plane; the"
+  echo "\"point-to-point\" rows: \`--odometry_point_to_plane 0\`, as KISS-ICP; pairwise: \`--sequential\` as"
+  echo "listed), simulated"
   echo "sweeps of ${LIDAR_POINTS:-120000} rays. Errors by \`evaluate_trajectory\` against the reference"
   echo "moved to the LiDAR by the reference extrinsic: KITTI's relative translation (%) and rotation"
   echo "(deg/m) over 10, 20, ... m segments, per-step translation error (mean, max)."

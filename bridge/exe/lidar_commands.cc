@@ -189,6 +189,9 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("odometry_max_range_m", &options->odometry.max_range_m);
   add.Add("odometry_min_range_m", &options->odometry.min_range_m, "nearer returns: the platform");
   add.Add("odometry_voxel_size_m", &options->odometry.voxel_size_m, "0: max range / 100");
+  add.Add("odometry_point_to_plane",
+          &options->odometry.icp.point_to_plane,
+          "distance to the map's local plane where it is one (0: point-to-point, KISS-ICP)");
 }
 
 namespace {
