@@ -149,7 +149,8 @@ std::vector<ImagePairPose> EstimateImagePairPoses(const colmap::Database& databa
 
 void ForEachTwoViewPose(const colmap::Database& database,
                         int min_inliers,
-                        const std::function<void(const TwoViewPose&)>& visit) {
+                        const std::function<void(const TwoViewPose&)>& visit,
+                        const std::function<bool(colmap::image_t, colmap::image_t)>& wanted) {
   std::vector<colmap::image_pair_t> pair_ids;
   std::vector<colmap::TwoViewGeometry> geometries;
   database.ReadTwoViewGeometries(&pair_ids, &geometries);
@@ -168,6 +169,7 @@ void ForEachTwoViewPose(const colmap::Database& database,
     colmap::TwoViewGeometry& geometry = geometries[k];
     if (static_cast<int>(geometry.inlier_matches.size()) < min_inliers) continue;
     const auto [image_id1, image_id2] = colmap::Database::PairIdToImagePair(pair_ids[k]);
+    if (wanted && !wanted(image_id1, image_id2)) continue;
     const colmap::Camera camera1 = database.ReadCamera(database.ReadImage(image_id1).CameraId());
     const colmap::Camera camera2 = database.ReadCamera(database.ReadImage(image_id2).CameraId());
     if (!colmap::EstimateTwoViewGeometryPose(

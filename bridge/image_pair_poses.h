@@ -54,10 +54,13 @@ struct TwoViewPose {
 };
 
 // Visits every pair COLMAP verified with at least `min_inliers` inlier matches whose pose COLMAP can
-// estimate, in the database's order.
-void ForEachTwoViewPose(const colmap::Database& database,
-                        int min_inliers,
-                        const std::function<void(const TwoViewPose&)>& visit);
+// estimate, in the database's order; with `wanted`, only the pairs (image_id1, image_id2) it accepts
+// (before their pose is estimated).
+void ForEachTwoViewPose(
+    const colmap::Database& database,
+    int min_inliers,
+    const std::function<void(const TwoViewPose&)>& visit,
+    const std::function<bool(colmap::image_t, colmap::image_t)>& wanted = nullptr);
 
 // Monocular image edges: for each image pair COLMAP verified with at least `min_inliers` inlier
 // matches, the relative rotation and the translation *direction* (unit norm: one camera has no scale)

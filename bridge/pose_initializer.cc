@@ -261,6 +261,24 @@ bool PoseInitializerOptions::Check() const {
   return true;
 }
 
+namespace {
+
+// The motions with an image and a LiDAR edge of the same station pair (the hand-eye's input).
+std::vector<HandEyeMotion> PairedMotions(const ImageEdges& image_edge,
+                                         const std::vector<LidarStationEdge>& lidar_edges) {
+  std::vector<HandEyeMotion> motions;
+  for (const auto& [i, j, lidar_i_from_lidar_j, weight] : lidar_edges) {
+    if (image_edge.count({i, j})) {
+      motions.push_back({image_edge.at({i, j}), lidar_i_from_lidar_j});
+    } else if (image_edge.count({j, i})) {
+      motions.push_back({colmap::Inverse(image_edge.at({j, i})), lidar_i_from_lidar_j});
+    }
+  }
+  return motions;
+}
+
+}  // namespace
+
 PoseInitialization InitializePoses(const std::string& database_path,
                                    const StationDataset& dataset,
                                    const std::string& registration_path,
@@ -308,16 +326,8 @@ PoseInitialization InitializePoses(const std::string& database_path,
   init.num_lidar_edges = static_cast<int>(lidar_edges.size());
 
   // cam_from_lidar.
-  std::vector<HandEyeMotion> motions;
-  for (const auto& [i, j, lidar_i_from_lidar_j, weight] : lidar_edges) {
-    if (image_edge.count({i, j})) {
-      motions.push_back({image_edge.at({i, j}), lidar_i_from_lidar_j});
-    } else if (image_edge.count({j, i})) {
-      motions.push_back({colmap::Inverse(image_edge.at({j, i})), lidar_i_from_lidar_j});
-    }
-  }
   ChooseExtrinsic(
-      motions,
+      PairedMotions(image_edge, lidar_edges),
       dataset,
       options,
       [&] {

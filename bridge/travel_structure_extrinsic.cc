@@ -55,20 +55,28 @@ std::vector<DirectionPair> CollectDirectionPairs(
     const std::map<colmap::image_t, std::string>& station_of_image,
     const std::map<std::string, colmap::Rigid3d>& world_from_lidar,
     const TravelStructureOptions& options) {
-  std::vector<DirectionPair> pairs;
-  ForEachTwoViewPose(database, options.min_inliers, [&](const TwoViewPose& view) {
+  // The LiDAR motion of each pair that translates and hardly turns: only their poses are estimated.
+  std::map<PairKey, colmap::Rigid3d> lidar_motions;
+  const auto wanted = [&](colmap::image_t image_id1, colmap::image_t image_id2) {
     const std::optional<colmap::Rigid3d> lidar =
-        LidarMotion(view.image_id1, view.image_id2, station_of_image, world_from_lidar);
+        LidarMotion(image_id1, image_id2, station_of_image, world_from_lidar);
     if (!lidar || lidar->translation.norm() < options.min_translation_m ||
         Eigen::AngleAxisd(lidar->rotation).angle() > options.max_rotation_deg * kDegToRad) {
-      return;
+      return false;
     }
+    lidar_motions[{image_id1, image_id2}] = *lidar;
+    return true;
+  };
+  std::vector<DirectionPair> pairs;
+  const auto visit = [&](const TwoViewPose& view) {
+    const Eigen::Vector3d& b = lidar_motions.at({view.image_id1, view.image_id2}).translation;
     pairs.push_back({view.image_id1,
                      view.image_id2,
                      view.geometry.cam2_from_cam1.translation,
-                     lidar->translation.normalized(),
-                     lidar->translation.norm()});
-  });
+                     b.normalized(),
+                     b.norm()});
+  };
+  ForEachTwoViewPose(database, options.min_inliers, visit, wanted);
   if (pairs.empty()) return pairs;
   // One sign along the drive: that of the longest LiDAR motion.
   const Eigen::Vector3d reference =
@@ -170,11 +178,16 @@ std::map<colmap::image_t, CameraDepthPoints> TriangulateTravelPairs(
     baselines[{pair.image_id1, pair.image_id2}] = pair.baseline_m;
   }
   std::map<colmap::image_t, CameraDepthPoints> points;
-  ForEachTwoViewPose(database, options.min_inliers, [&](const TwoViewPose& view) {
-    const auto baseline = baselines.find({view.image_id1, view.image_id2});
-    if (baseline == baselines.end()) return;
-    Triangulate(view, baseline->second, options, &points[view.image_id1]);
-  });
+  ForEachTwoViewPose(
+      database,
+      options.min_inliers,
+      [&](const TwoViewPose& view) {
+        Triangulate(
+            view, baselines.at({view.image_id1, view.image_id2}), options, &points[view.image_id1]);
+      },
+      [&](colmap::image_t image_id1, colmap::image_t image_id2) {
+        return baselines.count({image_id1, image_id2}) > 0;
+      });
   return points;
 }
 

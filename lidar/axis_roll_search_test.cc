@@ -1,5 +1,6 @@
 #include "lidar/axis_roll_search.h"
 
+#include "tests/testing/car_cam_from_lidar.h"
 #include "tests/testing/ray_cast_street.h"
 
 #include <gtest/gtest.h>
@@ -14,17 +15,7 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-// A forward-looking camera on a car whose LiDAR has x forward and z up: camera x = -LiDAR y,
-// camera y = -LiDAR z, tilted a little and offset as on a car.
-Eigen::Isometry3d TrueCamFromLidar() {
-  Eigen::Matrix3d axes;
-  axes << 0, -1, 0, 0, 0, -1, 1, 0, 0;
-  Eigen::Isometry3d cam_from_lidar = Eigen::Isometry3d::Identity();
-  cam_from_lidar.linear() =
-      Eigen::AngleAxisd(0.03, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix() * axes;
-  cam_from_lidar.translation() = Eigen::Vector3d(0.05, -0.08, -0.27);
-  return cam_from_lidar;
-}
+Eigen::Isometry3d TrueCamFromLidar() { return testing::CarCamFromLidar(0.03); }
 
 // Five stations 3 m apart along a straight street (no turn at all): static LiDAR scans (1 cm noise)
 // and camera points cast through a 90 x 30 deg field of view with a depth error of d^2 / 300 m

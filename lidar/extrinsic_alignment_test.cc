@@ -1,5 +1,6 @@
 #include "lidar/extrinsic_alignment.h"
 
+#include "tests/testing/car_cam_from_lidar.h"
 #include "tests/testing/synthetic_clouds.h"
 
 #include <gtest/gtest.h>
@@ -14,17 +15,7 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-// The camera looks along the LiDAR's x (forward); camera x = -LiDAR y, camera y = -LiDAR z, tilted
-// a little and offset as on a pod.
-Eigen::Isometry3d TrueCamFromLidar() {
-  Eigen::Matrix3d axes;
-  axes << 0, -1, 0, 0, 0, -1, 1, 0, 0;
-  Eigen::Isometry3d cam_from_lidar = Eigen::Isometry3d::Identity();
-  cam_from_lidar.linear() =
-      Eigen::AngleAxisd(0.02, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix() * axes;
-  cam_from_lidar.translation() = Eigen::Vector3d(0.05, -0.08, -0.27);
-  return cam_from_lidar;
-}
+Eigen::Isometry3d TrueCamFromLidar() { return testing::CarCamFromLidar(0.02); }
 
 Eigen::Isometry3d Perturbation(double angle_deg,
                                const Eigen::Vector3d& axis,

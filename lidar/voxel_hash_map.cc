@@ -63,21 +63,27 @@ void VoxelHashMap::ClassifyShape(const std::vector<Eigen::Vector3d>& points,
   }
 }
 
-void VoxelHashMap::ClassifyNeighbourhood(MapNeighbor* neighbor) const {
-  const Eigen::Vector3i centre = VoxelOf(neighbor->point);
-  const double squared_radius = voxel_size_ * voxel_size_;
-  std::vector<Eigen::Vector3d> points;
+template <typename Visit>
+void VoxelHashMap::ForEachVoxelAround(const Eigen::Vector3d& point, const Visit& visit) const {
+  const Eigen::Vector3i centre = VoxelOf(point);
   for (int dx = -1; dx <= 1; ++dx) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dz = -1; dz <= 1; ++dz) {
         const auto it = voxels_.find(centre + Eigen::Vector3i(dx, dy, dz));
-        if (it == voxels_.end()) continue;
-        for (const Eigen::Vector3d& point : it->second.points) {
-          if ((point - neighbor->point).squaredNorm() <= squared_radius) points.push_back(point);
-        }
+        if (it != voxels_.end()) visit(it->second);
       }
     }
   }
+}
+
+void VoxelHashMap::ClassifyNeighbourhood(MapNeighbor* neighbor) const {
+  const double squared_radius = voxel_size_ * voxel_size_;
+  std::vector<Eigen::Vector3d> points;
+  ForEachVoxelAround(neighbor->point, [&](const Voxel& voxel) {
+    for (const Eigen::Vector3d& point : voxel.points) {
+      if ((point - neighbor->point).squaredNorm() <= squared_radius) points.push_back(point);
+    }
+  });
   ClassifyShape(points, &neighbor->shape, &neighbor->normal);
 }
 
@@ -108,25 +114,18 @@ void VoxelHashMap::Update(const std::vector<Eigen::Vector3d>& points_in_world,
 }
 
 bool VoxelHashMap::NearestNeighbor(const Eigen::Vector3d& query, MapNeighbor* neighbor) const {
-  const Eigen::Vector3i centre = VoxelOf(query);
   double best = std::numeric_limits<double>::infinity();
   const Voxel* best_voxel = nullptr;
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dz = -1; dz <= 1; ++dz) {
-        const auto it = voxels_.find(centre + Eigen::Vector3i(dx, dy, dz));
-        if (it == voxels_.end()) continue;
-        for (const Eigen::Vector3d& point : it->second.points) {
-          const double squared = (point - query).squaredNorm();
-          if (squared < best) {
-            best = squared;
-            neighbor->point = point;
-            best_voxel = &it->second;
-          }
-        }
+  ForEachVoxelAround(query, [&](const Voxel& voxel) {
+    for (const Eigen::Vector3d& point : voxel.points) {
+      const double squared = (point - query).squaredNorm();
+      if (squared < best) {
+        best = squared;
+        neighbor->point = point;
+        best_voxel = &voxel;
       }
     }
-  }
+  });
   if (best_voxel == nullptr) return false;
   neighbor->distance = std::sqrt(best);
   neighbor->shape = best_voxel->shape;

@@ -58,6 +58,9 @@ class VoxelHashMap {
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     bool changed = false;  // within one Update
   };
+  // Calls visit(voxel) for each occupied voxel of the 27 around `point`'s.
+  template <typename Visit>
+  void ForEachVoxelAround(const Eigen::Vector3d& point, const Visit& visit) const;
   static void ClassifyShape(const std::vector<Eigen::Vector3d>& points,
                             VoxelShape* shape,
                             Eigen::Vector3d* normal);

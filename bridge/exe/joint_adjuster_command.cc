@@ -226,6 +226,12 @@ nlohmann::json MotionJson(const MotionAnalysis& motion) {
           {"verdict", motion.verdict}};
 }
 
+nlohmann::json StartDepartureJson(const StartDeparture& departure) {
+  return {{"move_deg_mm", departure.move},
+          {"allowed_deg_mm", departure.allowed},
+          {"warnings", departure.warnings}};
+}
+
 void WriteReport(const std::string& directory,
                  const JointAdjusterOptions& options,
                  const LoadedJointData& loaded,
@@ -258,10 +264,8 @@ void WriteReport(const std::string& directory,
                              {"unit", loaded.data.image_times.empty() ? "frames" : "s"}};
   }
   report["extrinsic_measurements"] = MeasurementsJson(loaded.data.extrinsic_measurements, refined);
-  const StartDeparture departure = CheckStartDeparture(initial, refined, loaded.data, summary);
-  report["start_departure"] = {{"move_deg_mm", departure.move},
-                               {"allowed_deg_mm", departure.allowed},
-                               {"warnings", departure.warnings}};
+  report["start_departure"] =
+      StartDepartureJson(CheckStartDeparture(initial, refined, loaded.data, summary));
   if (!summary.lidar_free_axis_in_cam.isZero()) {
     const Eigen::Vector3d& axis = summary.lidar_free_axis_in_cam;
     report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
@@ -618,6 +622,12 @@ void ResolveAutomaticOptions(const StationDataset& dataset,
   }
 }
 
+void PrintWarnings(const StartDeparture& departure) {
+  for (const std::string& warning : departure.warnings) {
+    std::cout << "WARNING: cam_from_lidar " << warning << std::endl;
+  }
+}
+
 }  // namespace
 
 void RunJointAdjusterStep(const StationDataset& dataset,
@@ -685,10 +695,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   }
   partial.Commit();
   PrintUncertainty(summary, caveat);
-  for (const std::string& warning :
-       CheckStartDeparture(initial, cam_from_lidar, loaded->data, summary).warnings) {
-    std::cout << "WARNING: cam_from_lidar " << warning << std::endl;
-  }
+  PrintWarnings(CheckStartDeparture(initial, cam_from_lidar, loaded->data, summary));
   std::cout << "Wrote " << paths.output_path << " (" << SecondsSince(start) << " s)" << std::endl;
 }
 
