@@ -35,9 +35,8 @@ struct ObservabilityOptions {
   double stereo_scale_sigma = 0.001;
   // Two-way clustering of the LiDAR term: besides each directed pair, the pairs that share a target
   // station and those that share a source station form clusters (a station's cloud errors, e.g. its
-  // normals near edges, enter every pair it is part of). Off by default: on the synthetic coverage test
-  // it lowered the 2-sigma coverage of rx, ry, tx from 88-96 % to 88 %, and end to end (10 stations)
-  // it moved the sigmas by -15..+10 % without explaining the errors.
+  // normals near edges, enter every pair it is part of). Off by default: it lowered the coverage of
+  // the synthetic coverage test without explaining the end-to-end errors.
   bool two_way_lidar_clusters = false;
   // relative rotations below this do not count as rotating
   double min_rotation_deg = 2.0;
@@ -99,11 +98,9 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
 // Empty if the reported covariance of T_e has been validated by coverage for this kind of capture
 // (stations that rotate about two axes: tests/joint_adjuster_coverage_test.cc and the T specimen end
 // to end), else one sentence saying why it has not. A moving platform (sweeps, or a one-axis
-// hand-eye) whose stations turn about one axis is not: on simulated 40-frame street drives (one
-// camera, no guess; docs/benchmarks/drive_uncertainty.md) the errors reached 4-8 reported sigmas in
-// the height and the rotation about the driving direction (0.27 deg off with sigma 0.05 deg), with
-// a sign that held across runs of one drive; with the vertical alignment (bridge/vertical_alignment.h)
-// 1.9-2.9 sigmas on seeds 1-4 (roll 0.007-0.052 deg with sigma 0.018-0.022 deg).
+// hand-eye) whose stations turn about one axis is not: on simulated street drives the errors in the
+// height and the rotation about the driving direction exceed the reported sigmas, with a sign that
+// holds across runs of one drive (docs/benchmarks/drive_uncertainty.md).
 std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform);
 
 // Marginal covariance of T_e's blocks in `problem` (both must be variable parameter blocks; the rotation

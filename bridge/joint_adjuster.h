@@ -70,9 +70,8 @@ struct JointAdjusterOptions {
   // w_c of E_d (E_f keeps weight 1).
   double depth_weight = 1.0;
   // With LiDAR terms, E_d joins from this round on (1: from the start, as in the paper). The start's
-  // landmarks are triangulated through the initial cam_from_lidar: on the 40-frame stereo drive from
-  // a 3 deg guess their depths were ~90 sigma_d off the priors, and a first solve with E_d deformed
-  // the model (reprojection cost x100, 80 % of E_m's associations lost for good): 0.49 deg. A first
+  // landmarks are triangulated through the initial cam_from_lidar: from a guess degrees off their
+  // depths are tens of sigma_d off the priors, and a first solve with E_d deforms the model. A first
   // round without E_d (reprojection, LiDAR, E_m) fits them first.
   int first_depth_prior_round = 2;
   // w_l of E_l.
@@ -114,8 +113,8 @@ struct JointAdjusterOptions {
   double max_reprojection_error_px = 3.0;
   double max_depth_error_sigmas = 3.0;
   // Scale the sigma gate by the priors' robust residual scale s = 1.4826 median |error| / sigma_d,
-  // clamped to [0.1, 1]: sigma_d with sigma_p = 1 px is several times conservative for SGBM (measured
-  // s ~ 0.16), and a gate of 3 sigma_d would then be 18 actual sigmas. With s = 1 this is 3 sigma_d.
+  // clamped to [0.1, 1]: sigma_d with sigma_p = 1 px is several times conservative for SGBM, and a
+  // gate of 3 sigma_d would then be many actual sigmas. With s = 1 this is 3 sigma_d.
   bool depth_gate_from_residual_scale = true;
   double max_depth_error_m = 0.0;
   double max_point_to_plane_m = 0.1;

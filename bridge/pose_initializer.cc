@@ -89,9 +89,9 @@ bool PlanarHandEye(const std::vector<HandEyeMotion>& motions,
                    const PoseInitializerOptions& options,
                    PoseInitialization* init) {
   if (motions.empty()) return false;
-  // One scale per motion, as for a monocular rig: with a common scale the forward translation is
-  // fitted from turns of 1-3 deg and came out 2.2 m off on the simulated drive; all of t_X is then 0
-  // (within decimetres of a car's rig), and the joint adjustment finds it.
+  // One scale per motion, as for a monocular rig: with a common scale the forward translation would
+  // be fitted from turns of a few degrees, metres off; all of t_X is then 0 (within decimetres of a
+  // car's rig), and the joint adjustment finds it.
   const HandEyeResult planar = SolveSimilarityHandEye(
       motions, options.similarity_hand_eye, Eigen::Vector3d::Zero(), /*per_motion_scale=*/true);
   if (!planar.rotation_unique) return false;

@@ -58,8 +58,8 @@ struct PoseInitializerOptions {
   // A LiDAR edge and an image edge of the same station pair measure one motion of the pod, so their
   // rotation angles agree whatever cam_from_lidar is (A = X B X^-1); a LiDAR edge whose angle differs
   // by more than this (degrees) is a wrong registration (sparse clouds: ICP slid along the ground) and
-  // is left out of the hand-eye and the pose graph. Wrong registrations differ by tens of degrees;
-  // a chain of image edges between stations 130 deg apart was measured 2.6 deg off on the seed's scale.
+  // is left out of the hand-eye and the pose graph. Wrong registrations differ by tens of degrees,
+  // while a long chain of image edges can itself be a few degrees off.
   double max_lidar_image_angle_deg = 5.0;
   // LiDAR edges that lidar_registrator accepted as degenerate (a direction its ICP barely
   // constrains: a ground plane leaves the yaw free) enter the pose graph as full 6-DoF edges, and on

@@ -33,8 +33,8 @@ inline PerpendicularDirectionOptions WideGate(double initial_max_angle_deg) {
 }
 
 struct VerticalAlignmentOptions {
-  // Wide first gates: on a drive the guesses come from noisy turn axes (their span reached 14 deg)
-  // and a hand-eye (roll up to 9.5 deg off). A gate narrower than the guess's error leaves the walls
+  // Wide first gates: on a drive the guesses come from noisy turn axes and a hand-eye whose roll can
+  // be degrees off. A gate narrower than the guess's error leaves the walls
   // out and fits whatever lies near perpendicular, consistently wrong at every station; the ground
   // (normal along the vertical) stays out of any gate below 50 deg.
   PerpendicularDirectionOptions lidar_fit = WideGate(35);

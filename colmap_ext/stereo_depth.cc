@@ -59,8 +59,8 @@ cv::Mat ToPixels(const cv::Mat& fixed, int min_disparity) {
 }
 
 // SGBM (5 paths) aggregates its smoothness term along paths that all come from the rows above, so a
-// surface slanted in y (the ground) gets the disparity of rows a fraction of a pixel higher: measured
-// on the simulator, depth too far by 0.7 px times the relative inverse-depth gradient per row. Matching
+// surface slanted in y (the ground) gets the disparity of rows a fraction of a pixel higher, so its
+// depth comes out too far in proportion to the inverse-depth gradient per row. Matching
 // the vertically flipped pair as well aggregates from below; the mean of both cancels the shift, and
 // pixels where the two passes disagree by more than max_diff_px are dropped. Fixed-point (x16) output.
 cv::Mat ComputeVerticallySymmetric(cv::StereoSGBM& matcher,

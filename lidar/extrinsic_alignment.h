@@ -32,9 +32,9 @@ struct ExtrinsicAlignmentOptions {
   // Huber threshold in sigma units: residuals beyond it count linearly (edges, moving objects)
   double huber_sigmas = 2.0;
   // Directions whose information is below this fraction of the strongest's (rotations scaled by the
-  // points' lever arm) are held at the start. Measured: a floor's tangent directions 2e-5 to 4e-4
-  // (noise in the LiDAR normals), the weakest direction of a room 0.015, of the T specimen's 8
-  // stations 0.0043, of the 40-frame street drive 0.0083.
+  // points' lever arm) are held at the start: between the tangent directions of a single floor
+  // (noise in the LiDAR normals, well below) and the weakest direction of a room or a street drive
+  // (several times above).
   double min_constraint_ratio = 0.001;
   // A weak prior on the start (1 sigma): what no scene constrains stays where it was.
   double prior_rotation_deg = 5.0;

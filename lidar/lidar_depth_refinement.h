@@ -35,8 +35,7 @@ struct LidarDepthRefinementOptions {
   double max_abs_diff_m = 0.003;
   double max_rel_diff = 0;
   // Where fold 2 could not put the LiDAR depth in its place, a stereo depth is removed only beyond
-  // this distance: between the two it is off, but the best there is (removing it cost 2 % of the
-  // completeness at 10 mm on the 25-station simulation).
+  // this distance: between the two it is off, but the best there is (removing it costs completeness).
   double max_unreplaceable_diff_m = 0.01;
   // The LiDAR plane is a reference only where the layer is flat: next to a crease the nearest
   // sample's plane may be the other face's, and judging stereo by it removed correct depths. Layers

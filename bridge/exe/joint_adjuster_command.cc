@@ -556,9 +556,7 @@ bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& 
 // Its weight on such a moving platform is kMovingPlatformLandmarkWeight, 1 on tripods: along a
 // drive the landmarks' errors are shared (an E_m solve moved the roll by 0.12 deg through its
 // associations alone, and the roll's error kept its sign over runs), so E_m counts for less than its
-// number of residuals. On 8 runs of the simulated drive of seed 0 (mono and stereo, both layouts)
-// the roll about the driving direction went from 0.153 to 0.088 deg mean absolute error (6 better,
-// 2 unchanged); on the drives of seeds 1-3, 0.217 to 0.211 deg (no clear difference).
+// number of residuals (docs/joint_adjuster.md).
 constexpr double kMovingPlatformLandmarkWeight = 0.25;
 
 // In joint mode: rig.json's guess with a sigma as a prior; the pose initialiser's stereo-LiDAR

@@ -244,10 +244,9 @@ void AddPipelineOptions(colmap::OptionManager* manager, PipelineOptions* options
       "mode",
       &options->mode,
       "joint | precalibrated | stereo_only (stereo_only also fuses unrefined stereo)");
-  // At 3 MP COLMAP's 8192 SIFT features (about 11,000 with their second orientations) make matching
-  // the import's cost; 4096 (about 6,600) took A's import from 212 to 127 s with cam_from_lidar
-  // 0.001 deg / 0.31 mm (8192: 0.002 deg / 0.33 mm): the LiDAR, not the feature count, sets the
-  // accuracy. Images of up to 1 MP rarely have more.
+  // At 3 MP COLMAP's 8192 SIFT features (more with their second orientations) make matching the
+  // import's cost; with 4096 the LiDAR, not the feature count, still sets the accuracy of
+  // cam_from_lidar (docs/benchmarks/pipeline.md). Images of up to 1 MP rarely have more.
   manager->sift_extraction->max_num_features = 4096;
   options->import.import.matcher = "auto";
   options->import.import.spatial_matching.max_num_neighbors = 12;

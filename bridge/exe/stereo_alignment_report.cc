@@ -90,12 +90,8 @@ std::optional<ExtrinsicMeasurement> ReadStereoAlignmentMeasurement(
       Eigen::Quaterniond(pose[0], pose[1], pose[2], pose[3]).normalized();
   measurement.cam_from_lidar.translation = Eigen::Vector3d(pose[4], pose[5], pose[6]);
   // Its marginal sigmas per camera axis, without the correlations. The alignment's errors are mostly
-  // shared by all stations (on the 40-frame drive 3-6 of its clustered sigmas), and they do not
-  // follow the correlations its information predicts: on seed 0 it put rotation about x and z at
-  // +0.88 while the errors were +0.051 and -0.010 deg. As a correlated measurement it dragged the
-  // roll along each time the LiDAR term corrected the pitch (-0.010 -> -0.073 deg); without the
-  // correlations, seeds 0/1/2/4 ended at 0.016/0.046/0.022/0.056 deg (correlated:
-  // 0.074/0.060/0.068/0.034).
+  // shared by all stations and do not follow the correlations its information predicts; as a
+  // correlated measurement it would drag the roll along each time the LiDAR term corrects the pitch.
   const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> full(covariance.data());
   if (!(full.diagonal().minCoeff() > 0)) {
     throw std::runtime_error(path + ": " + kBlock + "." + kCovariance +
