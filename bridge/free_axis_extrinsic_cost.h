@@ -10,8 +10,7 @@
 // through the relative motions (hand-eye, AX = XB), and its information about the rotation about the
 // driving direction comes from how the turns' axis maps between camera and LiDAR alone. With turns of
 // a few degrees a drift of 0.001 deg per frame in either trajectory moves that rotation by tenths of a
-// degree (the monocular street drive: 0.33 deg, the camera model's relative rotations and T_e rolled
-// together), so the rotation about the driving direction is left to the terms that see it directly
+// degree, so the rotation about the driving direction is left to the terms that see it directly
 // (E_m: the landmarks on the LiDAR surfaces of their own station, or the stereo alignment).
 //
 // Layout: the inner cost's last two parameter blocks are T_e's rotation (Eigen quaternion, x y z w,

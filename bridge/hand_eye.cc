@@ -221,8 +221,8 @@ HandEyeResult SimilarityHandEye(const std::vector<HandEyeMotion>& motions,
   RotationAxes axes = RotatingMotions(motions, options);
   result.num_motions = static_cast<int>(axes.motions.size());
   result.max_axis_angle_deg = MaxAngleBetweenLinesDeg(axes.in_cam);
-  // No turn left to give the axis (the last one left out as contradicting the fit): degenerate. Before,
-  // the axis was zero and the fit went on (a 40-frame mono drive ended 5.7 deg off).
+  // No turn left to give the axis (the last one left out as contradicting the fit): degenerate, not a
+  // fit about a zero axis.
   if (planar && axes.motions.empty()) {
     result.message = DegenerateMessage(0, 0) + " (the turns contradict the fit)";
     return result;
@@ -340,8 +340,8 @@ Contradiction MostContradictingMotion(const std::vector<HandEyeMotion>& motions,
 // SimilarityHandEye, leaving out the motion that contradicts the fit most (MostContradictingMotion)
 // and fitting again, until none does. A wrong two-view geometry (a flipped translation direction of
 // forward motion) otherwise gives a negative scale or a wrong axis; one poorly estimated axis among
-// tripod stations that rotate about axes 58 deg apart (0.54 deg rms with it) otherwise sent the fit to
-// the planar variant, whose translation is 0. Only one motion is left out for its axis alone: the
+// tripod stations that rotate about distinct axes would otherwise send the fit to the planar
+// variant, whose translation is 0. Only one motion is left out for its axis alone: the
 // noisy axes of a car's small turns must not be thinned until a few happen to fit. Fails
 // (rotation_unique false) when more than half of the motions would be left out, or when a general
 // fit's remaining axes are parallel. A planar fit keeps at least half of its rotating motions: the

@@ -122,9 +122,8 @@ struct JointAdjusterOptions {
   // ICP-like re-association of the LiDAR observations (the paper: 4 rounds).
   int num_association_rounds = 4;
   // Beyond the paper: further rounds (at the final gate, up to this many in all) while the last round
-  // still moved T_e by more than round_convergence_deg or round_convergence_mm. A coarse start (the
-  // hand-eye of a car, 1.3 deg and 25 cm off) is still converging after 4 rounds: 0.12 deg after 4,
-  // 0.09 deg after 6 on the 40-frame drive.
+  // still moved T_e by more than round_convergence_deg or round_convergence_mm: a coarse start (the
+  // hand-eye of a car, a degree and decimetres off) is still converging after 4 rounds.
   int max_association_rounds = 10;
   double round_convergence_deg = 0.01;
   double round_convergence_mm = 1.0;

@@ -16,7 +16,7 @@ constexpr double kAllowedTranslationMm = 100.0;
 constexpr double kAllowedSigmas = 3.0;
 constexpr const char* kAxisNames[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
 
-// "round 1 moved it 2.6 deg, 900 mm; variance factors (sigma / nominal) reprojection 0.44 ...".
+// "round R of N moved it most (x deg, y mm); sigma / nominal sigma: reprojection ...".
 std::string Evidence(const JointAdjustmentSummary& summary) {
   std::ostringstream text;
   text.precision(2);

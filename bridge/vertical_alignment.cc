@@ -273,8 +273,8 @@ VerticalAlignment MeasureVerticalAlignment(const std::vector<VerticalStationInpu
     return result;
   }
   result.axes = TangentBasis(mean_vertical.normalized());
-  // Gauss-Newton: linearised again at the corrected rotation (a drive's start can be degrees off;
-  // one linear step from 8 deg left 0.12 deg).
+  // Gauss-Newton: linearised again at the corrected rotation (a drive's start can be degrees off,
+  // beyond what one linear step corrects).
   Eigen::Vector2d correction = Eigen::Vector2d::Zero();
   for (int k = 0; k < kNumLinearisations; ++k) {
     result.correction = correction;

@@ -29,8 +29,7 @@ struct LidarDepthRefinementOptions {
   // Fold 1: a stereo depth is removed when its point lies farther than max_abs_diff_m +
   // max_rel_diff * z_l from the layer's plane (point-to-plane, as the model is evaluated).
   // The default, 3 mm, is a few sigma of the smoothed LiDAR surface for a VLP-16's 1 cm range noise;
-  // on the simulator tighter thresholds keep improving the mean (2 mm: -0.06 mm) because the smoothed
-  // LiDAR is better than the stereo there; a real LiDAR's range bias argues against going lower.
+  // a simulated LiDAR rewards tighter thresholds, a real LiDAR's range bias argues against them.
   bool remove_inconsistent = true;
   double max_abs_diff_m = 0.003;
   double max_rel_diff = 0;

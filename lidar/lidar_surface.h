@@ -23,9 +23,8 @@ struct LidarSurfaceOptions {
   // takes 1.5x the distance to its min_neighbors-th nearest sample as its radius, up to
   // max_radius_m. For a rotating LiDAR's sweep from a car (5-30 m away, rings 5-50 cm apart) the
   // 4 cm radius alone dropped nearly every sample. The densifier turns it on where the LiDAR is the
-  // only depth (no stereo) and on a moving platform (sweeps); tripods keep radius_m (on the T
-  // specimen growing let the LiDAR replace 1.6 M instead of 0.33 M stereo pixels: mean 2.03 instead
-  // of 2.00 mm).
+  // only depth (no stereo) and on a moving platform (sweeps); tripods keep radius_m, where growing
+  // would let the LiDAR replace far more stereo pixels without a better model.
   bool grow_sparse_neighbourhoods = false;
   double max_radius_m = 0.5;
   // Such a grown neighbourhood whose middle PCA eigenvalue is below this share of the largest is a

@@ -28,9 +28,9 @@ struct IcpOptions {
   double convergence_translation_m = 1e-5;
   // With target curvatures, the second phase: target points above this (edges, junctions, thin
   // cylinders, whose normals mix surfaces) enter no residual, only the overlap. Their residuals are
-  // biased at the true pose: on a car's forward-moving sweeps they pitched every registration by
-  // +0.0013-0.0015 deg (0.00026 without them; docs/mono.md, 2026-12-03). Leaving them out from the
-  // start loses the basin: a street's forward constraint comes mostly from them.
+  // biased at the true pose: on a car's forward-moving sweeps they pitch every registration alike.
+  // Leaving them out from the start loses the basin: a street's forward constraint comes mostly from
+  // them.
   double max_target_curvature = 0.02;
 
   bool Check() const;

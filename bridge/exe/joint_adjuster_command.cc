@@ -549,10 +549,9 @@ bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& 
 // platform (rig.json's clouds are sweeps, or initialization.json's one-axis hand-eye) whose stations
 // do not rotate about two axes (the uniqueness test of Zhen et al. 2019 on the input model): the
 // paper's terms then leave the roll about the driving direction and the translation to the
-// landmarks on the LiDAR surfaces (the 40-frame stereo drive from a 3 deg / 5 cm guess: 1.41 deg
-// without E_m, 0.49 deg with it). Not for tripod stations: there the tool asks for tilted stations,
-// and E_m from a 5 deg / 10 cm guess on 4 unrotated stations of the T specimen ended 128 mm off with
-// a reported sigma of 7 mm. Off (the paper's cost) otherwise.
+// landmarks on the LiDAR surfaces. Not for tripod stations: there the tool asks for tilted stations,
+// since E_m on unrotated stations ends far from the truth with a small reported sigma. Off (the
+// paper's cost) otherwise.
 // Its weight on such a moving platform is kMovingPlatformLandmarkWeight, 1 on tripods: along a
 // drive the landmarks' errors are shared (an E_m solve moved the roll by 0.12 deg through its
 // associations alone, and the roll's error kept its sign over runs), so E_m counts for less than its

@@ -205,8 +205,8 @@ int RunPoseInitializer(int argc, char** argv) {
   options.Parse(argc, argv);
   THROW_CHECK(initializer.Check());  // before any file is read
   paths.database_path = *options.database_path;
-  // The registrator's de-skewed, static clouds, as in the pipeline: the stereo-LiDAR alignment on
-  // raw sweeps of the 40-frame drive ended 0.34 deg off instead of 0.06 deg.
+  // The registrator's de-skewed, static clouds, as in the pipeline: raw sweeps are smeared by the
+  // platform's motion, which biases the stereo-LiDAR alignment.
   RunPoseInitializerStep(
       WithRegistratorClouds(ReadStationDataset(dataset_path), paths.registration_path),
       paths,
