@@ -1,8 +1,7 @@
 // The edge objective of bridge/edge_calibration.h along one rotation axis: J(exp(a u) T_e) for angles
 // a about a unit axis u in the camera frame, per station, and where it peaks. A moving platform's
-// T_e is weakest in its roll about the direction of travel (docs/mono.md): the joint adjustment's
-// terms leave it 0.1-0.4 deg off on a 40-frame drive, and the image edges see it directly (a LiDAR
-// edge 10 m to the side moves by 17 mm per 0.1 deg of that roll). The peak's uncertainty is a
+// T_e is weakest in its roll about the direction of travel (docs/mono.md), and the image edges see
+// it directly (a LiDAR edge 10 m to the side moves by 17 mm per 0.1 deg of that roll). The peak's uncertainty is a
 // bootstrap over stations (each station's image and cloud are one independent draw), not the
 // curvature of J, whose points are not independent.
 #pragma once

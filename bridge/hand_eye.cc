@@ -345,9 +345,8 @@ Contradiction MostContradictingMotion(const std::vector<HandEyeMotion>& motions,
 // noisy axes of a car's small turns must not be thinned until a few happen to fit. Fails
 // (rotation_unique false) when more than half of the motions would be left out, or when a general
 // fit's remaining axes are parallel. A planar fit keeps at least half of its rotating motions: the
-// axes of a drive's 1-2 deg turns from two-view geometries scatter by 10-25 deg, and leaving them out
-// worst first left none (a 40-frame drive failed to initialise); the rest are then judged by their
-// translation directions only.
+// axes of a drive's small turns from two-view geometries scatter widely, and leaving them out worst
+// first could leave none; the rest are then judged by their translation directions only.
 HandEyeResult FitWithoutContradictingMotions(std::vector<HandEyeMotion> motions,
                                              const HandEyeOptions& options,
                                              const Eigen::Vector3d& axis_translation_fallback,

@@ -63,8 +63,8 @@ struct PoseInitializerOptions {
   double max_lidar_image_angle_deg = 5.0;
   // LiDAR edges that lidar_registrator accepted as degenerate (a direction its ICP barely
   // constrains: a ground plane leaves the yaw free) enter the pose graph as full 6-DoF edges, and on
-  // sparse clouds they were wrong by up to 180 deg (7 of 7 on an 8-station, 100 k-ray capture and
-  // on B). They are left out unless this is set; a station only they reach is then unreachable.
+  // sparse clouds they can be wrong by up to 180 deg. They are left out unless this is set; a
+  // station only they reach is then unreachable.
   bool use_degenerate_lidar_edges = false;
   // Once cam_from_lidar is chosen, image and LiDAR edges are motions of one camera: an edge that
   // breaks every cycle (3 stations, or an image and a LiDAR edge of one pair) it lies on within these
