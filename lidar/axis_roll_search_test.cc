@@ -1,5 +1,6 @@
 #include "lidar/axis_roll_search.h"
 
+#include "tests/testing/camera_lidar_scene.h"
 #include "tests/testing/car_cam_from_lidar.h"
 #include "tests/testing/ray_cast_street.h"
 
@@ -20,16 +21,7 @@ Eigen::Isometry3d TrueCamFromLidar() { return testing::CarCamFromLidar(0.03); }
 // Five stations 3 m apart along a straight street (no turn at all): static LiDAR scans (1 cm noise)
 // and camera points cast through a 90 x 30 deg field of view with a depth error of d^2 / 300 m
 // along the ray (two-view triangulation over a short baseline).
-struct StraightStreet {
-  std::vector<std::unique_ptr<StationCloud>> clouds;
-  std::vector<CameraDepthPoints> points;
-
-  std::vector<const StationCloud*> Clouds() const {
-    std::vector<const StationCloud*> pointers;
-    for (const auto& cloud : clouds) pointers.push_back(cloud.get());
-    return pointers;
-  }
-};
+using StraightStreet = testing::CameraLidarScene;
 
 CameraDepthPoints CastCameraPoints(const std::vector<testing::Box>& boxes,
                                    const Eigen::Isometry3d& world_from_cam,

@@ -1,5 +1,6 @@
 #include "lidar/extrinsic_alignment.h"
 
+#include "tests/testing/camera_lidar_scene.h"
 #include "tests/testing/car_cam_from_lidar.h"
 #include "tests/testing/synthetic_clouds.h"
 
@@ -23,16 +24,7 @@ Eigen::Isometry3d Perturbation(double angle_deg,
   return Eigen::Translation3d(t) * Eigen::AngleAxisd(angle_deg / kRadToDeg, axis.normalized());
 }
 
-struct Scene {
-  std::vector<std::unique_ptr<StationCloud>> clouds;
-  std::vector<CameraDepthPoints> points;
-
-  std::vector<const StationCloud*> Clouds() const {
-    std::vector<const StationCloud*> pointers;
-    for (const auto& cloud : clouds) pointers.push_back(cloud.get());
-    return pointers;
-  }
-};
+using Scene = testing::CameraLidarScene;
 
 std::vector<Eigen::Isometry3d> FourStations() {
   return {Perturbation(0, Eigen::Vector3d::UnitZ(), Eigen::Vector3d(-3, -1, 1.7)),
