@@ -11,7 +11,6 @@
 
 #include "colmap/controllers/incremental_mapper.h"
 #include "colmap/estimators/cost_functions.h"
-#include "colmap/feature/utils.h"
 #include "colmap/scene/database.h"
 #include "colmap/scene/reconstruction_manager.h"
 
@@ -610,7 +609,13 @@ void TriangulateInitialModel(const std::string& database_path,
     for (const auto& [image_id, pose] : initialization.cam_from_world) {
       colmap::Image image = database.ReadImage(image_id);
       image.CamFromWorld() = pose;
-      image.SetPoints2D(colmap::FeatureKeypointsToPointsVector(database.ReadKeypoints(image_id)));
+      // Built here, not by COLMAP's FeatureKeypointsToPointsVector: a vector of Eigen types allocated
+      // inside COLMAP's library and freed here may pair different allocators (ASan reports it).
+      std::vector<Eigen::Vector2d> points2D;
+      for (const colmap::FeatureKeypoint& keypoint : database.ReadKeypoints(image_id)) {
+        points2D.emplace_back(keypoint.x, keypoint.y);
+      }
+      image.SetPoints2D(points2D);
       if (matched.count(image_id)) {
         reconstruction->AddImage(image);
         reconstruction->RegisterImage(image_id);
