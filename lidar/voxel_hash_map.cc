@@ -42,15 +42,29 @@ Eigen::Vector3i VoxelHashMap::VoxelOf(const Eigen::Vector3d& point) const {
   return VoxelIndex(point, voxel_size_);
 }
 
-void VoxelHashMap::ClassifyShape(const std::vector<Eigen::Vector3d>& points,
-                                 VoxelShape* shape,
-                                 Eigen::Vector3d* normal) {
+namespace {
+
+// First and second moments of points taken relative to `origin` (near them: no cancellation).
+struct PointMoments {
+  explicit PointMoments(const Eigen::Vector3d& origin) : origin(origin) {}
+  void Add(const Eigen::Vector3d& point) {
+    const Eigen::Vector3d p = point - origin;
+    sum += p;
+    outer += p * p.transpose();
+    ++count;
+  }
+  Eigen::Vector3d origin;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  size_t count = 0;
+};
+
+// The shape of the points whose moments are given (PCA of their scatter).
+void ClassifyShape(const PointMoments& moments, VoxelShape* shape, Eigen::Vector3d* normal) {
   *shape = VoxelShape::kScattered;
-  if (points.size() < 5) return;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : points) mean += p / static_cast<double>(points.size());
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3d& p : points) scatter += (p - mean) * (p - mean).transpose();
+  if (moments.count < 5) return;
+  const Eigen::Matrix3d scatter =
+      moments.outer - moments.sum * moments.sum.transpose() / static_cast<double>(moments.count);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
   const Eigen::Vector3d& variances = solver.eigenvalues();
   // Spreads (square roots) below 0.2 of the largest: a line; else thin across (below 0.3 of the
@@ -62,6 +76,8 @@ void VoxelHashMap::ClassifyShape(const std::vector<Eigen::Vector3d>& points,
     *normal = solver.eigenvectors().col(0);
   }
 }
+
+}  // namespace
 
 template <typename Visit>
 void VoxelHashMap::ForEachVoxelAround(const Eigen::Vector3d& point, const Visit& visit) const {
@@ -78,13 +94,13 @@ void VoxelHashMap::ForEachVoxelAround(const Eigen::Vector3d& point, const Visit&
 
 void VoxelHashMap::ClassifyNeighbourhood(MapNeighbor* neighbor) const {
   const double squared_radius = voxel_size_ * voxel_size_;
-  std::vector<Eigen::Vector3d> points;
+  PointMoments moments(neighbor->point);
   ForEachVoxelAround(neighbor->point, [&](const Voxel& voxel) {
     for (const Eigen::Vector3d& point : voxel.points) {
-      if ((point - neighbor->point).squaredNorm() <= squared_radius) points.push_back(point);
+      if ((point - neighbor->point).squaredNorm() <= squared_radius) moments.Add(point);
     }
   });
-  ClassifyShape(points, &neighbor->shape, &neighbor->normal);
+  ClassifyShape(moments, &neighbor->shape, &neighbor->normal);
 }
 
 void VoxelHashMap::Update(const std::vector<Eigen::Vector3d>& points_in_world,
@@ -100,7 +116,9 @@ void VoxelHashMap::Update(const std::vector<Eigen::Vector3d>& points_in_world,
     voxel.points.push_back(point);
   }
   for (Voxel* voxel : changed) {
-    ClassifyShape(voxel->points, &voxel->shape, &voxel->normal);
+    PointMoments moments(voxel->points.front());
+    for (const Eigen::Vector3d& point : voxel->points) moments.Add(point);
+    ClassifyShape(moments, &voxel->shape, &voxel->normal);
     voxel->changed = false;
   }
   const double max_squared = max_distance_ * max_distance_;

@@ -61,9 +61,6 @@ class VoxelHashMap {
   // Calls visit(voxel) for each occupied voxel of the 27 around `point`'s.
   template <typename Visit>
   void ForEachVoxelAround(const Eigen::Vector3d& point, const Visit& visit) const;
-  static void ClassifyShape(const std::vector<Eigen::Vector3d>& points,
-                            VoxelShape* shape,
-                            Eigen::Vector3d* normal);
 
   std::unordered_map<Eigen::Vector3i, Voxel, VoxelHash> voxels_;
 };
