@@ -478,6 +478,10 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
   summary.stations.resize(views.size());
   std::mutex mutex;
   size_t num_done = 0;
+  // Each station's LiDAR points join the map in station order (a voxel's mean depends on the order
+  // of its sums): finished stations wait here until those before them have joined.
+  std::map<int, std::vector<Eigen::Vector3d>> waiting;
+  int next_to_join = 0;
   ParallelForEach(static_cast<int>(views.size()), [&](int k) {
     const auto station_start = std::chrono::steady_clock::now();
     const colmap::camera_t camera_id = input_model.Image(views[k].image_id).CameraId();
@@ -495,8 +499,12 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
                       undistorter == undistorters.end() ? nullptr : undistorter->second.get(),
                       &points_in_world);
     std::lock_guard<std::mutex> lock(mutex);
-    for (const Eigen::Vector3d& point : points_in_world) {
-      lidar_map.Add(point, Eigen::Vector3f::Zero(), Color3ub(128, 128, 128));
+    waiting[k] = std::move(points_in_world);
+    for (auto next = waiting.begin(); next != waiting.end() && next->first == next_to_join;
+         next = waiting.erase(next), ++next_to_join) {
+      for (const Eigen::Vector3d& point : next->second) {
+        lidar_map.Add(point, Eigen::Vector3f::Zero(), Color3ub(128, 128, 128));
+      }
     }
     station.seconds = SecondsSince(station_start);
     PrintStation(num_done++, views.size(), station);

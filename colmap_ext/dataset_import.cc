@@ -357,6 +357,12 @@ colmap::SpatialMatchingOptions LidarSpatialMatchingOptions() {
   return options;
 }
 
+colmap::SiftMatchingOptions DeterministicSiftMatchingOptions() {
+  colmap::SiftMatchingOptions options;
+  options.num_threads = 1;
+  return options;
+}
+
 bool DatasetImportOptions::Check() const {
   CHECK_OPTION(matcher == "exhaustive" || matcher == "sequential" || matcher == "spatial");
   CHECK_OPTION(image_name_format.empty() ||

@@ -1,6 +1,7 @@
 #include "lidar/frame_to_map_icp.h"
 
 #include "lidar/check_option.h"
+#include "lidar/parallel_for_each.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -13,9 +14,6 @@ namespace {
 
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
-
-// Fixed chunks: the sums do not depend on the thread count.
-constexpr int kNumChunks = 64;
 
 struct NormalSystem {
   Matrix6d hessian = Matrix6d::Zero();
@@ -75,21 +73,13 @@ NormalSystem SumOverCorrespondences(const std::vector<Eigen::Vector3d>& points,
                                     double max_distance,
                                     bool neighbourhood_shape,
                                     const Add& add) {
-  std::vector<NormalSystem> chunks(kNumChunks);
-  const int n = static_cast<int>(points.size());
-#pragma omp parallel for schedule(static)
-  for (int c = 0; c < kNumChunks; ++c) {
-    for (int i = c * n / kNumChunks; i < (c + 1) * n / kNumChunks; ++i) {
-      const Eigen::Vector3d x = pose * points[i];
-      MapNeighbor neighbor;
-      if (!map.NearestNeighbor(x, &neighbor) || neighbor.distance > max_distance) continue;
-      if (neighbourhood_shape) map.ClassifyNeighbourhood(&neighbor);
-      add(i, x, neighbor, &chunks[c]);
-    }
-  }
-  NormalSystem total;
-  for (const NormalSystem& chunk : chunks) total.Add(chunk);
-  return total;
+  return ChunkedSum<NormalSystem>(static_cast<long>(points.size()), [&](long i, NormalSystem* sum) {
+    const Eigen::Vector3d x = pose * points[i];
+    MapNeighbor neighbor;
+    if (!map.NearestNeighbor(x, &neighbor) || neighbor.distance > max_distance) return;
+    if (neighbourhood_shape) map.ClassifyNeighbourhood(&neighbor);
+    add(i, x, neighbor, sum);
+  });
 }
 
 // One Gauss-Newton system of the residuals at `pose` (Eq. 7-8).

@@ -1,6 +1,7 @@
 #include "lidar/point_to_plane_icp.h"
 
 #include "lidar/check_option.h"
+#include "lidar/parallel_for_each.h"
 
 #include <Eigen/Dense>
 
@@ -39,34 +40,25 @@ NormalEquations BuildNormalEquations(const PointCloud& source,
                                      double gate,
                                      const std::vector<double>* curvature,
                                      double max_curvature) {
-  NormalEquations total;
   const long num = static_cast<long>((source.Size() + stride - 1) / stride);
-#pragma omp parallel
-  {
-    NormalEquations local;
-#pragma omp for schedule(static) nowait
-    for (long k = 0; k < num; ++k) {
-      const Eigen::Vector3d p = target_from_source * source.points[k * stride];
-      size_t index;
-      double squared;
-      if (!tree.Nearest(p, &index, &squared) || squared > gate * gate) continue;
-      const Eigen::Vector3d& n = target.normals[index];
-      if (n.squaredNorm() < 0.5) continue;  // no normal estimated there
-      ++local.count_in_gate;
-      if (curvature && (*curvature)[index] > max_curvature) continue;
-      const double r = n.dot(p - target.points[index]);
-      Eigen::Matrix<double, 6, 1> J;
-      J << p.cross(n), n;
-      local.H.noalias() += J * J.transpose();
-      local.g.noalias() += J * r;
-      local.squared_error += r * r;
-      local.squared_radius += p.squaredNorm();
-      ++local.count;
-    }
-#pragma omp critical
-    total.Add(local);
-  }
-  return total;
+  return ChunkedSum<NormalEquations>(num, [&](long k, NormalEquations* sum) {
+    const Eigen::Vector3d p = target_from_source * source.points[k * stride];
+    size_t index;
+    double squared;
+    if (!tree.Nearest(p, &index, &squared) || squared > gate * gate) return;
+    const Eigen::Vector3d& n = target.normals[index];
+    if (n.squaredNorm() < 0.5) return;  // no normal estimated there
+    ++sum->count_in_gate;
+    if (curvature && (*curvature)[index] > max_curvature) return;
+    const double r = n.dot(p - target.points[index]);
+    Eigen::Matrix<double, 6, 1> J;
+    J << p.cross(n), n;
+    sum->H.noalias() += J * J.transpose();
+    sum->g.noalias() += J * r;
+    sum->squared_error += r * r;
+    sum->squared_radius += p.squaredNorm();
+    ++sum->count;
+  });
 }
 
 }  // namespace

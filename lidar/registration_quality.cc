@@ -1,5 +1,7 @@
 #include "lidar/registration_quality.h"
 
+#include "lidar/parallel_for_each.h"
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -14,23 +16,29 @@ double PlaneNoiseRms(const PointCloud& cloud, const KdTree3& tree, size_t max_po
     throw std::invalid_argument("PlaneNoiseRms: the k-d tree is not built over the cloud");
   }
   const size_t stride = std::max<size_t>(1, cloud.Size() / std::max<size_t>(1, max_points));
-  double squared_sum = 0;
-  size_t count = 0;
-#pragma omp parallel for schedule(static) reduction(+ : squared_sum, count)
-  for (long k = 0; k < static_cast<long>(cloud.Size() / stride); ++k) {
+  struct SquaredSum {
+    double squared_sum = 0;
+    size_t count = 0;
+    void Add(const SquaredSum& other) {
+      squared_sum += other.squared_sum;
+      count += other.count;
+    }
+  };
+  const long num = static_cast<long>(cloud.Size() / stride);
+  const SquaredSum sum = ChunkedSum<SquaredSum>(num, [&](long k, SquaredSum* chunk) {
     const Eigen::Vector3d& p = cloud.points[k * stride];
     std::vector<size_t> indices;
     std::vector<double> squared_distances;
     tree.KNearest(p, 2, &indices, &squared_distances);
-    if (indices.size() < 2) continue;
+    if (indices.size() < 2) return;
     const size_t q = indices[0] == static_cast<size_t>(k * stride) ? indices[1] : indices[0];
     const Eigen::Vector3d& n = cloud.normals[q];
-    if (n.squaredNorm() < 0.5) continue;
+    if (n.squaredNorm() < 0.5) return;
     const double r = n.dot(p - cloud.points[q]);
-    squared_sum += r * r;
-    ++count;
-  }
-  return count ? std::sqrt(squared_sum / count) : 0.0;
+    chunk->squared_sum += r * r;
+    ++chunk->count;
+  });
+  return sum.count ? std::sqrt(sum.squared_sum / sum.count) : 0.0;
 }
 
 std::string ConstraintAnalysis::WeakestAxisName() const {

@@ -1,0 +1,102 @@
+// The same output with one thread and with four: lidar_registrator, joint_adjuster and densifier on
+// the default pipeline workspace (tests/testing/pipeline_fixture.h), each run with OMP_NUM_THREADS=1
+// and =4 into folders of its own and compared byte by byte (report.json without its timings).
+#include "tests/testing/pipeline_fixture.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace colmap_lidar {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::kCli;
+using testing::ReadJson;
+using testing::RunCommand;
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  EXPECT_TRUE(file) << "cannot read " << path;
+  std::ostringstream bytes;
+  bytes << file.rdbuf();
+  return bytes.str();
+}
+
+// `json` without the keys that hold wall-clock times.
+nlohmann::json WithoutTimings(nlohmann::json json) {
+  if (json.is_object()) {
+    for (auto it = json.begin(); it != json.end();) {
+      const std::string& key = it.key();
+      if (key == "seconds" || key.find("_seconds") != std::string::npos) {
+        it = json.erase(it);
+      } else {
+        *it = WithoutTimings(*it);
+        ++it;
+      }
+    }
+  } else if (json.is_array()) {
+    for (nlohmann::json& item : json) item = WithoutTimings(item);
+  }
+  return json;
+}
+
+class DeterminismTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(fs::is_regular_file(fixture_.File("sparse/joint/cam_from_lidar.txt")))
+        << "the pipeline fixture is missing: run PipelineTest.DefaultScene... first (ctest does)";
+  }
+
+  // Runs `arguments` of the CLI with `threads` OpenMP threads; the command must succeed.
+  static void RunWithThreads(int threads, const std::string& arguments) {
+    const auto run =
+        RunCommand("OMP_NUM_THREADS=" + std::to_string(threads) + " " + kCli + " " + arguments);
+    ASSERT_EQ(run.exit_code, 0) << arguments << "\n" << run.output;
+  }
+
+  // Each of `files` (in folders `one` and `four`) holds the same bytes.
+  static void ExpectSameFiles(const std::string& one,
+                              const std::string& four,
+                              const std::vector<std::string>& files) {
+    for (const std::string& name : files) {
+      EXPECT_EQ(FileBytes(one + "/" + name), FileBytes(four + "/" + name)) << name;
+    }
+  }
+
+  std::string Output(const std::string& name) const { return fixture_.File("determinism/" + name); }
+
+  const testing::PipelineFixture fixture_;
+};
+
+TEST_F(DeterminismTest, RegistrationJointAdjustmentAndDenseModelAreTheSameWithOneAndFourThreads) {
+  const testing::PipelineFixture& f = fixture_;
+  fs::remove_all(Output(""));
+  for (const int threads : {1, 4}) {
+    const std::string out = Output(std::to_string(threads));
+    RunWithThreads(
+        threads,
+        "lidar_registrator --lidar_path " + f.dataset + "/lidar --output_path " + out + "/lidar");
+    RunWithThreads(threads,
+                   "joint_adjuster --database_path " + f.File("database.db") + " --input_path " +
+                       f.File("sparse/initial") + " --dataset_path " + f.dataset +
+                       " --registration_path " + f.File("lidar") + " --output_path " + out +
+                       "/joint");
+    RunWithThreads(threads,
+                   "densifier --input_path " + out + "/joint --dataset_path " + f.dataset +
+                       " --depth_path " + f.File("stereo") + " --output_path " + out + "/dense");
+  }
+  const std::string one = Output("1"), four = Output("4");
+  ExpectSameFiles(one + "/lidar", four + "/lidar", {"lidar_poses.txt", "pairs.txt"});
+  ExpectSameFiles(one + "/joint",
+                  four + "/joint",
+                  {"cam_from_lidar.txt", "cameras.bin", "images.bin", "points3D.bin"});
+  EXPECT_EQ(WithoutTimings(ReadJson(one + "/joint/report.json")),
+            WithoutTimings(ReadJson(four + "/joint/report.json")));
+  ExpectSameFiles(one + "/dense", four + "/dense", {"fused.ply", "lidar_map.ply"});
+}
+
+}  // namespace
+}  // namespace colmap_lidar
