@@ -147,16 +147,36 @@ TEST(CliTest, HelpVersionAndErrors) {
   EXPECT_NE(missing_db.output.find(dir.File("x.db")), std::string::npos) << missing_db.output;
   EXPECT_FALSE(fs::exists(dir.File("x.db"))) << "database_info must not create a database";
 
-  // A nested option check (the observability thresholds inside the joint adjuster's options) is acted
-  // on: the value is refused before any file is read.
+  // A nested option check (the LiDAR noise inside the joint adjuster's options) is acted on: the
+  // value is refused before any file is read.
   const auto bad_threshold =
       RunCommand(cli + " joint_adjuster --database_path " + dir.File("x.db") + " --input_path " +
                  dir.File("m") + " --dataset_path " + dir.File("d") + " --output_path " +
-                 dir.File("o") + " --unobservable_translation_mm -1");
+                 dir.File("o") + " --sigma_lidar_m -1");
   EXPECT_NE(bad_threshold.exit_code, 0);
-  EXPECT_NE(bad_threshold.output.find("unobservable_translation_mm > 0"), std::string::npos)
+  EXPECT_NE(bad_threshold.output.find("sigma_lidar_m > 0"), std::string::npos)
       << bad_threshold.output;
   EXPECT_FALSE(fs::exists(dir.File("o")));
+
+  // An option joint_adjuster no longer takes is refused with what decides its value now.
+  const auto removed =
+      RunCommand(cli + " joint_adjuster --database_path " + dir.File("x.db") + " --input_path " +
+                 dir.File("m") + " --dataset_path " + dir.File("d") + " --output_path " +
+                 dir.File("o") + " --depth_weight 2");
+  EXPECT_NE(removed.exit_code, 0);
+  EXPECT_NE(removed.output.find("--depth_weight is no longer an option: each data group's weight "
+                                "is estimated"),
+            std::string::npos)
+      << removed.output;
+  EXPECT_FALSE(fs::exists(dir.File("o")));
+  const auto removed_in_pipeline =
+      RunCommand(cli + " pipeline --dataset_path " + dir.File("d") + " --workspace_path " +
+                 dir.File("ws") + " --JointAdjuster.loss=cauchy");
+  EXPECT_NE(removed_in_pipeline.exit_code, 0);
+  EXPECT_NE(removed_in_pipeline.output.find("--JointAdjuster.loss is no longer an option"),
+            std::string::npos)
+      << removed_in_pipeline.output;
+  EXPECT_FALSE(fs::exists(dir.File("ws")));
 
   // The pipeline registers every step's options under the step's section; a bad one is refused
   // before the workspace is created.
@@ -170,9 +190,9 @@ TEST(CliTest, HelpVersionAndErrors) {
   }
   const auto bad_step_option =
       RunCommand(cli + " pipeline --dataset_path " + dir.File("d") + " --workspace_path " +
-                 dir.File("ws") + " --JointAdjuster.unobservable_translation_mm -1");
+                 dir.File("ws") + " --JointAdjuster.sigma_lidar_m -1");
   EXPECT_NE(bad_step_option.exit_code, 0);
-  EXPECT_NE(bad_step_option.output.find("unobservable_translation_mm > 0"), std::string::npos)
+  EXPECT_NE(bad_step_option.output.find("sigma_lidar_m > 0"), std::string::npos)
       << bad_step_option.output;
   EXPECT_FALSE(fs::exists(dir.File("ws")));
 }

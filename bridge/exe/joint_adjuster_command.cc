@@ -403,83 +403,105 @@ void AddJointAdjusterOptions(const std::string& prefix,
                              JointAdjusterStepOptions* options) {
   PrefixedOptions add(manager, prefix);
   JointAdjusterOptions& adjuster = options->adjuster;
-  add.Add("sigma_lidar_m", &adjuster.sigma_lidar_m);
+  add.Add("sigma_lidar_m",
+          &adjuster.sigma_lidar_m,
+          "nominal LiDAR range noise: the starting weight of the LiDAR terms");
   add.Add("estimate_variance_components",
           &adjuster.estimate_variance_components,
           "weight each data group by its variance factor estimated with the solve");
   add.Add("estimate_time_offset",
           &options->estimate_time_offset,
           "on a moving platform, estimate the LiDAR clock's offset from the cameras");
-  add.Add("depth_weight", &adjuster.depth_weight);
-  add.Add("first_depth_prior_round",
-          &adjuster.first_depth_prior_round,
-          "with LiDAR, the depth priors join from this round (1: from the start, the paper)");
-  add.Add("lidar_weight", &adjuster.lidar_weight);
-  add.Add("loss", &adjuster.loss, "none | huber | cauchy");
-  add.Add("loss_scale", &adjuster.loss_scale);
-  add.Add("compress_lidar_blocks", &adjuster.compress_lidar_blocks);
-  add.Add("max_reprojection_error_px", &adjuster.max_reprojection_error_px);
-  add.Add("max_depth_error_sigmas", &adjuster.max_depth_error_sigmas);
-  add.Add("depth_gate_from_residual_scale", &adjuster.depth_gate_from_residual_scale);
-  add.Add("max_depth_error_m",
-          &adjuster.max_depth_error_m,
-          "absolute cap on top of the sigma gate; 0: off");
-  add.Add("max_point_to_plane_m", &adjuster.max_point_to_plane_m);
-  add.Add("landmark_lidar_weight",
-          &options->landmark_lidar_weight,
-          "w_m of the landmark-to-LiDAR-plane term; -1: 0.25 for a moving platform (sweeps) "
-          "whose stations do not rotate about two axes, else 1 for a monocular rig and 0 for a "
-          "stereo rig");
-  add.Add(
-      "free_lidar_drive_roll",
-      &adjuster.free_lidar_drive_roll,
-      "the LiDAR term leaves cam_from_lidar's rotation about the driving direction to the other "
-      "terms (an angle of its own)");
-  add.Add("sigma_landmark_lidar_m", &adjuster.sigma_landmark_lidar_m);
-  add.Add("max_landmark_plane_m", &adjuster.max_landmark_plane_m);
-  add.Add("max_landmark_plane_sigmas", &adjuster.max_landmark_plane_sigmas);
-  add.Add("max_outlier_iterations", &adjuster.max_outlier_iterations);
-  add.Add("num_association_rounds", &adjuster.num_association_rounds);
-  add.Add("num_samples_per_pair", &options->num_samples_per_pair);
-  add.Add("normal_space_sampling", &adjuster.association.normal_space_sampling);
-  add.Add("association_max_distance_m", &adjuster.association.max_distance);
-  add.Add("association_max_curvature",
-          &adjuster.association.max_curvature,
-          "target (and landmark) neighbourhoods above this curvature give no residual");
-  add.Add("initial_association_distance_m", &adjuster.initial_association_distance_m);
-  add.Add("max_association_rounds",
-          &adjuster.max_association_rounds,
-          "further rounds while cam_from_lidar still moves, up to this many in all");
-  add.Add("round_convergence_deg", &adjuster.round_convergence_deg);
-  add.Add("round_convergence_mm", &adjuster.round_convergence_mm);
-  add.Add("hold_rotation", &adjuster.hold_rotation);
-  add.Add(
-      "hold_translation", &options->hold_translation, "comma-separated camera axes, e.g. y or x,z");
-  add.Add("max_num_iterations", &adjuster.max_num_iterations);
-  add.Add("extrinsic_prior_sigma_m", &adjuster.extrinsic_prior_sigma_m);
-  add.Add("hold_unobservable",
-          &adjuster.hold_unobservable,
-          "solve again with unobservable directions of cam_from_lidar held at their initial value");
+  add.Add("hold_rotation", &adjuster.hold_rotation, "hold cam_from_lidar's rotation at its start");
+  add.Add("hold_translation",
+          &options->hold_translation,
+          "camera axes of cam_from_lidar's translation held at their start, e.g. y or x,z");
   add.Add("hold_rotation_deg",
           &adjuster.hold_rotation_deg,
-          "sigma above which a direction is held at its start (guess or hand-eye)");
-  add.Add("hold_translation_mm", &adjuster.hold_translation_mm);
-  add.Add("min_image_pair_inliers", &options->data.min_image_pair_inliers);
-  add.Add("max_lidar_neighbors", &options->data.max_lidar_neighbors);
-  add.Add("stereo_scale_sigma", &adjuster.observability.stereo_scale_sigma);
-  add.Add("two_way_lidar_clusters", &adjuster.observability.two_way_lidar_clusters);
-  add.Add("unobservable_translation_mm", &adjuster.observability.unobservable_translation_mm);
-  add.Add("unobservable_rotation_deg", &adjuster.observability.unobservable_rotation_deg);
-  add.Add("use_stereo_alignment",
-          &options->use_stereo_alignment,
-          "also take INPUT/initialization.json's stereo-LiDAR alignment as a measurement of "
-          "cam_from_lidar");
-  add.Add("vertical_alignment",
-          &options->vertical_alignment,
-          "walls and vertical image edges measure cam_from_lidar's tilt (a measurement in the "
-          "cost, when no stereo-LiDAR alignment is): 1 on, 0 off, -1 on for a moving platform "
-          "whose stations do not rotate about two axes");
+          "sigma above which a rotation direction is held at its start and named undetermined");
+  add.Add("hold_translation_mm",
+          &adjuster.hold_translation_mm,
+          "sigma above which a translation direction is held at its start and named undetermined");
   add.Add("write_text", &options->write_text, "also write cameras.txt, images.txt, points3D.txt");
+}
+
+namespace {
+
+// Options joint_adjuster no longer takes, with what decides their value now.
+struct RemovedOption {
+  const char* name;
+  const char* replacement;
+};
+
+constexpr char kWeightsEstimated[] =
+    "each data group's weight is estimated with the solve (variance components)";
+constexpr char kGatesFixed[] = "the outlier gates are fixed (docs/joint_adjuster.md lists them)";
+constexpr char kNoLoss[] =
+    "no robust loss: the outlier gates remove outliers (docs/joint_adjuster.md)";
+constexpr char kRoundsFixed[] =
+    "the association rounds run until cam_from_lidar stops moving (docs/joint_adjuster.md)";
+constexpr char kSamplingFixed[] =
+    "the LiDAR association's sampling is fixed (docs/joint_adjuster.md)";
+constexpr char kCovarianceFixed[] =
+    "the covariance model is fixed (docs/joint_adjuster.md, Uncertainty)";
+constexpr char kFromMotion[] = "decided from the stations' motion (docs/joint_adjuster.md)";
+
+constexpr RemovedOption kRemovedOptions[] = {
+    {"depth_weight", kWeightsEstimated},
+    {"lidar_weight", kWeightsEstimated},
+    {"landmark_lidar_weight", kFromMotion},
+    {"sigma_landmark_lidar_m", kWeightsEstimated},
+    {"loss", kNoLoss},
+    {"loss_scale", kNoLoss},
+    {"max_reprojection_error_px", kGatesFixed},
+    {"max_depth_error_sigmas", kGatesFixed},
+    {"depth_gate_from_residual_scale", kGatesFixed},
+    {"max_depth_error_m", kGatesFixed},
+    {"max_point_to_plane_m", kGatesFixed},
+    {"max_landmark_plane_m", kGatesFixed},
+    {"max_landmark_plane_sigmas", kGatesFixed},
+    {"association_max_curvature", kGatesFixed},
+    {"max_outlier_iterations", kGatesFixed},
+    {"first_depth_prior_round", kRoundsFixed},
+    {"num_association_rounds", kRoundsFixed},
+    {"max_association_rounds", kRoundsFixed},
+    {"round_convergence_deg", kRoundsFixed},
+    {"round_convergence_mm", kRoundsFixed},
+    {"initial_association_distance_m", kRoundsFixed},
+    {"association_max_distance_m", kRoundsFixed},
+    {"max_num_iterations", kRoundsFixed},
+    {"num_samples_per_pair", kSamplingFixed},
+    {"normal_space_sampling", kSamplingFixed},
+    {"max_lidar_neighbors", kSamplingFixed},
+    {"min_image_pair_inliers", kSamplingFixed},
+    {"compress_lidar_blocks", "the LiDAR term is always passed to Ceres in its compressed form"},
+    {"free_lidar_drive_roll", "the LiDAR term and the others share one cam_from_lidar"},
+    {"extrinsic_prior_sigma_m",
+     "a prior on cam_from_lidar comes only from rig.json's cam_from_lidar_guess_sigma"},
+    {"hold_unobservable",
+     "undetermined directions are always held at their start and named (hold_rotation_deg, "
+     "hold_translation_mm)"},
+    {"stereo_scale_sigma", kCovarianceFixed},
+    {"two_way_lidar_clusters", kCovarianceFixed},
+    {"unobservable_translation_mm", kCovarianceFixed},
+    {"unobservable_rotation_deg", kCovarianceFixed},
+    {"use_stereo_alignment",
+     "the stereo-LiDAR alignment is the start, not a measurement in the cost"},
+    {"vertical_alignment", kFromMotion},
+};
+
+}  // namespace
+
+void RefuseRemovedJointAdjusterOptions(int argc, char** argv, const std::string& prefix) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    for (const RemovedOption& removed : kRemovedOptions) {
+      const std::string flag = "--" + prefix + removed.name;
+      if (argument == flag || argument.rfind(flag + "=", 0) == 0) {
+        throw std::invalid_argument(flag + " is no longer an option: " + removed.replacement);
+      }
+    }
+  }
 }
 
 namespace {
@@ -712,6 +734,7 @@ int RunJointAdjuster(int argc, char** argv) {
                            "rig.json's cam_from_lidar_guess");
   options.AddDefaultOption("registration_path", &registration_path, kRegistrationPathHelp);
   AddJointAdjusterOptions("", &options, &joint);
+  RefuseRemovedJointAdjusterOptions(argc, argv, "");
   options.Parse(argc, argv);
   THROW_CHECK(joint.Check());  // before any file is read
   paths.database_path = *options.database_path;

@@ -484,6 +484,7 @@ int RunPipeline(int argc, char** argv) {
   PipelineOptions pipeline;
   colmap::OptionManager manager;
   AddPipelineOptions(&manager, &pipeline);
+  RefuseRemovedJointAdjusterOptions(argc, argv, "JointAdjuster.");
   manager.Parse(argc, argv);
   TakeColmapImportOptions(manager, &pipeline.import);
   pipeline.joint.mode = pipeline.mode;

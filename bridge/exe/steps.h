@@ -191,6 +191,9 @@ struct JointAdjusterStepOptions {
 void AddJointAdjusterOptions(const std::string& prefix,
                              colmap::OptionManager* manager,
                              JointAdjusterStepOptions* options);
+// Throws std::invalid_argument naming the first of argv that is an option joint_adjuster no longer
+// takes (under `prefix`, e.g. "JointAdjuster." in the pipeline) and what decides its value now.
+void RefuseRemovedJointAdjusterOptions(int argc, char** argv, const std::string& prefix);
 struct JointAdjusterPaths {
   std::string database_path;
   std::string input_path;
