@@ -164,6 +164,13 @@ bool PrepareCamera(const StationDataset& dataset,
   bool all_extracted = true;
   for (const std::string& name : names) {
     if (!database.ExistsImageWithName(name)) {
+      // COLMAP's extraction numbers new images in the order its threads finish them, and the
+      // matcher's pair order follows the ids. Written here in station order, the images get the
+      // same ids in every run; the extraction then fills in their features.
+      colmap::Image image;
+      image.SetName(name);
+      image.SetCameraId(summary->camera_id);
+      database.WriteImage(image);
       ++summary->num_new_images;
       all_extracted = false;
     } else if (!database.ExistsKeypoints(database.ReadImageWithName(name).ImageId())) {
@@ -354,12 +361,6 @@ std::string DatasetImportOptions::ImageName(const StationDataset& dataset, size_
 colmap::SpatialMatchingOptions LidarSpatialMatchingOptions() {
   colmap::SpatialMatchingOptions options;
   options.ignore_z = false;
-  return options;
-}
-
-colmap::SiftMatchingOptions DeterministicSiftMatchingOptions() {
-  colmap::SiftMatchingOptions options;
-  options.num_threads = 1;
   return options;
 }
 

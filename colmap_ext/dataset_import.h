@@ -26,15 +26,10 @@
 namespace colmap_lidar {
 
 colmap::SpatialMatchingOptions LidarSpatialMatchingOptions();
-// COLMAP's defaults except num_threads = 1. COLMAP's verifier threads draw RANSAC samples from one
-// generator per thread, so with several threads a pair's inliers depend on which thread took it and
-// what that thread verified before; one matcher and one verifier thread give the same matches in
-// every run, and every later step inherits that.
-colmap::SiftMatchingOptions DeterministicSiftMatchingOptions();
 
 struct DatasetImportOptions {
   colmap::SiftExtractionOptions sift_extraction;
-  colmap::SiftMatchingOptions sift_matching = DeterministicSiftMatchingOptions();
+  colmap::SiftMatchingOptions sift_matching;
   colmap::TwoViewGeometryOptions two_view_geometry;
   // "exhaustive" (every image pair), "sequential" (each image with its successors by name, for
   // frames of a moving platform: SequentialMatchingOptions::overlap of them) or "spatial" (each image

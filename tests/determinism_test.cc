@@ -1,29 +1,21 @@
 // The same output with one thread and with four: lidar_registrator, joint_adjuster and densifier on
 // the default pipeline workspace (tests/testing/pipeline_fixture.h), each run with OMP_NUM_THREADS=1
 // and =4 into folders of its own and compared byte by byte (report.json without its timings).
+#include "tests/testing/file_bytes.h"
 #include "tests/testing/pipeline_fixture.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace colmap_lidar {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::FileBytes;
 using testing::kCli;
 using testing::ReadJson;
 using testing::RunCommand;
-
-std::string FileBytes(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  EXPECT_TRUE(file) << "cannot read " << path;
-  std::ostringstream bytes;
-  bytes << file.rdbuf();
-  return bytes.str();
-}
 
 // `json` without the keys that hold wall-clock times.
 nlohmann::json WithoutTimings(nlohmann::json json) {
@@ -62,7 +54,9 @@ class DeterminismTest : public ::testing::Test {
                               const std::string& four,
                               const std::vector<std::string>& files) {
     for (const std::string& name : files) {
-      EXPECT_EQ(FileBytes(one + "/" + name), FileBytes(four + "/" + name)) << name;
+      const std::string bytes = FileBytes(one + "/" + name);
+      EXPECT_FALSE(bytes.empty()) << "cannot read " << one << "/" << name;
+      EXPECT_EQ(bytes, FileBytes(four + "/" + name)) << name;
     }
   }
 

@@ -7,6 +7,7 @@
 #include "lidar/statistics.h"
 #include "tests/simulator/scene.h"
 #include "tests/simulator/simulate_dataset.h"
+#include "tests/testing/file_bytes.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 
@@ -29,18 +30,12 @@ namespace colmap_lidar {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::FileBytes;
 using testing::RunCommand;
 
 const std::string kCli = COLMAP_LIDAR_CLI_EXE;
 const std::string kColmap = COLMAP_LIDAR_COLMAP_EXE;
 const std::string kSift = " --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2";
-
-std::string FileBytes(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << file.rdbuf();
-  return bytes.str();
-}
 
 std::string Simulate(const testing::ScopedTempDir& dir,
                      const std::string& name,

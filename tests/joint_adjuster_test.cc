@@ -4,6 +4,7 @@
 #include "bridge/calibration_evaluation.h"
 #include "colmap_ext/station_dataset.h"
 #include "tests/simulator/simulate_dataset.h"
+#include "tests/testing/file_bytes.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 
@@ -23,6 +24,7 @@ namespace colmap_lidar {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::FileBytes;
 using testing::RunCommand;
 using testing::RunStep;
 
@@ -181,11 +183,6 @@ TEST(JointAdjusterTest, DefaultSceneWithNoise) {
   EXPECT_LT(joint.evaluation.mean_position_error_mm, stereo_only.evaluation.mean_position_error_mm);
   EXPECT_TRUE(fs::exists(dir.File("joint/perturbation_rotation.png")));
   EXPECT_TRUE(fs::exists(dir.File("joint/cost.png")));
-}
-
-std::string FileBytes(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
 }
 
 // Results do not depend on the thread count: OpenMP's (associations) and Ceres' (the solves).

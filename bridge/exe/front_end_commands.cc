@@ -17,7 +17,6 @@ void AddImportStepOptions(const std::string& prefix,
   // GPU SIFT needs CUDA or an OpenGL context; a headless build has neither.
   manager->sift_extraction->use_gpu = false;
   manager->sift_matching->use_gpu = false;
-  manager->sift_matching->num_threads = options->import.sift_matching.num_threads;
   manager->AddExtractionOptions();
   manager->AddExhaustiveMatchingOptions();
   manager->AddSequentialMatchingOptions();
