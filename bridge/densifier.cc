@@ -434,6 +434,30 @@ nlohmann::json DensifierReport(const DensifierOptions& options,
   return report;
 }
 
+// Joins each station's LiDAR points into the map in station order, whatever order the stations
+// finish in: a voxel's mean depends on the order of its sums. A station that finishes early waits
+// here until those before it have joined.
+class StationOrderedMap {
+ public:
+  explicit StationOrderedMap(VoxelAccumulator* map) : map_(map) {}
+
+  // Not thread-safe: the caller serialises the calls.
+  void Add(int station, std::vector<Eigen::Vector3d> points) {
+    waiting_[station] = std::move(points);
+    for (auto next = waiting_.begin(); next != waiting_.end() && next->first == next_station_;
+         next = waiting_.erase(next), ++next_station_) {
+      for (const Eigen::Vector3d& point : next->second) {
+        map_->Add(point, Eigen::Vector3f::Zero(), Color3ub(128, 128, 128));
+      }
+    }
+  }
+
+ private:
+  VoxelAccumulator* map_;
+  std::map<int, std::vector<Eigen::Vector3d>> waiting_;
+  int next_station_ = 0;
+};
+
 }  // namespace
 
 bool DensifierOptions::Check() const {
@@ -478,10 +502,7 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
   summary.stations.resize(views.size());
   std::mutex mutex;
   size_t num_done = 0;
-  // Each station's LiDAR points join the map in station order (a voxel's mean depends on the order
-  // of its sums): finished stations wait here until those before them have joined.
-  std::map<int, std::vector<Eigen::Vector3d>> waiting;
-  int next_to_join = 0;
+  StationOrderedMap ordered_lidar_map(&lidar_map);
   ParallelForEach(static_cast<int>(views.size()), [&](int k) {
     const auto station_start = std::chrono::steady_clock::now();
     const colmap::camera_t camera_id = input_model.Image(views[k].image_id).CameraId();
@@ -499,13 +520,7 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
                       undistorter == undistorters.end() ? nullptr : undistorter->second.get(),
                       &points_in_world);
     std::lock_guard<std::mutex> lock(mutex);
-    waiting[k] = std::move(points_in_world);
-    for (auto next = waiting.begin(); next != waiting.end() && next->first == next_to_join;
-         next = waiting.erase(next), ++next_to_join) {
-      for (const Eigen::Vector3d& point : next->second) {
-        lidar_map.Add(point, Eigen::Vector3f::Zero(), Color3ub(128, 128, 128));
-      }
-    }
+    ordered_lidar_map.Add(k, std::move(points_in_world));
     station.seconds = SecondsSince(station_start);
     PrintStation(num_done++, views.size(), station);
     summary.stations[k] = std::move(station);
