@@ -145,8 +145,9 @@ void CheckNewImagesExist(const StationDataset& dataset,
   }
 }
 
-// Before extraction: every new image exists, the stations' camera is chosen (and counted into
-// `summary`); true if every station image is in the database with its features already.
+// Before extraction: every new image exists, the stations' camera is chosen, and the new images are
+// written in station order (counted into `summary`); true if every station image is in the database
+// with its features already.
 bool PrepareCamera(const StationDataset& dataset,
                    const std::vector<std::string>& names,
                    const std::string& image_path,

@@ -1,7 +1,6 @@
 // colmap-lidar joint_adjuster: the joint problem on a COLMAP sparse model (bridge/joint_adjuster.h).
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
-#include "bridge/exe/stereo_alignment_report.h"
 #include "bridge/exe/vertical_alignment_step.h"
 #include "bridge/joint_adjuster.h"
 #include "bridge/joint_problem_data.h"
@@ -391,8 +390,6 @@ bool JointAdjusterStepOptions::Check() {
   CHECK_OPTION(vertical_alignment >= -1 && vertical_alignment <= 1);
   adjuster.mode = JointModeFromName(mode);
   adjuster.hold_translation = ParseHeldAxes(hold_translation);
-  CHECK_OPTION_GT(num_samples_per_pair, 0);
-  adjuster.association.num_samples = static_cast<size_t>(num_samples_per_pair);
   CHECK_OPTION(landmark_lidar_weight == -1 || landmark_lidar_weight >= 0);
   if (landmark_lidar_weight >= 0) adjuster.landmark_lidar_weight = landmark_lidar_weight;
   return adjuster.Check() && data.Check();
@@ -467,9 +464,9 @@ constexpr RemovedOption kRemovedOptions[] = {
     {"max_association_rounds", kRoundsFixed},
     {"round_convergence_deg", kRoundsFixed},
     {"round_convergence_mm", kRoundsFixed},
-    {"initial_association_distance_m", kRoundsFixed},
-    {"association_max_distance_m", kRoundsFixed},
-    {"max_num_iterations", kRoundsFixed},
+    {"initial_association_distance_m", kGatesFixed},
+    {"association_max_distance_m", kGatesFixed},
+    {"max_num_iterations", "each solve runs up to Ceres' fixed iteration limit (100)"},
     {"num_samples_per_pair", kSamplingFixed},
     {"normal_space_sampling", kSamplingFixed},
     {"max_lidar_neighbors", kSamplingFixed},
@@ -509,8 +506,6 @@ namespace {
 // What pose_initializer wrote about its start (INPUT/initialization.json), if anything.
 struct InitialisationFacts {
   bool one_axis = false;  // every rotation about one axis (a driving platform)
-  // The stereo-LiDAR alignment, if it was used.
-  std::optional<ExtrinsicMeasurement> stereo_alignment;
 };
 
 // A model without one (e.g. the user's own) has no facts; an unreadable one is an error naming it.
@@ -525,7 +520,6 @@ InitialisationFacts ReadInitialisationFacts(const std::string& input_path) {
   }
   facts.one_axis = init.contains("hand_eye") &&
                    init["hand_eye"].contains("unobservable_translation_axis_in_cam");
-  facts.stereo_alignment = ReadStereoAlignmentMeasurement(init, path.string());
   return facts;
 }
 
@@ -580,9 +574,8 @@ bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& 
 // number of residuals (docs/joint_adjuster.md).
 constexpr double kMovingPlatformLandmarkWeight = 0.25;
 
-// In joint mode: rig.json's guess with a sigma as a prior; the pose initialiser's stereo-LiDAR
-// alignment, or else the vertical alignment (which the cameras' start then takes). Returns the
-// vertical alignment if it ran.
+// In joint mode: rig.json's guess with a sigma as a prior, and the vertical alignment (which the
+// start then takes when significant). Returns the vertical alignment if it ran.
 std::optional<VerticalAlignment> AddExtrinsicMeasurements(
     const StationDataset& dataset,
     const InitialisationFacts& facts,
@@ -595,11 +588,6 @@ std::optional<VerticalAlignment> AddExtrinsicMeasurements(
   if (dataset.rig.cam_from_lidar_guess && dataset.rig.cam_from_lidar_guess_sigma) {
     measurements.push_back(GuessPrior(dataset.rig));
     PrintMeasurement(measurements.back());
-  }
-  if (options.use_stereo_alignment && facts.stereo_alignment) {
-    measurements.push_back(*facts.stereo_alignment);
-    PrintMeasurement(measurements.back());
-    return std::nullopt;
   }
   if (options.vertical_alignment != 1) return std::nullopt;
   std::optional<VerticalAlignment> vertical = MeasureStationVerticals(
@@ -636,8 +624,8 @@ void ResolveAutomaticOptions(const StationDataset& dataset,
     std::ostringstream weight;  // std::cout may hold a fixed precision of 1
     weight << kMovingPlatformLandmarkWeight;
     std::cout << "A moving platform whose stations do not rotate about two axes (" << motion.verdict
-              << "): the landmark-to-LiDAR-plane term is on (--landmark_lidar_weight "
-              << weight.str() << ")" << std::endl;
+              << "): the landmark-to-LiDAR-plane term is on (weight " << weight.str() << ")"
+              << std::endl;
   }
 }
 

@@ -167,16 +167,9 @@ struct JointAdjusterStepOptions {
   // stereo rig, tripods included (decided by RunJointAdjusterStep); into `adjuster` by Check() when
   // >= 0.
   double landmark_lidar_weight = -1;
-  // LiDAR samples per pair (int for the OptionManager); into `adjuster.association` by Check().
-  int num_samples_per_pair = static_cast<int>(JointAdjusterOptions().association.num_samples);
-  // Also take the pose initialiser's stereo-LiDAR alignment (INPUT/initialization.json) as a
-  // measurement of cam_from_lidar in joint mode (it is always the start). Off: the alignment fits
-  // the same stereo depth and LiDAR that the depth priors and E_l bring into the cost, so its
-  // information would count twice.
-  bool use_stereo_alignment = false;
   // Measure cam_from_lidar's tilt from the vertical structure both sensors see
-  // (bridge/vertical_alignment.h), start from it and take it as a measurement, in joint mode when no
-  // stereo-LiDAR alignment is one: 1 on, 0 off, -1 on for a moving platform whose stations do not
+  // (bridge/vertical_alignment.h), start from it and take it as a measurement, in joint mode: 1 on,
+  // 0 off, -1 on for a moving platform whose stations do not
   // rotate about two axes (decided by RunJointAdjusterStep, as for landmark_lidar_weight).
   int vertical_alignment = -1;
   // On a moving platform (rig.json), estimate the LiDAR clock's offset from the cameras in E_m
@@ -185,7 +178,7 @@ struct JointAdjusterStepOptions {
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
   bool write_text = false;
 
-  // Copies mode, hold_translation and num_samples_per_pair in; throws on a malformed one.
+  // Copies mode and hold_translation in; throws on a malformed one.
   bool Check();
 };
 void AddJointAdjusterOptions(const std::string& prefix,
