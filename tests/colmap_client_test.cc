@@ -177,6 +177,17 @@ TEST(CliTest, HelpVersionAndErrors) {
             std::string::npos)
       << removed_in_pipeline.output;
   EXPECT_FALSE(fs::exists(dir.File("ws")));
+  // The same in a project file (--project_path), in a section or at the top level.
+  std::ofstream(dir.File("project.ini")) << "[JointAdjuster]\nsigma_lidar_m=0.01\n"
+                                            "max_landmark_plane_sigmas = 2\n";
+  const auto removed_in_project =
+      RunCommand(cli + " pipeline --project_path " + dir.File("project.ini"));
+  EXPECT_NE(removed_in_project.exit_code, 0);
+  EXPECT_NE(removed_in_project.output.find(dir.File("project.ini") +
+                                           ": JointAdjuster.max_landmark_plane_sigmas is no "
+                                           "longer an option"),
+            std::string::npos)
+      << removed_in_project.output;
 
   // The pipeline registers every step's options under the step's section; a bad one is refused
   // before the workspace is created.

@@ -1,5 +1,6 @@
-// Kill it, run it again (docs/reliability.md): the pipeline is killed with SIGKILL at 10 seeded moments
-// spread over an uninterrupted run's duration (every step gets hit). After each kill the database passes
+// Kill it, run it again (docs/reliability.md): the pipeline is killed with SIGKILL once inside every
+// step that lasted 0.2 s or more in an uninterrupted run, at a seeded moment in the middle half of the
+// step (from the previous step's marker on). After each kill the database passes
 // SQLite's integrity check, no step is marked done without its output, no OUTPUT.partial folder stands
 // where a result belongs, and a rerun on the same workspace finishes and gives the uninterrupted run's
 // cam_from_lidar within the run-to-run spread of COLMAP's feature matching (our own steps are
@@ -16,8 +17,10 @@
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -76,38 +79,76 @@ void ExpectConsistentWorkspace(const fs::path& ws, const std::string& when) {
   }
 }
 
-TEST(KillRerunTest, KilledAtTenMomentsTheRerunGivesTheSameCalibration) {
+// A step of the uninterrupted run to kill the pipeline in: its name, the step before it (empty for the
+// first) and its wall time [s], from that run's pipeline_steps.csv (step, status, wall seconds, ...).
+struct KillTarget {
+  std::string step;
+  std::string previous_step;
+  double wall_s = 0;
+};
+
+// Every step that lasted at least `min_wall_s`.
+std::vector<KillTarget> KillTargets(const std::string& steps_csv, double min_wall_s) {
+  std::vector<KillTarget> targets;
+  std::string previous;
+  std::ifstream file(steps_csv);
+  for (std::string line; std::getline(file, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::stringstream fields(line);
+    std::string step, status, wall;
+    std::getline(fields, step, ',');
+    std::getline(fields, status, ',');
+    std::getline(fields, wall, ',');
+    if (std::stod(wall) >= min_wall_s) targets.push_back({step, previous, std::stod(wall)});
+    previous = step;
+  }
+  return targets;
+}
+
+// Waits until `target`'s step has begun in WS (the previous step's marker is written) and then for
+// `within` of its wall time; false if the pipeline `pid` ended first.
+bool WaitIntoStep(pid_t pid, const fs::path& ws, const KillTarget& target, double within) {
+  const fs::path marker = ws / "steps" / (target.previous_step + ".done");
+  while (!target.previous_step.empty() && !fs::exists(marker)) {
+    if (waitpid(pid, nullptr, WNOHANG) == pid) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::this_thread::sleep_for(std::chrono::duration<double>(within * target.wall_s));
+  return true;
+}
+
+TEST(KillRerunTest, KilledInEveryStepTheRerunGivesTheSameCalibration) {
   testing::ScopedTempDir dir("colmap_lidar_kill");
   sim::SimulateSmallDataset(dir.File("dataset"), 6, 0.5, 60000);
 
-  const auto start = std::chrono::steady_clock::now();
   const pid_t reference =
       StartPipeline(dir.File("dataset"), dir.File("reference"), dir.File("r.log"));
   int status = 0;
   ASSERT_EQ(waitpid(reference, &status, 0), reference);
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "see " << dir.File("r.log");
-  const double duration_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const colmap::Rigid3d expected =
       ReadPoseFile(dir.File("reference/sparse/joint/cam_from_lidar.txt"));
 
+  const std::vector<KillTarget> targets =
+      KillTargets(dir.File("reference/pipeline_steps.csv"), 0.2);
+  ASSERT_GE(targets.size(), 5u) << "import, registration, initialisation, joint, densifier";
   std::mt19937 rng(17);
-  for (int k = 0; k < 10; ++k) {
-    // Moments spread over the whole run: the k-th tenth of it, at a seeded place within.
-    const double at_s = duration_s * (k + std::uniform_real_distribution<double>(0, 1)(rng)) / 10;
+  for (size_t k = 0; k < targets.size(); ++k) {
+    const double within = std::uniform_real_distribution<double>(0.25, 0.75)(rng);
     const fs::path ws = dir.Path() / ("ws" + std::to_string(k));
     const pid_t pid = StartPipeline(dir.File("dataset"), ws.string(), dir.File("killed.log"));
-    std::this_thread::sleep_for(std::chrono::duration<double>(at_s));
+    ASSERT_TRUE(WaitIntoStep(pid, ws, targets[k], within)) << targets[k].step << " never began";
     kill(pid, SIGKILL);
     waitpid(pid, &status, 0);
-    const std::string when = "killed at " + std::to_string(at_s) + " s";
+    const std::string when =
+        "killed " + std::to_string(within * targets[k].wall_s) + " s into " + targets[k].step;
     ExpectConsistentWorkspace(ws, when);
     const testing::CommandResult rerun = RunCommand(
         kPipeline + " --dataset_path " + dir.File("dataset") + " --workspace_path " + ws.string());
     ASSERT_EQ(rerun.exit_code, 0) << when << "\n" << rerun.output;
     const colmap::Rigid3d result = ReadPoseFile((ws / "sparse/joint/cam_from_lidar.txt").string());
     // COLMAP's matching differs from run to run (docs/reliability.md, Determinism): measured between
-    // the uninterrupted run and 10 reruns up to 0.107 deg, 4.8 mm; bounds about 3x.
+    // the uninterrupted run and its reruns up to 0.107 deg, 4.8 mm; bounds about 3x.
     const double rotation_deg = AngleDeg(result, expected);
     const double translation_mm = 1000 * (result.translation - expected.translation).norm();
     std::cout << when << ": rerun differs from the uninterrupted run by " << rotation_deg

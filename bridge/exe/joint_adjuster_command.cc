@@ -489,13 +489,54 @@ constexpr RemovedOption kRemovedOptions[] = {
 
 }  // namespace
 
+namespace {
+
+// The option keys of a COLMAP project file (boost's ini syntax): "key = value" lines, a key under a
+// "[Section]" header named "Section.key".
+std::vector<std::string> ProjectFileKeys(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw std::invalid_argument("cannot read the project file " + path);
+  std::vector<std::string> keys;
+  std::string section;
+  for (std::string line; std::getline(file, line);) {
+    const size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    if (line[first] == '[') {
+      section = line.substr(first + 1, line.find(']') - first - 1) + ".";
+      continue;
+    }
+    const std::string key = line.substr(first, line.find('=') - first);
+    keys.push_back(section + key.substr(0, key.find_last_not_of(" \t") + 1));
+  }
+  return keys;
+}
+
+// The removed option `key` names (with `prefix`), or null.
+const RemovedOption* FindRemovedOption(const std::string& key, const std::string& prefix) {
+  for (const RemovedOption& removed : kRemovedOptions) {
+    if (key == prefix + removed.name) return &removed;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 void RefuseRemovedJointAdjusterOptions(int argc, char** argv, const std::string& prefix) {
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
-    for (const RemovedOption& removed : kRemovedOptions) {
-      const std::string flag = "--" + prefix + removed.name;
-      if (argument == flag || argument.rfind(flag + "=", 0) == 0) {
-        throw std::invalid_argument(flag + " is no longer an option: " + removed.replacement);
+    if (argument.rfind("--", 0) != 0) continue;
+    const std::string key = argument.substr(2, argument.find('=') - 2);
+    if (const RemovedOption* removed = FindRemovedOption(key, prefix)) {
+      throw std::invalid_argument("--" + key + " is no longer an option: " + removed->replacement);
+    }
+    if (key != "project_path") continue;
+    const std::string path = argument.find('=') != std::string::npos
+                                 ? argument.substr(argument.find('=') + 1)
+                                 : (i + 1 < argc ? argv[i + 1] : "");
+    for (const std::string& file_key : ProjectFileKeys(path)) {
+      if (const RemovedOption* removed = FindRemovedOption(file_key, prefix)) {
+        throw std::invalid_argument(path + ": " + file_key +
+                                    " is no longer an option: " + removed->replacement);
       }
     }
   }

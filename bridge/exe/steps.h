@@ -185,7 +185,8 @@ void AddJointAdjusterOptions(const std::string& prefix,
                              colmap::OptionManager* manager,
                              JointAdjusterStepOptions* options);
 // Throws std::invalid_argument naming the first of argv that is an option joint_adjuster no longer
-// takes (under `prefix`, e.g. "JointAdjuster." in the pipeline) and what decides its value now.
+// takes (under `prefix`, e.g. "JointAdjuster." in the pipeline), on the command line or in the project
+// file of --project_path, and what decides its value now.
 void RefuseRemovedJointAdjusterOptions(int argc, char** argv, const std::string& prefix);
 struct JointAdjusterPaths {
   std::string database_path;
