@@ -1,7 +1,8 @@
 // Straight segments of an image (OpenCV's line segment detector, LSD) and their interpretation
 // planes: the plane through the camera centre and a segment contains the segment's 3D line, so its
 // unit normal is perpendicular to that line's direction in the camera frame. Vertical segments thus
-// measure the vertical in the camera frame (bridge/vertical_alignment.h). Not part of Zhen et al. 2019.
+// measure the vertical in the camera frame (bridge/initialization/vertical_alignment.h). Not part
+// of Zhen et al. 2019.
 #pragma once
 
 #include "colmap/scene/camera.h"

@@ -3,7 +3,7 @@
 // in a camera frame is perpendicular to the interpretation planes of vertical image lines (the plane
 // through the camera centre and a segment contains the segment's 3D direction). Not part of Zhen et
 // al. 2019: it measures cam_from_lidar's tilt about the two horizontal axes where motion cannot
-// (bridge/vertical_alignment.h).
+// (bridge/initialization/vertical_alignment.h).
 #pragma once
 
 #include <Eigen/Core>

@@ -2,8 +2,8 @@
 // the first node of each connected component), then a Ceres refinement over every edge with a robust
 // loss on the whitened residuals (relative_pose_error.h), the first node of each component held as the
 // gauge. One module for the LiDAR pose graph A_l (lidar_pose_graph.h) and the camera pose graph
-// A_c v A_l of the initialisation (bridge/pose_initializer.h). Poses are world_from_node; an edge
-// measures target_from_source, so world_from_source = world_from_target * target_from_source.
+// A_c v A_l of the initialisation (bridge/initialization/pose_initializer.h). Poses are
+// world_from_node; an edge measures target_from_source, so world_from_source = world_from_target * target_from_source.
 #pragma once
 
 #include <Eigen/Core>

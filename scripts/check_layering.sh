@@ -2,7 +2,9 @@
 # Fails when a layer includes (or links) what it must not:
 #   lidar/       no COLMAP, no colmap_ext/bridge/tests; its public headers (.h) include only Eigen and std
 #   colmap_ext/  no lidar/, bridge/ or tests/
-#   bridge/      no tests/ (only the CLI main, bridge/exe/colmap_lidar_main.cc, links the simulator)
+#   bridge/      no tests/ (only the CLI main, bridge/exe/colmap_lidar_main.cc, links the simulator);
+#                its concern folders (initialization, joint, dense, baselines, evaluation) include
+#                none of each other
 #   bridge/exe/  the commands: nothing outside it includes bridge/exe/ (algorithms never include a
 #                command), and the bridge library's sources list none of its files
 #   all layers   no struct or class name defined in two headers (one namespace: an ODR violation)
@@ -27,6 +29,13 @@ hits=$(grep -rnE '^\s*#\s*include\s*"tests/' --include='*.h' --include='*.cc' br
        grep -vE '_test\.cc:[0-9]+:\s*#\s*include\s*"tests/testing/' || true)
 [ -z "$hits" ] || violation "the bridge library must not include tests/:"$'\n'"$hits"
 
+# bridge/'s concern folders stand side by side: none includes another's headers.
+for concern in initialization joint dense baselines evaluation; do
+  others=$(echo initialization joint dense baselines evaluation | tr ' ' '\n' | grep -vx "$concern" |
+           paste -sd'|')
+  check_includes "bridge/$concern" "bridge/($others)/" "another concern folder of bridge/"
+done
+
 # Commands apart from algorithms: only bridge/exe/ includes bridge/exe/.
 hits=$(grep -rnE '^\s*#\s*include\s*"bridge/exe/' --include='*.h' --include='*.cc' \
          lidar colmap_ext bridge tests | grep -v '^bridge/exe/' || true)
@@ -50,8 +59,8 @@ sed -n '/add_library(colmap_lidar_bridge/,/^)/p;/target_link_libraries(colmap_li
 # One definition per type name: the layers share the namespace colmap_lidar, and two headers defining
 # one struct or class name is an ODR violation the linker does not report (it merges their inline
 # functions: a vector of one type reallocated with the other's layout).
-hits=$(grep -HnoE '^(struct|class) [A-Za-z0-9_]+( final)? ?[:{]' lidar/*.h colmap_ext/*.h bridge/*.h \
-         bridge/exe/*.h | awk -F'[: ]' '{print $4, $1 ":" $2}' | sort |
+hits=$(grep -HnoE '^(struct|class) [A-Za-z0-9_]+( final)? ?[:{]' lidar/*.h colmap_ext/*.h bridge/*/*.h \
+         | awk -F'[: ]' '{print $4, $1 ":" $2}' | sort |
        awk '{n[$1]++; where[$1] = where[$1] " " $2} END {for (t in n) if (n[t] > 1) print t ":" where[t]}')
 [ -z "$hits" ] || violation "type names defined in more than one header:"$'\n'"$hits"
 

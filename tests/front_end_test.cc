@@ -1,7 +1,7 @@
 // The front end through the CLI on simulated stations: import_dataset (COLMAP SIFT into the database),
 // stereo_depth, depth_prior_extractor; accuracy against the simulator's ground truth; COLMAP's own
 // mapper on the imported database; bad input.
-#include "bridge/lidar_registration_files.h"
+#include "bridge/initialization/lidar_registration_files.h"
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/statistics.h"

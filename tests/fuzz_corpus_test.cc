@@ -1,7 +1,7 @@
 // Replays the fuzzers' corpus (tests/fuzz/corpus/<target>/, seeds and every input a fuzzer or a user
 // once crashed us with) through the same readers as the fuzz targets, in the normal build: each file
 // is read or refused with an exception naming the file; regression_* files must be refused.
-#include "bridge/lidar_registration_files.h"
+#include "bridge/initialization/lidar_registration_files.h"
 #include "colmap_ext/dense_workspace.h"
 #include "colmap_ext/kitti_oxts.h"
 #include "colmap_ext/station_dataset.h"

@@ -6,7 +6,7 @@
 // axes, translation along them). Measured: 88-98 % per axis, rms error/sigma 0.9-1.2. The formal
 // covariance (no clusters, no stereo-scale consider term) covers tz 46 % of the time; the rotation
 // axes fail while the manifold's tangent is read as a rotation vector (half the angle).
-#include "bridge/joint_adjuster.h"
+#include "bridge/joint/joint_adjuster.h"
 #include "tests/testing/synthetic_joint_problem.h"
 
 #include <gtest/gtest.h>

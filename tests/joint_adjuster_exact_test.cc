@@ -2,7 +2,7 @@
 // tests/testing/synthetic_joint_problem.h): exact data recovers the truth; the outlier loop's rules
 // (depth gate in sigma_d units, priors coming back, a capped loop) and the observability guard behave as
 // documented. Uses the C++ API directly.
-#include "bridge/joint_adjuster.h"
+#include "bridge/joint/joint_adjuster.h"
 #include "tests/testing/synthetic_joint_problem.h"
 
 #include <gtest/gtest.h>

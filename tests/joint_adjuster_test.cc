@@ -1,7 +1,7 @@
 // The joint problem end to end on simulated stations, through the CLI: simulate -> stereo_depth ->
 // import_dataset -> depth_prior_extractor -> an initial model (true poses perturbed, landmarks
 // triangulated by the real `colmap point_triangulator`) -> joint_adjuster; accuracy against ground truth.
-#include "bridge/calibration_evaluation.h"
+#include "bridge/evaluation/calibration_evaluation.h"
 #include "colmap_ext/station_dataset.h"
 #include "tests/simulator/simulate_dataset.h"
 #include "tests/testing/file_bytes.h"

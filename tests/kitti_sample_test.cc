@@ -5,7 +5,7 @@
 // and clouds share nothing.) With default options the registration must group the sweeps by place,
 // with the car's standstill as the relative motion, close the one 3-cycle, and refuse every pair across
 // places.
-#include "bridge/vertical_alignment.h"
+#include "bridge/initialization/vertical_alignment.h"
 #include "colmap_ext/kitti_calibration.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
@@ -237,8 +237,8 @@ TEST(KittiSampleTest, EdgeCalibrationRecoversTheRotationFromAThreeDegreeGuess) {
 namespace colmap_lidar {
 namespace {
 
-// The vertical alignment (bridge/vertical_alignment.h) on the real sweeps and images, which needs no
-// motion (the car stands). Measured at KITTI's reference: 0.71 and -1.04 deg on the two measured axes
+// The vertical alignment (bridge/initialization/vertical_alignment.h) on the real sweeps and
+// images, which needs no motion (the car stands). Measured at KITTI's reference: 0.71 and -1.04 deg on the two measured axes
 // with sigmas of 1.2 and 1.0 deg. The six frames see three places; at the building entrance (frames
 // 1 and 34) walls and image edges disagree by 1.2-1.3 deg, at the square the camera's vertical edges
 // are few among slanted ones (fit RMS 5-7 deg). So on this sample the measurement is weak, and it

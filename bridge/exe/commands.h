@@ -41,7 +41,7 @@ int RunJointAdjuster(int argc, char** argv);
 int RunPoseInitializer(int argc, char** argv);
 
 // The dense model: stereo depth refined by LiDAR (remove, fill), fused.ply, lidar_map.ply and COLMAP's
-// dense workspace (bridge/densifier.h).
+// dense workspace (bridge/dense/densifier.h).
 int RunDensifier(int argc, char** argv);
 
 // Every step from a station dataset to the refined model, restartable (bridge/pipeline_commands.cc).
@@ -54,7 +54,7 @@ int RunEvaluateModel(int argc, char** argv);
 int RunEvaluateCalibration(int argc, char** argv);
 
 // A trajectory (lidar_poses.txt, a COLMAP model, KITTI or TUM poses) against a reference: KITTI's
-// relative errors, per-step and absolute errors, plots (bridge/trajectory_evaluation.h).
+// relative errors, per-step and absolute errors, plots (bridge/evaluation/trajectory_evaluation.h).
 int RunEvaluateTrajectory(int argc, char** argv);
 
 // The database's depth priors against ground_truth/depth/: errors in units of sigma_d, at and away
@@ -66,7 +66,7 @@ int RunEvaluateDepthPriors(int argc, char** argv);
 int RunEvaluateDenseDepth(int argc, char** argv);
 
 // cam_from_lidar from image edges and LiDAR depth discontinuities (Levinson & Thrun 2013), the
-// baseline of the paper's comparison (bridge/edge_calibration.h).
+// baseline of the paper's comparison (bridge/baselines/edge_calibration.h).
 int RunCalibrateEdges(int argc, char** argv);
 
 }  // namespace colmap_lidar

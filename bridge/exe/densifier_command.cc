@@ -1,7 +1,7 @@
-// colmap-lidar densifier: the dense model of a refined sparse model (bridge/densifier.h).
+// colmap-lidar densifier: the dense model of a refined sparse model (bridge/dense/densifier.h).
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
-#include "bridge/lidar_registration_files.h"
+#include "bridge/initialization/lidar_registration_files.h"
 #include "colmap_ext/logging.h"
 
 #include <filesystem>

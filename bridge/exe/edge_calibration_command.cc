@@ -1,13 +1,13 @@
 // colmap-lidar calibrate_edges: cam_from_lidar by the edge-based method of Levinson & Thrun (RSS 2013),
-// the baseline the joint optimisation is compared with (bridge/edge_calibration.h).
+// the baseline the joint optimisation is compared with (bridge/baselines/edge_calibration.h).
 //   OUTPUT/cam_from_lidar.txt   qw qx qy qz tx ty tz (quaternion w first)
 //   OUTPUT/report.json          J at the start and end, F_c, moves per level, time, the options
 //   OUTPUT/edges_<station>.png  one station's edge transform, discontinuities before (red), after (green)
 // With --profile_axis, no grid search: J along the rotation about that camera axis through the start
-// (bridge/edge_axis_profile.h), the result turned to its peak, and OUTPUT/profile.png.
-#include "bridge/calibration_evaluation.h"
-#include "bridge/edge_axis_profile.h"
-#include "bridge/edge_calibration.h"
+// (bridge/baselines/edge_axis_profile.h), the result turned to its peak, and OUTPUT/profile.png.
+#include "bridge/baselines/edge_axis_profile.h"
+#include "bridge/baselines/edge_calibration.h"
+#include "bridge/evaluation/calibration_evaluation.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "colmap_ext/atomic_file.h"

@@ -1,4 +1,4 @@
-#include "bridge/calibration_evaluation.h"
+#include "bridge/evaluation/calibration_evaluation.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "colmap_ext/logging.h"

@@ -1,7 +1,7 @@
 // The front end's steps and commands: import_dataset, stereo_depth, depth_prior_extractor.
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
-#include "bridge/lidar_registration_files.h"
+#include "bridge/initialization/lidar_registration_files.h"
 #include "colmap_ext/logging.h"
 
 #include "colmap/feature/pairing.h"

@@ -1,11 +1,12 @@
-// colmap-lidar joint_adjuster: the joint problem on a COLMAP sparse model (bridge/joint_adjuster.h).
+// colmap-lidar joint_adjuster: the joint problem on a COLMAP sparse model
+// (bridge/joint/joint_adjuster.h).
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "bridge/exe/vertical_alignment_step.h"
-#include "bridge/joint_adjuster.h"
-#include "bridge/joint_problem_data.h"
-#include "bridge/lidar_registration_files.h"
-#include "bridge/start_departure.h"
+#include "bridge/initialization/lidar_registration_files.h"
+#include "bridge/joint/joint_adjuster.h"
+#include "bridge/joint/joint_problem_data.h"
+#include "bridge/joint/start_departure.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/plot.h"

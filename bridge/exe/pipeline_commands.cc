@@ -4,9 +4,9 @@
 #include "bridge/exe/steps.h"
 #include "bridge/exe/stereo_alignment_report.h"
 #include "bridge/exe/workspace_lock.h"
-#include "bridge/lidar_registration_files.h"
-#include "bridge/model_completion.h"
-#include "bridge/pose_initializer.h"
+#include "bridge/initialization/lidar_registration_files.h"
+#include "bridge/initialization/model_completion.h"
+#include "bridge/initialization/pose_initializer.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 

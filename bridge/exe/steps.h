@@ -8,13 +8,13 @@
 // as COLMAP's automatic_reconstructor does. Errors are thrown.
 #pragma once
 
-#include "bridge/densifier.h"
-#include "bridge/edge_axis_profile.h"
-#include "bridge/edge_calibration.h"
-#include "bridge/joint_adjuster.h"
-#include "bridge/joint_problem_data.h"
-#include "bridge/pose_initializer.h"
-#include "bridge/trajectory_evaluation.h"
+#include "bridge/baselines/edge_axis_profile.h"
+#include "bridge/baselines/edge_calibration.h"
+#include "bridge/dense/densifier.h"
+#include "bridge/evaluation/trajectory_evaluation.h"
+#include "bridge/initialization/pose_initializer.h"
+#include "bridge/joint/joint_adjuster.h"
+#include "bridge/joint/joint_problem_data.h"
 #include "colmap_ext/dataset_import.h"
 #include "colmap_ext/depth_prior_evaluation.h"
 #include "colmap_ext/depth_prior_extractor.h"
@@ -168,8 +168,8 @@ struct JointAdjusterStepOptions {
   // >= 0.
   double landmark_lidar_weight = -1;
   // Measure cam_from_lidar's tilt from the vertical structure both sensors see
-  // (bridge/vertical_alignment.h), start from it and take it as a measurement, in joint mode: 1 on,
-  // 0 off, -1 on for a moving platform whose stations do not
+  // (bridge/initialization/vertical_alignment.h), start from it and take it as a measurement, in
+  // joint mode: 1 on, 0 off, -1 on for a moving platform whose stations do not
   // rotate about two axes (decided by RunJointAdjusterStep, as for landmark_lidar_weight).
   int vertical_alignment = -1;
   // On a moving platform (rig.json), estimate the LiDAR clock's offset from the cameras in E_m
@@ -239,7 +239,8 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
                                 const std::string& output_path,
                                 const std::string& alignment);
 
-// evaluate_trajectory: a trajectory against a reference (bridge/trajectory_evaluation.h).
+// evaluate_trajectory: a trajectory against a reference
+// (bridge/evaluation/trajectory_evaluation.h).
 struct TrajectoryEvaluationStepOptions {
   std::string trajectory_path, reference_path, output_path;
   std::string trajectory_format = "auto", reference_format = "auto";

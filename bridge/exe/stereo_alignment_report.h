@@ -5,8 +5,8 @@
 // the rotation) then translation [m].
 #pragma once
 
-#include "bridge/joint_adjuster.h"
-#include "bridge/stereo_lidar_alignment.h"
+#include "bridge/initialization/stereo_lidar_alignment.h"
+#include "bridge/joint/joint_adjuster.h"
 
 #include <nlohmann/json.hpp>
 

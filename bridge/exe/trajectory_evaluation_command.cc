@@ -1,7 +1,8 @@
-// evaluate_trajectory: a trajectory against a reference (bridge/trajectory_evaluation.h).
+// evaluate_trajectory: a trajectory against a reference
+// (bridge/evaluation/trajectory_evaluation.h).
+#include "bridge/evaluation/trajectory_evaluation.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
-#include "bridge/trajectory_evaluation.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 

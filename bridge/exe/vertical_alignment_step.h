@@ -1,12 +1,12 @@
-// The joint adjuster's use of the vertical alignment (bridge/vertical_alignment.h): measured on the
-// registered images with clouds, turned into a measurement of cam_from_lidar's rotation about the two
+// The joint adjuster's use of the vertical alignment (bridge/initialization/vertical_alignment.h):
+// measured on the registered images with clouds, turned into a measurement of cam_from_lidar's rotation about the two
 // horizontal camera axes, and reported (report.json's "vertical_alignment", vertical_alignment.png).
 #pragma once
 
-#include "bridge/extrinsic_observability.h"
-#include "bridge/joint_adjuster.h"
-#include "bridge/joint_problem_data.h"
-#include "bridge/vertical_alignment.h"
+#include "bridge/initialization/vertical_alignment.h"
+#include "bridge/joint/extrinsic_observability.h"
+#include "bridge/joint/joint_adjuster.h"
+#include "bridge/joint/joint_problem_data.h"
 #include "colmap_ext/station_dataset.h"
 
 #include "colmap/scene/reconstruction.h"

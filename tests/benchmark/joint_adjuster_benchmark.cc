@@ -5,8 +5,8 @@
 // DATABASE must hold the dataset's images, matches and depth priors (import_dataset,
 // depth_prior_extractor). The initial model is the true poses with landmarks from `colmap
 // point_triangulator`; cam_from_lidar starts at the truth.
-#include "bridge/joint_adjuster.h"
-#include "bridge/joint_problem_data.h"
+#include "bridge/joint/joint_adjuster.h"
+#include "bridge/joint/joint_problem_data.h"
 #include "colmap_ext/station_dataset.h"
 
 #include "colmap/estimators/bundle_adjustment.h"

@@ -1,5 +1,5 @@
 // Uses one call of each installed layer: prints "consumer ok" and exits 0 when they work.
-#include "bridge/hand_eye.h"
+#include "bridge/initialization/hand_eye.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/pose_graph.h"
 

@@ -3,7 +3,7 @@
 // (ReadPoseFile), pairs.txt (bridge ReadLidarPairs), trajectory files in any format
 // (ReadTrajectoryFile after DetectTrajectoryFileFormat), OXTS packets and KITTI timestamps. Errors are std::exception with the file named;
 // anything else is a finding.
-#include "bridge/lidar_registration_files.h"
+#include "bridge/initialization/lidar_registration_files.h"
 #include "colmap_ext/kitti_oxts.h"
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/trajectory_files.h"

@@ -15,8 +15,8 @@
 // (the thresholds that call a direction unobservable: 0.2 deg, 5 mm by default).
 #pragma once
 
-#include "bridge/extrinsic_observability.h"
-#include "bridge/joint_adjuster.h"
+#include "bridge/joint/extrinsic_observability.h"
+#include "bridge/joint/joint_adjuster.h"
 #include "lidar/point_cloud.h"
 #include "tests/simulator/scene.h"
 #include "tests/simulator/synthetic_joint_problem.h"

@@ -6,7 +6,7 @@
 // plan_survey, which predicts the calibration of planned stations before anyone goes to the field.
 #pragma once
 
-#include "bridge/joint_adjuster.h"
+#include "bridge/joint/joint_adjuster.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/point_cloud.h"
 #include "lidar/station_cloud.h"
