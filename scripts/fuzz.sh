@@ -7,7 +7,7 @@
 # per-input timeout. Findings are written to build-fuzz/findings/<target>/ and fail the script; once
 # fixed, copy each into tests/fuzz/corpus/<target>/regression_<what>.<ext> (unit/fuzz_corpus replays
 # the corpus in every test run and requires regression_* inputs to be refused with the file named).
-# Prints executions per target (docs/reliability.md keeps them).
+# Prints the executions and the outcome per target.
 #   SECONDS_PER_TARGET  (default 60)
 set -euo pipefail
 cd "$(dirname "$0")/.."
