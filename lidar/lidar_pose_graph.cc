@@ -234,7 +234,7 @@ void SolveLidarPoseGraph(size_t n, const LidarGraphOptions& options, LidarGraph*
   }
   PoseGraphOptions pose_graph;
   pose_graph.refine = options.refine;
-  pose_graph.loss = "huber";
+  pose_graph.loss = RobustLoss::kHuber;
   pose_graph.loss_scale = options.robust_loss_sigmas;
   PoseGraphSolution solution = SolvePoseGraph(n, edges, pose_graph);
   graph->world_from_lidar = std::move(solution.world_from_node);

@@ -58,7 +58,7 @@ void RefinePoses(const std::vector<RelativePoseEdge>& edges,
   ceres::Problem problem;
   for (const RelativePoseEdge& e : edges) {
     ceres::LossFunction* loss =
-        options.loss == "cauchy"
+        options.loss == RobustLoss::kCauchy
             ? static_cast<ceres::LossFunction*>(new ceres::CauchyLoss(options.loss_scale))
             : new ceres::HuberLoss(options.loss_scale);
     problem.AddResidualBlock(RelativePoseError::Create(e.target_from_source, e.sqrt_information),
@@ -103,7 +103,7 @@ Eigen::Matrix<double, 6, 6> DiagonalSqrtInformation(double sigma_rotation_rad,
 }
 
 bool PoseGraphOptions::Check() const {
-  LIDAR_CHECK_OPTION(loss == "huber" || loss == "cauchy");
+  LIDAR_CHECK_OPTION(loss != RobustLoss::kNone);
   LIDAR_CHECK_OPTION_GT(loss_scale, 0);
   LIDAR_CHECK_OPTION_GE(max_num_iterations, 0);
   return true;

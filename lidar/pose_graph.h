@@ -3,8 +3,11 @@
 // loss on the whitened residuals (relative_pose_error.h), the first node of each component held as the
 // gauge. One module for the LiDAR pose graph A_l (lidar_pose_graph.h) and the camera pose graph
 // A_c v A_l of the initialisation (bridge/initialization/pose_initializer.h). Poses are
-// world_from_node; an edge measures target_from_source, so world_from_source = world_from_target * target_from_source.
+// world_from_node; an edge measures target_from_source, so
+// world_from_source = world_from_target * target_from_source.
 #pragma once
+
+#include "lidar/robust_loss.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -31,8 +34,8 @@ Eigen::Matrix<double, 6, 6> DiagonalSqrtInformation(double sigma_rotation_rad,
 struct PoseGraphOptions {
   // Refine the spanning-tree poses over all edges (false: the tree's poses only).
   bool refine = true;
-  // Robust loss of the refinement on the whitened residuals: "huber" or "cauchy".
-  std::string loss = "huber";
+  // Robust loss of the refinement on the whitened residuals: Huber or Cauchy (not none).
+  RobustLoss loss = RobustLoss::kHuber;
   // Its scale, in sigmas of the whitened residual.
   double loss_scale = 3.0;
   int max_num_iterations = 100;

@@ -115,7 +115,7 @@ TEST(SolvePoseGraph, ComponentsGetTheirOwnGaugeAndABadEdgeIsRefused) {
   EXPECT_THROW(SolvePoseGraph(2, {{0, 2, a_from_b, 1.0, {}}}, PoseGraphOptions()),
                std::invalid_argument);
   PoseGraphOptions bad;
-  bad.loss = "l1";
+  bad.loss = RobustLoss::kNone;
   EXPECT_FALSE(bad.Check());
   EXPECT_THROW(SolvePoseGraph(2, edges, bad), std::invalid_argument);
 }

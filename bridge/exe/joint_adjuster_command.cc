@@ -388,11 +388,8 @@ void PrintUncertainty(const JointAdjustmentSummary& summary, const std::string& 
 }  // namespace
 
 bool JointAdjusterStepOptions::Check() {
-  CHECK_OPTION(vertical_alignment >= -1 && vertical_alignment <= 1);
   adjuster.mode = JointModeFromName(mode);
   adjuster.hold_translation = ParseHeldAxes(hold_translation);
-  CHECK_OPTION(landmark_lidar_weight == -1 || landmark_lidar_weight >= 0);
-  if (landmark_lidar_weight >= 0) adjuster.landmark_lidar_weight = landmark_lidar_weight;
   return adjuster.Check() && data.Check();
 }
 
@@ -603,11 +600,11 @@ bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& 
   return dataset.rig.IsMovingPlatform() || facts.one_axis;
 }
 
-// The -1 (automatic) options. E_m: on for a monocular rig, and for a stereo rig on a moving
-// platform (rig.json's clouds are sweeps, or initialization.json's one-axis hand-eye) whose stations
-// do not rotate about two axes (the uniqueness test of Zhen et al. 2019 on the input model): the
-// paper's terms then leave the roll about the driving direction and the translation to the
-// landmarks on the LiDAR surfaces. Not for tripod stations: there the tool asks for tilted stations,
+// Decided from the motion (DecideFromMotion). E_m: on for a monocular rig, and for a stereo rig on
+// a moving platform (rig.json's clouds are sweeps, or initialization.json's one-axis hand-eye) whose
+// stations do not rotate about two axes (the uniqueness test of Zhen et al. 2019 on the input
+// model): the paper's terms then leave the roll about the driving direction and the translation to
+// the landmarks on the LiDAR surfaces. Not for tripod stations: there the tool asks for tilted stations,
 // since E_m on unrotated stations ends far from the truth with a small reported sigma. Off (the
 // paper's cost) otherwise.
 // Its weight on such a moving platform is kMovingPlatformLandmarkWeight, 1 on tripods: along a
@@ -616,11 +613,11 @@ bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& 
 // number of residuals (docs/joint_adjuster.md).
 constexpr double kMovingPlatformLandmarkWeight = 0.25;
 
-// In joint mode: rig.json's guess with a sigma as a prior, and the vertical alignment (which the
-// start then takes when significant). Returns the vertical alignment if it ran.
+// In joint mode: rig.json's guess with a sigma as a prior, and with `vertical_alignment` the vertical
+// alignment (which the start then takes when significant). Returns the vertical alignment if it ran.
 std::optional<VerticalAlignment> AddExtrinsicMeasurements(
     const StationDataset& dataset,
-    const InitialisationFacts& facts,
+    bool vertical_alignment,
     const colmap::Reconstruction& reconstruction,
     const JointAdjusterStepOptions& options,
     LoadedJointData* loaded,
@@ -631,7 +628,7 @@ std::optional<VerticalAlignment> AddExtrinsicMeasurements(
     measurements.push_back(GuessPrior(dataset.rig));
     PrintMeasurement(measurements.back());
   }
-  if (options.vertical_alignment != 1) return std::nullopt;
+  if (!vertical_alignment) return std::nullopt;
   std::optional<VerticalAlignment> vertical = MeasureStationVerticals(
       dataset, reconstruction, *loaded, *cam_from_lidar, options.adjuster.observability);
   if (vertical->valid) {
@@ -650,17 +647,16 @@ std::optional<VerticalAlignment> AddExtrinsicMeasurements(
   return vertical;
 }
 
-void ResolveAutomaticOptions(const StationDataset& dataset,
-                             const InitialisationFacts& facts,
-                             const colmap::Reconstruction& reconstruction,
-                             JointAdjusterStepOptions* options) {
-  if (options->landmark_lidar_weight >= 0 && options->vertical_alignment >= 0) return;
-  const MotionAnalysis motion = AnalyseMotion(reconstruction, options->adjuster.observability);
+// What the motion decides: E_m's weight (into `adjuster`) and whether the vertical alignment runs
+// (returned): both for a moving platform whose stations do not rotate about two axes.
+bool DecideFromMotion(const StationDataset& dataset,
+                      const InitialisationFacts& facts,
+                      const colmap::Reconstruction& reconstruction,
+                      JointAdjusterOptions* adjuster) {
+  const MotionAnalysis motion = AnalyseMotion(reconstruction, adjuster->observability);
   const bool degenerate_motion =
       facts.one_axis || (!motion.unique && dataset.rig.IsMovingPlatform());
-  if (options->vertical_alignment < 0) options->vertical_alignment = degenerate_motion ? 1 : 0;
-  if (options->landmark_lidar_weight >= 0) return;
-  options->adjuster.landmark_lidar_weight =
+  adjuster->landmark_lidar_weight =
       degenerate_motion ? kMovingPlatformLandmarkWeight : (dataset.rig.IsStereo() ? 0.0 : 1.0);
   if (degenerate_motion) {
     std::ostringstream weight;  // std::cout may hold a fixed precision of 1
@@ -669,6 +665,7 @@ void ResolveAutomaticOptions(const StationDataset& dataset,
               << "): the landmark-to-LiDAR-plane term is on (weight " << weight.str() << ")"
               << std::endl;
   }
+  return degenerate_motion;
 }
 
 void PrintWarnings(const StartDeparture& departure) {
@@ -694,7 +691,8 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   THROW_CHECK_GE(reconstruction.NumRegImages(), 2)
       << paths.input_path << " has fewer than 2 registered images";
   const InitialisationFacts facts = ReadInitialisationFacts(paths.input_path);
-  ResolveAutomaticOptions(dataset, facts, reconstruction, &options);
+  const bool vertical_alignment =
+      DecideFromMotion(dataset, facts, reconstruction, &options.adjuster);
   colmap::Rigid3d cam_from_lidar =
       InitialCamFromLidar(paths.cam_from_lidar_path, paths.input_path, dataset);
   const colmap::Rigid3d initial = cam_from_lidar;
@@ -715,7 +713,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
     loaded->data.image_times = ImageTimes(dataset, *loaded);
   }
   const std::optional<VerticalAlignment> vertical = AddExtrinsicMeasurements(
-      dataset, facts, reconstruction, options, loaded.get(), &cam_from_lidar);
+      dataset, vertical_alignment, reconstruction, options, loaded.get(), &cam_from_lidar);
   const JointAdjustmentSummary summary =
       JointAdjuster(options.adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);
 

@@ -162,16 +162,6 @@ struct JointAdjusterStepOptions {
   std::string mode = "joint";
   // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by Check().
   std::string hold_translation;
-  // w_m of the landmark-to-LiDAR-plane term; -1: 0.25 for a moving platform (sweeps, or a one-axis
-  // hand-eye) whose stations do not rotate about two axes, else 1 for a monocular rig and 0 for a
-  // stereo rig, tripods included (decided by RunJointAdjusterStep); into `adjuster` by Check() when
-  // >= 0.
-  double landmark_lidar_weight = -1;
-  // Measure cam_from_lidar's tilt from the vertical structure both sensors see
-  // (bridge/initialization/vertical_alignment.h), start from it and take it as a measurement, in
-  // joint mode: 1 on, 0 off, -1 on for a moving platform whose stations do not
-  // rotate about two axes (decided by RunJointAdjusterStep, as for landmark_lidar_weight).
-  int vertical_alignment = -1;
   // On a moving platform (rig.json), estimate the LiDAR clock's offset from the cameras in E_m
   // (JointAdjusterOptions::estimate_time_offset).
   bool estimate_time_offset = true;

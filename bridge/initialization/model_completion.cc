@@ -159,7 +159,7 @@ CompletedPoses CompleteThroughLidar(const std::vector<const colmap::Reconstructi
     ++completed.num_lidar_edges;
   }
   PoseGraphOptions pose_graph;
-  pose_graph.loss = "cauchy";
+  pose_graph.loss = RobustLoss::kCauchy;
   pose_graph.loss_scale = 3.0;
   const PoseGraphSolution solution = SolvePoseGraph(nodes.image_of_node.size(), edges, pose_graph);
 

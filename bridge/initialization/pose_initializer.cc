@@ -198,7 +198,7 @@ void SolveCameraPoseGraph(const std::map<std::string, colmap::image_t>& image_of
                      sqrt_information});
   }
   PoseGraphOptions pose_graph;
-  pose_graph.loss = "cauchy";
+  pose_graph.loss = RobustLoss::kCauchy;
   pose_graph.loss_scale = 3.0;
   const PoseGraphSolution solution = SolvePoseGraph(image_of_node.size(), edges, pose_graph);
   std::vector<std::string> node_names;

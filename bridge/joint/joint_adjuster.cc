@@ -75,9 +75,15 @@ colmap::Rigid3d LidarIFromLidarJ(const colmap::Rigid3d& cam_i_from_world,
          cam_from_lidar;
 }
 
-std::unique_ptr<ceres::LossFunction> MakeLoss(const std::string& name, double scale) {
-  if (name == "huber") return std::make_unique<ceres::HuberLoss>(scale);
-  if (name == "cauchy") return std::make_unique<ceres::CauchyLoss>(scale);
+std::unique_ptr<ceres::LossFunction> MakeLoss(RobustLoss loss, double scale) {
+  switch (loss) {
+    case RobustLoss::kNone:
+      return nullptr;
+    case RobustLoss::kHuber:
+      return std::make_unique<ceres::HuberLoss>(scale);
+    case RobustLoss::kCauchy:
+      return std::make_unique<ceres::CauchyLoss>(scale);
+  }
   return nullptr;
 }
 
@@ -982,7 +988,6 @@ bool JointAdjusterOptions::Check() const {
   CHECK_OPTION_GT(sigma_landmark_lidar_m, 0);
   CHECK_OPTION_GT(max_landmark_plane_m, 0);
   CHECK_OPTION_GT(max_landmark_plane_sigmas, 0);
-  CHECK_OPTION(loss == "none" || loss == "huber" || loss == "cauchy");
   CHECK_OPTION_GT(loss_scale, 0);
   CHECK_OPTION_GT(max_reprojection_error_px, 0);
   CHECK_OPTION_GT(max_depth_error_sigmas, 0);

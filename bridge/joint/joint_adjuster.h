@@ -33,6 +33,7 @@
 #include "bridge/joint/variance_components.h"
 #include "colmap_ext/extension_database.h"
 #include "lidar/point_to_plane_association.h"
+#include "lidar/robust_loss.h"
 #include "lidar/station_cloud.h"
 
 #include "colmap/geometry/rigid3.h"
@@ -99,10 +100,9 @@ struct JointAdjusterOptions {
   // which is also the cap of every round but the last (a coarse start is pulled in first).
   double max_landmark_plane_m = 0.1;
   double max_landmark_plane_sigmas = 3.0;
-  // Robust loss on every term: none | huber | cauchy (none in the paper). With a loss, each LiDAR
-  // observation is its own residual block (the loss applies per observation); without, one block per
-  // directed station pair.
-  std::string loss = "none";
+  // Robust loss on every term (none in the paper). With a loss, each LiDAR observation is its own
+  // residual block (the loss applies per observation); without, one block per directed station pair.
+  RobustLoss loss = RobustLoss::kNone;
   // Each LiDAR pair block in its compressed form (bridge/joint/lidar_pair_cost.h): the same cost,
   // gradient and Gauss-Newton model in 13 moment rows, evaluated in O(1) instead of one row per observation.
   bool compress_lidar_blocks = true;
