@@ -13,6 +13,9 @@ endfunction()
 function(colmap_lidar_add_test)
   cmake_parse_arguments(ARG "" "NAME;COST;LABEL;FILTER;FIXTURES_SETUP;FIXTURES_REQUIRED"
                         "SOURCES;LINKS" ${ARGN})
+  if(ARG_LABEL STREQUAL "slow" AND COLMAP_LIDAR_SKIP_SLOW_TESTS)
+    return()
+  endif()
   string(REPLACE "/" "_" exe ${ARG_NAME})
   add_executable(${exe} ${ARG_SOURCES})
   target_link_libraries(${exe} PRIVATE ${ARG_LINKS} GTest::gtest GTest::gtest_main)
@@ -40,6 +43,9 @@ function(colmap_lidar_discover_tests)
   if(NOT ARG_LABEL)
     set(ARG_LABEL unit)
   endif()
+  if(ARG_LABEL STREQUAL "slow" AND COLMAP_LIDAR_SKIP_SLOW_TESTS)
+    return()
+  endif()
   if(NOT ARG_FILTER)
     set(ARG_FILTER "*")
   endif()
@@ -55,4 +61,12 @@ function(colmap_lidar_discover_tests)
                        DISCOVERY_TIMEOUT 60
                        PROPERTIES TIMEOUT 1200 COST ${ARG_COST} LABELS ${ARG_LABEL}
                                   ENVIRONMENT OMP_WAIT_POLICY=PASSIVE ${fixtures})
+endfunction()
+
+# colmap_lidar_needs_cli(test_target): the test runs the colmap-lidar executable, so build it first
+# (no-op for a test target that is not built, see COLMAP_LIDAR_SKIP_SLOW_TESTS).
+function(colmap_lidar_needs_cli target)
+  if(TARGET ${target})
+    add_dependencies(${target} colmap_lidar_cli)
+  endif()
 endfunction()

@@ -20,7 +20,11 @@ readonly kJobs="${JOBS:-$(nproc)}"
 readonly kFlags="-O1 -g1 -fsanitize=address,undefined -fno-omit-frame-pointer \
 -fno-sanitize-recover=undefined -DEIGEN_MALLOC_ALREADY_ALIGNED=1"
 source scripts/ccache_env.sh
+# The tests labelled slow are neither run nor built here, unless FULL=1, LABELS or TESTS ask for more.
+skip_slow=ON
+[[ "${FULL:-0}" == 1 || -n "${LABELS:-}" || -n "${TESTS:-}" ]] && skip_slow=OFF
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=None "${ccache_launcher[@]}" \
+  -DCOLMAP_LIDAR_SKIP_SLOW_TESTS="$skip_slow" \
   -DCMAKE_CXX_FLAGS="$kFlags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
   -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" \
   -DCMAKE_PREFIX_PATH="$kColmapPrefix" >/dev/null
