@@ -493,6 +493,7 @@ namespace {
 // "[Section]" header named "Section.key".
 std::vector<std::string> ProjectFileKeys(const std::string& path) {
   std::ifstream file(path);
+  if (path.empty()) throw std::invalid_argument("--project_path needs a file");
   if (!file) throw std::invalid_argument("cannot read the project file " + path);
   std::vector<std::string> keys;
   std::string section;
