@@ -36,13 +36,17 @@ Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
 }
 
 // One residual's contribution: point-to-plane where the map is a plane, point-to-point where it is
-// scattered; none on a line (one scan line's arc: across it lies the scanner's ring pattern).
+// scattered; none on a line (one scan line's arc: across it lies the scanner's ring pattern) or
+// where the map is too sparse to tell (its points there follow the scanner's pattern too).
 void AddResidual(const Eigen::Vector3d& x,
                  const MapNeighbor& neighbor,
                  double kernel,
                  bool point_to_plane,
                  NormalSystem* system) {
-  if (point_to_plane && neighbor.shape == VoxelShape::kLine) return;
+  if (point_to_plane &&
+      (neighbor.shape == VoxelShape::kLine || neighbor.shape == VoxelShape::kSparse)) {
+    return;
+  }
   Eigen::Matrix<double, 3, 6> jacobian;
   jacobian << -Skew(x), Eigen::Matrix3d::Identity();
   if (point_to_plane && neighbor.shape == VoxelShape::kPlane) {

@@ -5,9 +5,11 @@
 // q_i the nearest map point of T p_i within `max_correspondence_m` (tau), kappa = sigma / 3.
 // With FrameToMapIcpOptions::point_to_plane (the default), the residual is the distance to the
 // map's local plane (the map points within one voxel size of the nearest one, spanning several
-// scan lines) where that neighbourhood is a plane, and there is none where it is the arc of one
-// scan line: on flat ground and along facades the rings and scan lines of a multi-beam scanner
-// match best where they were recorded, which holds a point-to-point ICP at the previous pose.
+// scan lines) where that neighbourhood is a plane, point-to-point where it is scattered, and there
+// is none where it is the arc of one scan line or holds too few points to tell (the far ground
+// and facades of a map of one or a few sweeps): a platform moving along flat ground and facades
+// sees their rings and scan lines where it saw them before, so nearest points on these surfaces
+// match best with no motion at all and would hold the ICP at the previous pose.
 // After convergence the frame's information is measured point-to-plane (the map voxels' planes): a
 // point-to-point Hessian is isotropic in translation whatever the geometry and cannot show a street
 // of facades or a tunnel; the planes can.

@@ -65,7 +65,7 @@ bool LidarOdometryOptions::Check() const {
   LIDAR_CHECK_OPTION_GE(min_motion_m, 0);
   LIDAR_CHECK_OPTION_GT(degenerate_ratio, 0);
   LIDAR_CHECK_OPTION_LT(degenerate_ratio, 1);
-  return timing.Check() && icp.Check() && bootstrap_cloud.Check() && bootstrap_pair.Check();
+  return timing.Check() && icp.Check();
 }
 
 LidarOdometry::LidarOdometry(const LidarOdometryOptions& options)
@@ -105,19 +105,6 @@ void LidarOdometry::FinishFrame(const FrameToMapIcpResult& icp, OdometryFrame* f
   }
 }
 
-bool LidarOdometry::Bootstrap(const std::vector<Eigen::Vector3d>& points, double clock) {
-  PointCloud first, second;
-  first.points = std::move(first_sweep_);
-  second.points = points;
-  const auto target = PrepareStationCloud(first, options_.bootstrap_cloud);
-  const auto source = PrepareStationCloud(second, options_.bootstrap_cloud);
-  const PairRegistration pair = RegisterStationClouds(*source, *target, options_.bootstrap_pair);
-  first_sweep_.clear();
-  if (!pair.accepted) return false;
-  velocity_ = ScaleMotion(pair.target_from_source, 1.0 / (clock - last_clock_));
-  return true;
-}
-
 const OdometryFrame& LidarOdometry::RegisterFrame(const std::vector<Eigen::Vector3d>& points,
                                                   double clock) {
   if (!frames_.empty() && !(clock > last_clock_)) {
@@ -136,9 +123,7 @@ const OdometryFrame& LidarOdometry::RegisterFrame(const std::vector<Eigen::Vecto
   frame.num_source_points = source.size();
   if (frames_.empty()) {
     frame.converged = true;
-    if (options_.bootstrap) first_sweep_ = points;
   } else {
-    if (frames_.size() == 1 && options_.bootstrap) frame.bootstrapped = Bootstrap(points, clock);
     const Eigen::Isometry3d& last = frames_.back().world_from_lidar;
     frame.prediction = last * ScaleMotion(velocity_, clock - last_clock_);
     const double sigma = threshold_.Sigma();

@@ -6,20 +6,20 @@
 //   3. subsampling: one point per voxel of alpha v for the map, of beta v for the registration
 //      (alpha = 0.5, beta = 1.5; v = voxel size);
 //   4. robust ICP against the local voxel-hash map (lidar/frame_to_map_icp.h: point-to-plane where
-//      the map is locally a plane, point-to-point elsewhere) with
-//      the adaptive threshold (lidar/adaptive_threshold.h);
+//      the map is locally a plane, point-to-point where it is scattered) with the adaptive
+//      threshold (lidar/adaptive_threshold.h);
 //   5. the map updated with the registered frame, far voxels dropped.
-// The first motion has no velocity to predict it: it is found by the pairwise registration of the
-// first two sweeps (BSC + RANSAC + ICP, lidar/pair_registration.h), global and without a prior,
-// so that a platform that is already moving when the recording starts is followed from its first
-// frame. Every frame gets a pose. Its information is measured point-to-plane against the map; a frame
-// whose weakest constrained direction is below `degenerate_ratio` of its strongest (a tunnel, a
-// street of bare facades) is flagged with that direction, never silently accepted.
+// The first motion has no velocity to predict it: the second frame starts from rest with the
+// initial threshold (tau = 3 initial_sigma_m), whose basin holds the motion of a platform already
+// moving at driving speed (the residuals leave the scanner's sampling pattern out,
+// lidar/frame_to_map_icp.h). Every frame gets a pose. Its information is measured point-to-plane
+// against the map; a frame whose weakest constrained direction is below `degenerate_ratio` of its
+// strongest (a tunnel, a street of bare facades) is flagged with that direction, never silently
+// accepted.
 #pragma once
 
 #include "lidar/adaptive_threshold.h"
 #include "lidar/frame_to_map_icp.h"
-#include "lidar/pair_registration.h"
 #include "lidar/registration_quality.h"
 #include "lidar/sweep_deskew.h"
 #include "lidar/voxel_hash_map.h"
@@ -46,10 +46,6 @@ struct LidarOdometryOptions {
   bool deskew = true;
   SweepTimingOptions timing;
   FrameToMapIcpOptions icp;
-  // The first motion from the pairwise registration of the first two sweeps (else: from rest).
-  bool bootstrap = true;
-  StationCloudOptions bootstrap_cloud;
-  PairRegistrationOptions bootstrap_pair;
   // Weakest over strongest eigenvalue of the translation's information (the Schur complement of the
   // rotation in the point-to-plane information) below which the frame is degenerate.
   double degenerate_ratio = 0.02;
@@ -68,8 +64,6 @@ struct OdometryFrame {
   ConstraintAnalysis constraints;
   bool degenerate = false;
   bool converged = false;
-  // The second frame: its prediction came from the pairwise registration (accepted), or from rest.
-  bool bootstrapped = false;
   int num_iterations = 0;
   size_t num_points = 0;  // after the range filter
   size_t num_source_points = 0;
@@ -94,8 +88,6 @@ class LidarOdometry {
  private:
   std::vector<Eigen::Vector3d> Preprocess(const std::vector<Eigen::Vector3d>& points) const;
   void FinishFrame(const FrameToMapIcpResult& icp, OdometryFrame* frame) const;
-  // The first motion by pairwise registration of the first sweep and `points`; false if refused.
-  bool Bootstrap(const std::vector<Eigen::Vector3d>& points, double clock);
 
   LidarOdometryOptions options_;
   VoxelHashMap map_;
@@ -103,7 +95,6 @@ class LidarOdometry {
   std::vector<OdometryFrame> frames_;
   double last_clock_ = 0;
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();
-  std::vector<Eigen::Vector3d> first_sweep_;  // kept for the bootstrap only
 };
 
 // The motion `motion` scaled to `fraction` of itself (rotation angle and translation), constant

@@ -97,12 +97,10 @@ TEST(LidarOdometry, NamesTheDegenerateDirectionOfAStreetOfBareWalls) {
   }
 }
 
-// The odometry's sums are combined in a fixed order. (The bootstrap's pairwise registration is not
-// bitwise reproducible across thread counts: it is left out here.)
+// The odometry's sums are combined in a fixed order.
 TEST(LidarOdometry, GivesTheSamePosesOnOneAndFourThreads) {
   const Drive drive = SimulateDrive(8, 12.0);
-  LidarOdometryOptions options = StreetOptions();
-  options.bootstrap = false;
+  const LidarOdometryOptions options = StreetOptions();
   omp_set_num_threads(1);
   const auto one = RunOdometry(drive, options);
   omp_set_num_threads(4);

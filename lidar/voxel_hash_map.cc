@@ -61,8 +61,9 @@ struct PointMoments {
 
 // The shape of the points whose moments are given (PCA of their scatter).
 void ClassifyShape(const PointMoments& moments, VoxelShape* shape, Eigen::Vector3d* normal) {
-  *shape = VoxelShape::kScattered;
+  *shape = VoxelShape::kSparse;
   if (moments.count < 5) return;
+  *shape = VoxelShape::kScattered;
   const Eigen::Matrix3d scatter =
       moments.outer - moments.sum * moments.sum.transpose() / static_cast<double>(moments.count);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);

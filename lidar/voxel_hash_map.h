@@ -4,7 +4,8 @@
 // by construction), voxels farther than `max_distance` from the sensor dropped. The nearest map point
 // of a query is searched among the 27 voxels around it. Each voxel knows the shape of its points
 // (PCA, redone when points enter): a plane (with its normal), a line (the arc of one scan line: its
-// spread across the line is the scanner's pattern, not the surface's) or scattered.
+// spread across the line is the scanner's pattern, not the surface's), scattered, or sparse (fewer
+// than five points: too few to tell which).
 #pragma once
 
 #include <Eigen/Core>
@@ -14,7 +15,7 @@
 
 namespace colmap_lidar {
 
-enum class VoxelShape { kScattered, kPlane, kLine };
+enum class VoxelShape { kScattered, kPlane, kLine, kSparse };
 
 struct MapNeighbor {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
