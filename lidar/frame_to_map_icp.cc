@@ -66,29 +66,47 @@ void AddResidual(const Eigen::Vector3d& x,
   ++system->count;
 }
 
-// The sum over the points' correspondences (the map point nearest to pose * p within
-// max_distance) of `add(i, x, neighbor, system)`, in fixed chunks combined in order.
-// With `neighbourhood_shape`, the neighbour's shape is that of the map around it
-// (VoxelHashMap::ClassifyNeighbourhood), else that of its voxel.
+// The nearest map point of pose * p for each point p within max_distance (index -1: none), with
+// the shape of the map around it when `neighbourhood_shape`
+// (VoxelHashMap::ClassifyNeighbourhoods), else that of its voxel.
+std::vector<MapNeighbor> FindCorrespondences(const std::vector<Eigen::Vector3d>& points,
+                                             VoxelHashMap* map,
+                                             const Eigen::Isometry3d& pose,
+                                             double max_distance,
+                                             bool neighbourhood_shape) {
+  std::vector<MapNeighbor> neighbors(points.size());
+  // Each item writes its own slot and cannot throw: a plain static loop (ParallelForEach's
+  // per-item scheduling costs as much as a search).
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < static_cast<long>(points.size()); ++i) {
+    MapNeighbor& neighbor = neighbors[i];
+    if (!map->NearestNeighbor(pose * points[i], &neighbor) || neighbor.distance > max_distance) {
+      neighbor.index = -1;
+    }
+  }
+  if (neighbourhood_shape) map->ClassifyNeighbourhoods(&neighbors);
+  return neighbors;
+}
+
+// The sum over the points' correspondences (FindCorrespondences) of
+// `add(i, x, neighbor, system)`, x = pose * points[i], in fixed chunks combined in order.
 template <typename Add>
 NormalSystem SumOverCorrespondences(const std::vector<Eigen::Vector3d>& points,
-                                    const VoxelHashMap& map,
+                                    VoxelHashMap* map,
                                     const Eigen::Isometry3d& pose,
                                     double max_distance,
                                     bool neighbourhood_shape,
                                     const Add& add) {
+  const std::vector<MapNeighbor> neighbors =
+      FindCorrespondences(points, map, pose, max_distance, neighbourhood_shape);
   return ChunkedSum<NormalSystem>(static_cast<long>(points.size()), [&](long i, NormalSystem* sum) {
-    const Eigen::Vector3d x = pose * points[i];
-    MapNeighbor neighbor;
-    if (!map.NearestNeighbor(x, &neighbor) || neighbor.distance > max_distance) return;
-    if (neighbourhood_shape) map.ClassifyNeighbourhood(&neighbor);
-    add(i, x, neighbor, sum);
+    if (neighbors[i].index >= 0) add(i, pose * points[i], neighbors[i], sum);
   });
 }
 
 // One Gauss-Newton system of the residuals at `pose` (Eq. 7-8).
 NormalSystem IcpSystem(const std::vector<Eigen::Vector3d>& points,
-                       const VoxelHashMap& map,
+                       VoxelHashMap* map,
                        const Eigen::Isometry3d& pose,
                        double max_distance,
                        double kernel,
@@ -116,7 +134,7 @@ Eigen::Isometry3d Increment(const Vector6d& dx) {
 
 // Point-to-plane information of the converged pose in the LiDAR frame (right increment).
 void PlaneInformation(const std::vector<Eigen::Vector3d>& points,
-                      const VoxelHashMap& map,
+                      VoxelHashMap* map,
                       double max_distance,
                       double kernel,
                       FrameToMapIcpResult* result) {
@@ -152,7 +170,7 @@ bool FrameToMapIcpOptions::Check() const {
 }
 
 FrameToMapIcpResult AlignFrameToMap(const std::vector<Eigen::Vector3d>& points_in_lidar,
-                                    const VoxelHashMap& map,
+                                    VoxelHashMap* map,
                                     const Eigen::Isometry3d& initial,
                                     double max_correspondence_m,
                                     double kernel_m,

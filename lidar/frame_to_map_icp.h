@@ -51,10 +51,11 @@ struct FrameToMapIcpResult {
   double plane_rms_m = 0;
 };
 
-// `points_in_lidar` (already de-skewed and subsampled) against `map`, from `initial`. Throws
+// `points_in_lidar` (already de-skewed and subsampled) against `map`, from `initial`; the map's
+// points stay as they are, it keeps the shapes of their neighbourhoods for later frames. Throws
 // std::invalid_argument for invalid options or a non-positive threshold or kernel.
 FrameToMapIcpResult AlignFrameToMap(const std::vector<Eigen::Vector3d>& points_in_lidar,
-                                    const VoxelHashMap& map,
+                                    VoxelHashMap* map,
                                     const Eigen::Isometry3d& initial,
                                     double max_correspondence_m,
                                     double kernel_m,

@@ -43,7 +43,7 @@ TEST(FrameToMapIcp, FindsTheMotionAlongAStreetFromRest) {
     map.Update(FirstPointPerVoxel(first, 0.5), Eigen::Vector3d::Zero());
     const FrameToMapIcpResult result =
         AlignFrameToMap(FirstPointPerVoxel(FirstPointPerVoxel(second, 0.5), 1.5),
-                        map,
+                        &map,
                         Eigen::Isometry3d::Identity(),
                         6.0,
                         2.0 / 3.0,
@@ -63,7 +63,7 @@ TEST(FrameToMapIcp, RefusesANonPositiveThreshold) {
   VoxelHashMap map(1.0, 100, 20);
   map.Update({Eigen::Vector3d(1, 0, 0)}, Eigen::Vector3d::Zero());
   EXPECT_THROW(AlignFrameToMap({Eigen::Vector3d(1, 0, 0)},
-                               map,
+                               &map,
                                Eigen::Isometry3d::Identity(),
                                0,
                                1,

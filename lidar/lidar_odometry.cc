@@ -129,7 +129,7 @@ const OdometryFrame& LidarOdometry::RegisterFrame(const std::vector<Eigen::Vecto
     const double sigma = threshold_.Sigma();
     frame.threshold_m = 3.0 * sigma;
     FinishFrame(
-        AlignFrameToMap(source, map_, frame.prediction, 3.0 * sigma, sigma / 3.0, options_.icp),
+        AlignFrameToMap(source, &map_, frame.prediction, 3.0 * sigma, sigma / 3.0, options_.icp),
         &frame);
     const Eigen::Isometry3d motion = last.inverse() * frame.world_from_lidar;
     threshold_.Update(frame.prediction.inverse() * frame.world_from_lidar, motion);

@@ -93,60 +93,130 @@ void VoxelHashMap::ForEachVoxelAround(const Eigen::Vector3d& point, const Visit&
   }
 }
 
-void VoxelHashMap::ClassifyNeighbourhood(MapNeighbor* neighbor) const {
+void VoxelHashMap::ClassifyPoint(Voxel* voxel, int index) const {
+  const Eigen::Vector3d& centre = voxel->points[index];
   const double squared_radius = voxel_size_ * voxel_size_;
-  PointMoments moments(neighbor->point);
-  ForEachVoxelAround(neighbor->point, [&](const Voxel& voxel) {
-    for (const Eigen::Vector3d& point : voxel.points) {
-      if ((point - neighbor->point).squaredNorm() <= squared_radius) moments.Add(point);
+  PointMoments moments(centre);
+  ForEachVoxelAround(centre, [&](const Voxel& other) {
+    for (const Eigen::Vector3d& point : other.points) {
+      if ((point - centre).squaredNorm() <= squared_radius) moments.Add(point);
     }
   });
-  ClassifyShape(moments, &neighbor->shape, &neighbor->normal);
+  PointShape& shape = voxel->point_shapes[index];
+  ClassifyShape(moments, &shape.shape, &shape.normal);
+  shape.generation = voxel->generation;
+}
+
+void VoxelHashMap::ClassifyNeighbourhoods(std::vector<MapNeighbor>* neighbors) {
+  std::vector<std::pair<Voxel*, int>> stale;
+  for (const MapNeighbor& neighbor : *neighbors) {
+    if (neighbor.index < 0) continue;
+    Voxel& voxel = voxels_.at(neighbor.voxel);
+    voxel.point_shapes.resize(voxel.points.size());
+    PointShape& shape = voxel.point_shapes[neighbor.index];
+    if (shape.generation == voxel.generation || shape.queued) continue;
+    shape.queued = true;
+    stale.emplace_back(&voxel, neighbor.index);
+  }
+  // Each item writes its own point's shape and cannot throw: a plain static loop.
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < static_cast<long>(stale.size()); ++i) {
+    ClassifyPoint(stale[i].first, stale[i].second);
+    stale[i].first->point_shapes[stale[i].second].queued = false;
+  }
+  for (MapNeighbor& neighbor : *neighbors) {
+    if (neighbor.index < 0) continue;
+    const PointShape& shape = voxels_.at(neighbor.voxel).point_shapes[neighbor.index];
+    neighbor.shape = shape.shape;
+    neighbor.normal = shape.normal;
+  }
+}
+
+void VoxelHashMap::InvalidateAround(const Eigen::Vector3i& key) {
+  for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dz = -1; dz <= 1; ++dz) {
+        const auto it = voxels_.find(key + Eigen::Vector3i(dx, dy, dz));
+        if (it != voxels_.end()) ++it->second.generation;
+      }
+    }
+  }
 }
 
 void VoxelHashMap::Update(const std::vector<Eigen::Vector3d>& points_in_world,
                           const Eigen::Vector3d& origin) {
-  std::vector<Voxel*> changed;
+  std::vector<Eigen::Vector3i> changed;
   for (const Eigen::Vector3d& point : points_in_world) {
-    Voxel& voxel = voxels_[VoxelOf(point)];
+    const Eigen::Vector3i key = VoxelOf(point);
+    Voxel& voxel = voxels_[key];
     if (voxel.points.size() >= max_points_per_voxel_) continue;
     if (!voxel.changed) {
       voxel.changed = true;
-      changed.push_back(&voxel);
+      changed.push_back(key);
     }
     voxel.points.push_back(point);
   }
-  for (Voxel* voxel : changed) {
-    PointMoments moments(voxel->points.front());
-    for (const Eigen::Vector3d& point : voxel->points) moments.Add(point);
-    ClassifyShape(moments, &voxel->shape, &voxel->normal);
-    voxel->changed = false;
+  for (const Eigen::Vector3i& key : changed) {
+    Voxel& voxel = voxels_.at(key);
+    PointMoments moments(voxel.points.front());
+    for (const Eigen::Vector3d& point : voxel.points) moments.Add(point);
+    ClassifyShape(moments, &voxel.shape, &voxel.normal);
+    voxel.changed = false;
+    InvalidateAround(key);
   }
   const double max_squared = max_distance_ * max_distance_;
+  std::vector<Eigen::Vector3i> dropped;
   for (auto it = voxels_.begin(); it != voxels_.end();) {
     if ((it->second.points.front() - origin).squaredNorm() > max_squared) {
+      dropped.push_back(it->first);
       it = voxels_.erase(it);
     } else {
       ++it;
     }
   }
+  for (const Eigen::Vector3i& key : dropped) InvalidateAround(key);
 }
 
 bool VoxelHashMap::NearestNeighbor(const Eigen::Vector3d& query, MapNeighbor* neighbor) const {
   double best = std::numeric_limits<double>::infinity();
   const Voxel* best_voxel = nullptr;
-  ForEachVoxelAround(query, [&](const Voxel& voxel) {
-    for (const Eigen::Vector3d& point : voxel.points) {
-      const double squared = (point - query).squaredNorm();
+  int best_index = -1;
+  const auto visit = [&](const Eigen::Vector3i& key) {
+    const auto it = voxels_.find(key);
+    if (it == voxels_.end()) return;
+    const Voxel& voxel = it->second;
+    for (size_t k = 0; k < voxel.points.size(); ++k) {
+      const double squared = (voxel.points[k] - query).squaredNorm();
       if (squared < best) {
         best = squared;
-        neighbor->point = point;
+        neighbor->point = voxel.points[k];
         best_voxel = &voxel;
+        best_index = static_cast<int>(k);
       }
     }
-  });
+  };
+  // The query's own voxel first; then a voxel around only where it can hold a nearer point (its
+  // box nearer than the best so far), which leaves most of the 26 unvisited.
+  const Eigen::Vector3i centre = VoxelOf(query);
+  visit(centre);
+  const Eigen::Vector3d below = query - voxel_size_ * centre.cast<double>();
+  const Eigen::Vector3d above = Eigen::Vector3d::Constant(voxel_size_) - below;
+  for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dz = -1; dz <= 1; ++dz) {
+        const Eigen::Vector3i step(dx, dy, dz);
+        double gap = 0;
+        for (int axis = 0; axis < 3; ++axis) {
+          if (step[axis] != 0) gap += std::pow(step[axis] < 0 ? below[axis] : above[axis], 2);
+        }
+        if (!step.isZero() && gap < best) visit(centre + step);
+      }
+    }
+  }
   if (best_voxel == nullptr) return false;
   neighbor->distance = std::sqrt(best);
+  neighbor->voxel = VoxelOf(neighbor->point);
+  neighbor->index = best_index;
   neighbor->shape = best_voxel->shape;
   neighbor->normal = best_voxel->normal;
   return true;

@@ -22,6 +22,9 @@ struct MapNeighbor {
   double distance = 0;
   VoxelShape shape = VoxelShape::kScattered;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // of a plane
+  // Which map point: its voxel and its place there (-1: none found).
+  Eigen::Vector3i voxel = Eigen::Vector3i::Zero();
+  int index = -1;
 };
 
 class VoxelHashMap {
@@ -36,10 +39,11 @@ class VoxelHashMap {
   // they are empty.
   bool NearestNeighbor(const Eigen::Vector3d& query, MapNeighbor* neighbor) const;
 
-  // The shape of the map around `neighbor->point` (a point of the map): the points within one voxel
-  // size of it among the 27 voxels around, which span several scan lines where one voxel holds the
-  // arc of one. Sets neighbor->shape and ->normal.
-  void ClassifyNeighbourhood(MapNeighbor* neighbor) const;
+  // For each found neighbour (index >= 0), the shape of the map around its point: the points within
+  // one voxel size of it among the 27 voxels around, which span several scan lines where one voxel
+  // holds the arc of one. Sets shape and normal. Each map point's shape is computed once and kept
+  // until a voxel among the 27 around its own changes; the voxels to compute are done in parallel.
+  void ClassifyNeighbourhoods(std::vector<MapNeighbor>* neighbors);
 
   double VoxelSize() const { return voxel_size_; }
   bool Empty() const { return voxels_.empty(); }
@@ -53,15 +57,29 @@ class VoxelHashMap {
   double voxel_size_;
   double max_distance_;
   size_t max_points_per_voxel_;
+  struct PointShape {
+    VoxelShape shape = VoxelShape::kSparse;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    int generation = -1;  // the voxel's generation it was computed in
+    bool queued = false;  // within one ClassifyNeighbourhoods
+  };
   struct Voxel {
     std::vector<Eigen::Vector3d> points;
     VoxelShape shape = VoxelShape::kScattered;
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     bool changed = false;  // within one Update
+    // The shape of the map around each point (ClassifyNeighbourhoods), valid while computed in the
+    // current generation, which a change among the 27 voxels around ends.
+    std::vector<PointShape> point_shapes;
+    int generation = 0;
   };
   // Calls visit(voxel) for each occupied voxel of the 27 around `point`'s.
   template <typename Visit>
   void ForEachVoxelAround(const Eigen::Vector3d& point, const Visit& visit) const;
+  // The shape of the map around point `index` of `voxel`.
+  void ClassifyPoint(Voxel* voxel, int index) const;
+  // Ends the generation of the voxel `key` and of the 26 around it.
+  void InvalidateAround(const Eigen::Vector3i& key);
 
   std::unordered_map<Eigen::Vector3i, Voxel, VoxelHash> voxels_;
 };

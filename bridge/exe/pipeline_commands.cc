@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <functional>
@@ -455,11 +456,13 @@ void RunSteps(const std::vector<PipelineStep>& steps, const fs::path& ws, bool o
     WriteStepTable(ws, records);
   }
   std::cout << "\n== Pipeline summary (" << ws.string() << "): wall s, CPU s, peak MiB\n";
+  size_t name_width = 0;
+  for (const StepRecord& r : records) name_width = std::max(name_width, r.name.size() + 2);
   for (const StepRecord& r : records) {
-    std::cout << "  " << std::left << std::setw(24) << r.name << std::setw(9) << r.status
-              << std::right << std::fixed << std::setprecision(1) << std::setw(8) << r.wall_s
-              << std::setw(9) << r.cpu_s << std::setw(9) << std::setprecision(0) << r.peak_mib
-              << "\n";
+    std::cout << "  " << std::left << std::setw(static_cast<int>(name_width)) << r.name
+              << std::setw(9) << r.status << std::right << std::fixed << std::setprecision(1)
+              << std::setw(8) << r.wall_s << std::setw(9) << r.cpu_s << std::setw(9)
+              << std::setprecision(0) << r.peak_mib << "\n";
   }
 }
 
