@@ -185,7 +185,7 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("method",
           &options->method,
           "auto | pairwise (BSC + RANSAC + ICP per pair) | odometry (sweeps: frame-to-map ICP); "
-          "auto: odometry for the sweeps of a moving platform");
+          "auto: pairwise");
   add.Add("odometry_max_range_m", &options->odometry.max_range_m);
   add.Add("odometry_min_range_m", &options->odometry.min_range_m, "nearer returns: the platform");
   add.Add("odometry_voxel_size_m", &options->odometry.voxel_size_m, "0: max range / 100");
@@ -302,12 +302,11 @@ void RemoveMovingPoints(const std::vector<std::string>& names,
             << moving_ply.string() << ")" << std::endl;
 }
 
-// Odometry when asked for (--method odometry); auto: the pairwise path.
+// Odometry when asked for (--method odometry); auto: the pairwise path. The odometry's edges join
+// consecutive frames only, whose rotations are too small for the hand-eye's motion pairs on a
+// gently turning drive: the pipeline's initialisation is built on the pairwise path's longer edges.
 bool UseOdometry(const LidarRegistratorStepOptions& options) {
   if (options.method != "auto") return options.method == "odometry";
-  // The odometry is opt-in: from a moving start on a street whose facades leave the driving
-  // direction to few features (the simulator's), frame-to-map ICP without a first velocity does
-  // not leave the start (docs/benchmarks/odometry.md); the pairwise path finds that motion by BSC.
   std::cout << "lidar_registrator: pairwise registration (BSC + RANSAC + ICP)"
             << (options.deskew_sweeps || options.moving_platform
                     ? "; --method odometry registers the frames of a moving platform faster"
