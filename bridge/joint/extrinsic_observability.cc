@@ -9,7 +9,9 @@
 #include <ceres/cost_function.h>
 #include <ceres/crs_matrix.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iomanip>
 #include <map>
 #include <sstream>
@@ -94,6 +96,38 @@ Eigen::Vector3d TravelDirectionInCam(const colmap::Reconstruction& reconstructio
 
 }  // namespace
 
+double LargestAngleBetweenAxesDeg(const std::vector<Eigen::Vector3d>& unit_axes) {
+  const auto line_angle_deg = [&](size_t a, size_t b) {
+    const Eigen::Vector3d& first = unit_axes[std::min(a, b)];
+    const Eigen::Vector3d& second = unit_axes[std::max(a, b)];
+    return std::acos(std::min(1.0, std::abs(first.dot(second)))) * kRadToDeg;
+  };
+  if (unit_axes.size() < 2) return 0;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& axis : unit_axes) scatter += axis * axis.transpose();
+  const Eigen::Vector3d main_axis =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2);
+  // Axes by their angle from the main direction, farthest first.
+  std::vector<std::pair<double, size_t>> from_main;
+  for (size_t a = 0; a < unit_axes.size(); ++a) {
+    const double cosine = std::min(1.0, std::abs(unit_axes[a].dot(main_axis)));
+    from_main.emplace_back(std::acos(cosine) * kRadToDeg, a);
+  }
+  std::sort(from_main.begin(), from_main.end(), std::greater<>());
+  // A pair's bound a + b is checked with a margin far above acos' rounding, so that the pair of
+  // the largest angle is always compared.
+  constexpr double kMarginDeg = 1e-6;
+  double largest = 0;
+  for (size_t i = 0; i + 1 < from_main.size(); ++i) {
+    if (from_main[i].first + from_main[i + 1].first + kMarginDeg < largest) break;
+    for (size_t j = i + 1; j < from_main.size(); ++j) {
+      if (from_main[i].first + from_main[j].first + kMarginDeg < largest) break;
+      largest = std::max(largest, line_angle_deg(from_main[i].second, from_main[j].second));
+    }
+  }
+  return largest;
+}
+
 MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
                              const ObservabilityOptions& options) {
   MotionAnalysis analysis;
@@ -119,13 +153,7 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
   }
   analysis.num_rotating_pairs = static_cast<int>(axes.size());
   analysis.travel_direction_in_cam = TravelDirectionInCam(reconstruction);
-  for (size_t a = 0; a < axes.size(); ++a) {
-    for (size_t b = a + 1; b < axes.size(); ++b) {
-      const double cosine = std::min(1.0, std::abs(axes[a].dot(axes[b])));
-      analysis.max_axis_angle_deg =
-          std::max(analysis.max_axis_angle_deg, std::acos(cosine) * kRadToDeg);
-    }
-  }
+  analysis.max_axis_angle_deg = LargestAngleBetweenAxesDeg(axes);
   analysis.second_axis_rotation_deg = LargestRotationOffMainAxisDeg(rotation_vectors);
   analysis.unique = analysis.num_stations >= 3 &&
                     analysis.max_axis_angle_deg > options.max_parallel_axes_deg &&

@@ -91,6 +91,12 @@ struct MotionAnalysis {
   std::string verdict;
 };
 
+// The largest angle [deg] between two of the lines along `unit_axes` (0 to 90; 0 for fewer than
+// two): the same value as comparing every pair, found without most pairs when the axes gather
+// about one direction (the angle between lines is a metric, so two axes at angles a and b from
+// their main direction are at most a + b apart).
+double LargestAngleBetweenAxesDeg(const std::vector<Eigen::Vector3d>& unit_axes);
+
 // The uniqueness test of Zhen et al. 2019 on the relative motions of the registered cameras.
 MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
                              const ObservabilityOptions& options);

@@ -30,6 +30,31 @@ Eigen::Matrix3d Rotation(double deg, const Eigen::Vector3d& axis) {
   return Eigen::AngleAxisd(deg * kDeg, axis.normalized()).toRotationMatrix();
 }
 
+// The pruned search gives the largest angle of every pair, bit for bit: axes gathered about one
+// direction (a drive's turns), spread over all directions, and two clusters (two-axis stations).
+TEST(LargestAngleBetweenAxesDeg, EqualsTheLargestOfEveryPair) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal(0, 1);
+  for (const double spread : {0.02, 1.0, -1.0}) {
+    std::vector<Eigen::Vector3d> axes;
+    for (int i = 0; i < 300; ++i) {
+      Eigen::Vector3d axis(normal(rng), normal(rng), normal(rng));
+      if (spread > 0 && spread < 1) axis = Eigen::Vector3d(spread * axis.x(), 1, spread * axis.z());
+      if (spread < 0) axis = Eigen::Vector3d(0.05 * axis.x(), i % 2 ? 1 : 0, i % 2 ? 0 : 1);
+      axes.push_back(axis.normalized() * (i % 3 == 0 ? -1 : 1));
+    }
+    double every_pair = 0;
+    for (size_t a = 0; a < axes.size(); ++a) {
+      for (size_t b = a + 1; b < axes.size(); ++b) {
+        every_pair = std::max(
+            every_pair, std::acos(std::min(1.0, std::abs(axes[a].dot(axes[b])))) * (180.0 / M_PI));
+      }
+    }
+    EXPECT_EQ(LargestAngleBetweenAxesDeg(axes), every_pair) << spread;
+  }
+  EXPECT_EQ(LargestAngleBetweenAxesDeg({Eigen::Vector3d::UnitX()}), 0.0);
+}
+
 // A car: headings (about the camera's y axis) of 0-3 deg, with 0.15 deg of pose noise about the other
 // axes. The axes of the 2-3 deg turns scatter by more than the 5 deg "not parallel" threshold, yet
 // no pair turns about a second axis: not unique.
