@@ -36,31 +36,42 @@ std::string LowerExtension(const std::string& path) {
 // Accumulates points, dropping non-finite ones and counting them.
 class CloudBuilder {
  public:
-  CloudBuilder(bool normals, bool colors, bool intensities)
-      : normals_(normals), colors_(colors), intensities_(intensities) {}
+  CloudBuilder(bool normals, bool colors, bool intensities, bool times = false)
+      : normals_(normals), colors_(colors), intensities_(intensities), times_(times) {}
 
   // Callers pass a count the file's bytes can hold, never a header's bare claim.
-  void Reserve(size_t num_points) { cloud_.Reserve(num_points, normals_, colors_, intensities_); }
+  void Reserve(size_t num_points) {
+    cloud_.Reserve(num_points, normals_, colors_, intensities_);
+    if (times_) cloud_.times.reserve(num_points);
+  }
 
   void Add(const Eigen::Vector3d& point,
            const Eigen::Vector3d& normal,
            const Color3ub& color,
-           float intensity) {
+           float intensity,
+           double time = 0) {
     ++num_read_;
     if (!point.allFinite() || (normals_ && !normal.allFinite())) {
       ++num_dropped_;
       return;
     }
+    if (times_ && !std::isfinite(time)) ++num_non_finite_times_;
     cloud_.points.push_back(point);
     if (normals_) cloud_.normals.push_back(normal);
     if (colors_) cloud_.colors.push_back(color);
     if (intensities_) cloud_.intensities.push_back(intensity);
+    if (times_) cloud_.times.push_back(time);
   }
 
   PointCloud Finish(const std::string& path, CloudReadStats* stats) {
     if (num_read_ == 0) Fail(path, "the file holds no points");
     if (cloud_.Empty()) {
       Fail(path, "all " + std::to_string(num_read_) + " points are NaN or infinite");
+    }
+    if (num_non_finite_times_ > 0) {
+      Fail(path,
+           std::to_string(num_non_finite_times_) +
+               " points have a NaN or infinite time (the per-point time field)");
     }
     if (stats) {
       stats->num_read = num_read_;
@@ -70,9 +81,10 @@ class CloudBuilder {
   }
 
  private:
-  bool normals_, colors_, intensities_;
+  bool normals_, colors_, intensities_, times_;
   size_t num_read_ = 0;
   size_t num_dropped_ = 0;
+  size_t num_non_finite_times_ = 0;
   PointCloud cloud_;
 };
 
@@ -161,12 +173,15 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
   const pcl::PCLPointField* fz = find("z");
   if (!fx || !fy || !fz) Fail(path, "no x, y, z fields");
   const pcl::PCLPointField* fi = find("intensity");
+  const pcl::PCLPointField* ft = find("t");
+  if (!ft) ft = find("time");
+  if (!ft) ft = find("timestamp");
   const pcl::PCLPointField* fnx = find("normal_x");
   const pcl::PCLPointField* fny = find("normal_y");
   const pcl::PCLPointField* fnz = find("normal_z");
   const pcl::PCLPointField* frgb = find("rgb");
   if (!frgb) frgb = find("rgba");
-  for (const pcl::PCLPointField* field : {fx, fy, fz, fi, fnx, fny, fnz, frgb}) {
+  for (const pcl::PCLPointField* field : {fx, fy, fz, fi, ft, fnx, fny, fnz, frgb}) {
     if (field &&
         field->offset + std::max(PcdValueBytes(*field), field == frgb ? 4 : 0) > blob.point_step) {
       Fail(path, "field '" + field->name + "' lies outside the point record");
@@ -177,7 +192,7 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
   if (num_points != header.num_points || blob.data.size() < num_points * blob.point_step) {
     Fail(path, "truncated data section");
   }
-  CloudBuilder builder(normals, frgb != nullptr, fi != nullptr);
+  CloudBuilder builder(normals, frgb != nullptr, fi != nullptr, ft != nullptr);
   for (size_t i = 0; i < num_points; ++i) {
     const uint8_t* p = blob.data.data() + i * blob.point_step;
     const Eigen::Vector3d point(ReadPcdValue(*fx, p + fx->offset),
@@ -196,7 +211,7 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
       color = Color3ub((rgb >> 16) & 0xff, (rgb >> 8) & 0xff, rgb & 0xff);
     }
     const float intensity = fi ? static_cast<float>(ReadPcdValue(*fi, p + fi->offset)) : 0.f;
-    builder.Add(point, normal, color, intensity);
+    builder.Add(point, normal, color, intensity, ft ? ReadPcdValue(*ft, p + ft->offset) : 0.0);
   }
   return builder.Finish(path, stats);
 }
@@ -369,12 +384,14 @@ struct PlyFields {
         index_of({"nx", "normal_x"}), index_of({"ny", "normal_y"}), index_of({"nz", "normal_z"})};
     rgb = {index_of({"red", "r"}), index_of({"green", "g"}), index_of({"blue", "b"})};
     intensity = index_of({"intensity", "scalar_intensity", "scalar_Intensity"});
+    time = index_of({"t", "time", "timestamp"});
   }
   static bool All(const std::array<int, 3>& fields) {
     return fields[0] >= 0 && fields[1] >= 0 && fields[2] >= 0;
   }
   std::array<int, 3> xyz, normal, rgb;
   int intensity;
+  int time;
 };
 
 void ReadPlyAsciiVertex(const std::string& path,
@@ -429,7 +446,7 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
   if (!PlyFields::All(fields.xyz)) Fail(path, "no x, y, z vertex properties");
   const bool normals = PlyFields::All(fields.normal);
   const bool colors = PlyFields::All(fields.rgb);
-  CloudBuilder builder(normals, colors, fields.intensity >= 0);
+  CloudBuilder builder(normals, colors, fields.intensity >= 0, fields.time >= 0);
   std::vector<double> values(header.properties.size());
   size_t record_size = 0;
   for (const auto& p : header.properties) record_size += p.size;
@@ -457,7 +474,8 @@ PointCloud ReadPly(const std::string& path, CloudReadStats* stats) {
     builder.Add(vector_of(fields.xyz),
                 normals ? vector_of(fields.normal) : Eigen::Vector3d::Zero(),
                 color,
-                fields.intensity >= 0 ? static_cast<float>(values[fields.intensity]) : 0.f);
+                fields.intensity >= 0 ? static_cast<float>(values[fields.intensity]) : 0.f,
+                fields.time >= 0 ? values[fields.time] : 0.0);
   }
   return builder.Finish(path, stats);
 }

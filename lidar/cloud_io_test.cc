@@ -94,6 +94,26 @@ TEST_F(CloudIoTest, ReadsEveryPcdEncodingWrittenByPcl) {
   }
 }
 
+// A driver's per-point time field ("t", "time" or "timestamp") is read as it is; a NaN time is an
+// error naming the file, not a point silently timed.
+TEST_F(CloudIoTest, ReadsPerPointTimesOfPcdAndPly) {
+  std::ofstream(Path("t.pcd")) << "VERSION 0.7\nFIELDS x y z t\nSIZE 4 4 4 4\nTYPE F F F U\n"
+                                  "COUNT 1 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+                                  "POINTS 3\nDATA ascii\n1 0 0 0\n0 1 0 50000000\n0 0 1 99999999\n";
+  const PointCloud pcd = ReadPointCloud(Path("t.pcd"));
+  ASSERT_TRUE(pcd.HasTimes());
+  EXPECT_EQ(pcd.times, std::vector<double>({0, 50000000, 99999999}));
+  std::ofstream(Path("t.ply")) << "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                                  "property float y\nproperty float z\nproperty double time\n"
+                                  "end_header\n1 2 3 1317384000.25\n4 5 6 1317384000.30\n";
+  const PointCloud ply = ReadPointCloud(Path("t.ply"));
+  EXPECT_EQ(ply.times, std::vector<double>({1317384000.25, 1317384000.30}));
+  std::ofstream(Path("nan.ply")) << "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                                    "property float y\nproperty float z\nproperty double time\n"
+                                    "end_header\n1 2 3 0.25\n4 5 6 nan\n";
+  ExpectReadError(Path("nan.ply"), "NaN or infinite time");
+}
+
 TEST_F(CloudIoTest, ReadsKittiBinAndXyzText) {
   const std::vector<float> kitti = {1, 2, 3, 0.5f, 4, 5, 6, 0.25f};
   std::ofstream(Path("k.bin"), std::ios::binary)

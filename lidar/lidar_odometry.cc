@@ -73,21 +73,21 @@ LidarOdometry::LidarOdometry(const LidarOdometryOptions& options)
       map_(options.VoxelSize(), options.max_range_m, options.max_points_per_voxel),
       threshold_(options.initial_sigma_m, options.min_motion_m, options.max_range_m) {}
 
-std::vector<Eigen::Vector3d> LidarOdometry::Preprocess(
-    const std::vector<Eigen::Vector3d>& points) const {
-  std::vector<Eigen::Vector3d> in_range;
-  in_range.reserve(points.size());
-  for (const Eigen::Vector3d& p : points) {
-    const double range = p.norm();
-    if (range >= options_.min_range_m && range <= options_.max_range_m) in_range.push_back(p);
+std::vector<Eigen::Vector3d> LidarOdometry::Preprocess(const PointCloud& sweep) const {
+  const bool deskew = options_.deskew && frames_.size() >= 2;
+  PointCloud in_range;
+  in_range.points.reserve(sweep.Size());
+  for (size_t i = 0; i < sweep.Size(); ++i) {
+    const double range = sweep.points[i].norm();
+    if (range < options_.min_range_m || range > options_.max_range_m) continue;
+    in_range.points.push_back(sweep.points[i]);
+    if (deskew && sweep.HasTimes()) in_range.times.push_back(sweep.times[i]);
   }
-  if (!options_.deskew || frames_.size() < 2) return in_range;
-  PointCloud sweep;
-  sweep.points = std::move(in_range);
+  if (!deskew || in_range.Empty()) return std::move(in_range.points);
   SweepMotion motion;
   motion.mid_from_next_mid = velocity_;
   motion.mid_from_previous_mid = velocity_.inverse();
-  return DeskewSweep(sweep, motion, options_.timing).points;
+  return DeskewSweep(in_range, motion, options_.timing).points;
 }
 
 void LidarOdometry::FinishFrame(const FrameToMapIcpResult& icp, OdometryFrame* frame) const {
@@ -107,12 +107,18 @@ void LidarOdometry::FinishFrame(const FrameToMapIcpResult& icp, OdometryFrame* f
 
 const OdometryFrame& LidarOdometry::RegisterFrame(const std::vector<Eigen::Vector3d>& points,
                                                   double clock) {
+  PointCloud sweep;
+  sweep.points = points;
+  return RegisterFrame(sweep, clock);
+}
+
+const OdometryFrame& LidarOdometry::RegisterFrame(const PointCloud& sweep, double clock) {
   if (!frames_.empty() && !(clock > last_clock_)) {
     throw std::invalid_argument("LidarOdometry: frame clock " + std::to_string(clock) +
                                 " does not follow " + std::to_string(last_clock_));
   }
   OdometryFrame frame;
-  const std::vector<Eigen::Vector3d> deskewed = Preprocess(points);
+  const std::vector<Eigen::Vector3d> deskewed = Preprocess(sweep);
   if (deskewed.empty()) throw std::runtime_error("no point within the LiDAR's range");
   frame.num_points = deskewed.size();
   const double voxel = options_.VoxelSize();

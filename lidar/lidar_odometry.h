@@ -78,15 +78,18 @@ class LidarOdometry {
   // Throws std::invalid_argument for invalid options.
   explicit LidarOdometry(const LidarOdometryOptions& options);
 
-  // Registers the next frame: its points in its LiDAR frame, taken at `clock` (the sweep's middle,
-  // in sweep durations; increasing). Throws std::invalid_argument for a clock that does not
-  // increase and std::runtime_error for a frame with no point in range.
+  // Registers the next frame: its sweep in its LiDAR frame (with per-point times, if it has them,
+  // for the de-skewing), taken at `clock` (the sweep's middle, in sweep durations; increasing).
+  // Throws std::invalid_argument for a clock that does not increase or per-point times that do not
+  // time a sweep (lidar/sweep_deskew.h SweepFractions), std::runtime_error for a frame with no
+  // point in range.
+  const OdometryFrame& RegisterFrame(const PointCloud& sweep, double clock);
   const OdometryFrame& RegisterFrame(const std::vector<Eigen::Vector3d>& points, double clock);
 
   const std::vector<OdometryFrame>& Frames() const { return frames_; }
 
  private:
-  std::vector<Eigen::Vector3d> Preprocess(const std::vector<Eigen::Vector3d>& points) const;
+  std::vector<Eigen::Vector3d> Preprocess(const PointCloud& sweep) const;
   void FinishFrame(const FrameToMapIcpResult& icp, OdometryFrame* frame) const;
 
   LidarOdometryOptions options_;

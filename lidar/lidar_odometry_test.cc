@@ -67,6 +67,41 @@ TEST(LidarOdometry, FollowsARawDrive) {
   EXPECT_LT(deskewed.translation_percent, skewed.translation_percent);
 }
 
+// Sweeps that carry per-point times are de-skewed by them: with a wrong start azimuth in the
+// options, the timed sweeps follow the drive as well as correctly timed ones, the untimed do not.
+TEST(LidarOdometry, PerPointTimesDeskewWhateverTheAzimuthOptions) {
+  const Drive drive = SimulateDrive(30, 12.0);
+  LidarOdometryOptions wrong = StreetOptions();
+  wrong.timing.start_azimuth_deg = 0;
+  LidarOdometry timed(wrong), untimed(wrong), right(StreetOptions());
+  std::vector<Eigen::Isometry3d> timed_poses, untimed_poses, right_poses;
+  for (size_t k = 0; k < drive.sweeps.size(); ++k) {
+    PointCloud sweep;
+    sweep.points = drive.sweeps[k];
+    for (const Eigen::Vector3d& point : sweep.points) {
+      sweep.times.push_back(5.0 + kPeriod * k + kPeriod * SweepFraction(point, {}));
+    }
+    timed_poses.push_back(timed.RegisterFrame(sweep, static_cast<double>(k)).world_from_lidar);
+    untimed_poses.push_back(
+        untimed.RegisterFrame(drive.sweeps[k], static_cast<double>(k)).world_from_lidar);
+    right_poses.push_back(
+        right.RegisterFrame(drive.sweeps[k], static_cast<double>(k)).world_from_lidar);
+  }
+  TrajectoryErrorOptions metric;
+  metric.lengths_m = {10, 20};
+  const double with_times =
+      EvaluateTrajectoryError(timed_poses, drive.truth, metric).translation_percent;
+  const double without =
+      EvaluateTrajectoryError(untimed_poses, drive.truth, metric).translation_percent;
+  const double correct =
+      EvaluateTrajectoryError(right_poses, drive.truth, metric).translation_percent;
+  std::cout << "wrong start azimuth: timed " << with_times << " %, untimed " << without
+            << " %; right azimuth " << correct << " %" << std::endl;
+  // Measured 0.0920 % and 0.0927 % timed and right, 0.157 % untimed.
+  EXPECT_NEAR(with_times, correct, 0.003);
+  EXPECT_GT(without, 1.3 * with_times);
+}
+
 TEST(LidarOdometry, NamesTheDegenerateDirectionOfAStreetOfBareWalls) {
   const Drive drive = SimulateDrive(12, 10.0, /*walls_only=*/true);
   LidarOdometry odometry(StreetOptions());

@@ -45,8 +45,8 @@ OdometryRegistration RegisterSweepsByOdometry(const std::vector<std::string>& cl
     const PointCloud sweep = ReadStationCloud(cloud_paths[k]);
     const auto start = std::chrono::steady_clock::now();
     try {
-      odometry.RegisterFrame(sweep.points, clock[k]);
-    } catch (const std::runtime_error& error) {
+      odometry.RegisterFrame(sweep, clock[k]);
+    } catch (const std::exception& error) {
       throw std::runtime_error(cloud_paths[k] + ": " + error.what());
     }
     result.seconds_registering +=

@@ -19,6 +19,7 @@ void PointCloud::CheckConsistent() const {
   CheckAttribute(points.size(), normals.size(), "normals");
   CheckAttribute(points.size(), colors.size(), "colors");
   CheckAttribute(points.size(), intensities.size(), "intensities");
+  CheckAttribute(points.size(), times.size(), "times");
 }
 
 void PointCloud::Reserve(size_t n, bool with_normals, bool with_colors, bool with_intensities) {

@@ -1,5 +1,6 @@
-// An Eigen-only point cloud: positions, optional normals, colours and intensities (each either empty or
-// of the same length as `points`). Positions are in the frame the producer names (e.g. point_in_lidar).
+// An Eigen-only point cloud: positions, optional normals, colours, intensities and per-point times
+// (each either empty or of the same length as `points`). Positions are in the frame the producer
+// names (e.g. point_in_lidar).
 #pragma once
 
 #include <Eigen/Core>
@@ -16,12 +17,17 @@ struct PointCloud {
   std::vector<Eigen::Vector3d> normals;
   std::vector<Color3ub> colors;
   std::vector<float> intensities;
+  // When each point was measured, as the file's time field gives it (any unit and origin: a driver's
+  // seconds or nanoseconds, from the sweep's start or absolute); lidar/sweep_deskew.h times a sweep
+  // by it.
+  std::vector<double> times;
 
   size_t Size() const { return points.size(); }
   bool Empty() const { return points.empty(); }
   bool HasNormals() const { return !normals.empty(); }
   bool HasColors() const { return !colors.empty(); }
   bool HasIntensities() const { return !intensities.empty(); }
+  bool HasTimes() const { return !times.empty(); }
 
   // Throws std::invalid_argument when an attribute has neither 0 nor Size() entries.
   void CheckConsistent() const;

@@ -83,10 +83,39 @@ std::vector<double> SweepClockFromTimes(const std::vector<std::pair<double, doub
   return clock;
 }
 
+std::vector<double> SweepFractions(const PointCloud& sweep, const SweepTimingOptions& options) {
+  ThrowUnlessValid(options, "SweepTimingOptions");
+  std::vector<double> fractions(sweep.Size());
+  if (!sweep.HasTimes()) {
+    for (size_t i = 0; i < sweep.Size(); ++i)
+      fractions[i] = SweepFraction(sweep.points[i], options);
+    return fractions;
+  }
+  if (sweep.times.size() != sweep.Size()) {
+    throw std::invalid_argument("a per-point time for each point is needed");
+  }
+  std::vector<double> sorted = sweep.times;
+  std::sort(sorted.begin(), sorted.end());
+  const double earliest = sorted.front(), span = sorted.back() - sorted.front();
+  if (!(span > 0)) {
+    throw std::invalid_argument(
+        "the per-point times are all equal: they do not time the sweep (remove the time field to "
+        "time the points by their azimuth)");
+  }
+  const double middle_span = sorted[sorted.size() * 99 / 100] - sorted[sorted.size() / 100];
+  if (middle_span < 0.9 * 0.98 * span) {
+    throw std::invalid_argument("per-point times out of range: 98 % of the points span " +
+                                std::to_string(middle_span) + ", all of them " +
+                                std::to_string(span) + " (a few times far from the sweep's)");
+  }
+  for (size_t i = 0; i < sweep.Size(); ++i) fractions[i] = (sweep.times[i] - earliest) / span;
+  return fractions;
+}
+
 PointCloud DeskewSweep(const PointCloud& sweep,
                        const SweepMotion& motion,
                        const SweepTimingOptions& options) {
-  ThrowUnlessValid(options, "SweepTimingOptions");
+  const std::vector<double> fractions = SweepFractions(sweep, options);
   // Index 0: towards the previous middle (s < 0), 1: towards the next one.
   const Eigen::AngleAxisd rotations[2] = {
       Eigen::AngleAxisd(motion.mid_from_previous_mid.rotation()),
@@ -100,7 +129,7 @@ PointCloud DeskewSweep(const PointCloud& sweep,
 #pragma omp parallel for schedule(static)
   for (int64_t i = 0; i < static_cast<int64_t>(sweep.Size()); ++i) {
     const Eigen::Vector3d& point = sweep.points[i];
-    const double s = SweepFraction(point, options) - 0.5;
+    const double s = fractions[i] - 0.5;
     const int half = s >= 0 ? 1 : 0;
     const double a = std::abs(s);
     deskewed.points[i] =

@@ -35,6 +35,12 @@ struct SweepTimingOptions {
 // The fraction [0, 1) of the revolution at which a point in the LiDAR frame was measured.
 double SweepFraction(const Eigen::Vector3d& point_in_lidar, const SweepTimingOptions& options);
 
+// Each point's fraction [0, 1] of the sweep: from its time where the cloud carries per-point times
+// ((t - earliest) / (latest - earliest), whatever their unit and origin), else from its azimuth
+// (SweepFraction). Throws std::invalid_argument for times that do not time a sweep: all equal, or
+// a few far outside the rest (the span of the middle 98 % is below 0.9 of the full span's 98 %).
+std::vector<double> SweepFractions(const PointCloud& sweep, const SweepTimingOptions& options);
+
 // Where a sweep began and ended: the middles of its neighbours in its own middle's frame. With one
 // neighbour only, the other is its mirror (constant velocity).
 struct SweepMotion {
@@ -57,7 +63,8 @@ std::vector<SweepMotion> SweepMotionsFromPoses(
 // std::invalid_argument for a sweep that does not end after it starts.
 std::vector<double> SweepClockFromTimes(const std::vector<std::pair<double, double>>& start_end);
 
-// The sweep in the LiDAR frame at its middle; normals are not carried (they change with the points).
+// The sweep in the LiDAR frame at its middle, each point moved by its SweepFractions; normals and
+// times are not carried (they change with the points, and the points are no longer skewed).
 PointCloud DeskewSweep(const PointCloud& sweep,
                        const SweepMotion& motion,
                        const SweepTimingOptions& options);

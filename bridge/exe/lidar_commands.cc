@@ -196,6 +196,19 @@ void AddLidarRegistratorOptions(const std::string& prefix,
 
 namespace {
 
+// The sweep read from `file`, de-skewed; per-point times that do not time it are an error naming
+// the file.
+PointCloud DeskewFileSweep(const fs::path& file,
+                           const PointCloud& raw,
+                           const SweepMotion& motion,
+                           const SweepTimingOptions& timing) {
+  try {
+    return DeskewSweep(raw, motion, timing);
+  } catch (const std::invalid_argument& error) {
+    throw std::runtime_error(file.string() + ": " + error.what());
+  }
+}
+
 // Reads, optionally de-skews (motion per sweep given), prepares and registers the clouds; prints
 // progress. With `deskewed_path`, each de-skewed cloud is written there as <station>.pcd.
 LidarGraph RegisterClouds(const std::vector<fs::path>& files,
@@ -209,7 +222,7 @@ LidarGraph RegisterClouds(const std::vector<fs::path>& files,
     CloudReadStats stats;
     PointCloud raw = ReadStationCloud(files[i].string(), &stats);
     if (sweep_motions != nullptr) {
-      raw = DeskewSweep(raw, (*sweep_motions)[i], options.sweep_timing);
+      raw = DeskewFileSweep(files[i], raw, (*sweep_motions)[i], options.sweep_timing);
       WritePointCloud((fs::path(deskewed_path) / (files[i].stem().string() + ".pcd")).string(),
                       raw);
     }
@@ -322,7 +335,7 @@ void WriteDeskewedSweeps(const std::vector<fs::path>& files,
   for (size_t i = 0; i < files.size(); ++i) {
     const PointCloud raw = ReadStationCloud(files[i].string());
     WritePointCloud((deskewed_path / (files[i].stem().string() + ".pcd")).string(),
-                    DeskewSweep(raw, motions[i], timing));
+                    DeskewFileSweep(files[i], raw, motions[i], timing));
   }
 }
 
@@ -516,7 +529,7 @@ void RunDeskewSweepsStep(const StationDataset& dataset,
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
     const PointCloud raw = ReadStationCloud(dataset.cloud_paths[i]);
     WritePointCloud(partial.File(dataset.stations[i] + ".pcd"),
-                    DeskewSweep(raw, motions[i], timing));
+                    DeskewFileSweep(dataset.cloud_paths[i], raw, motions[i], timing));
   }
   partial.Commit();
   std::cout << "deskew_sweeps: " << dataset.stations.size()
