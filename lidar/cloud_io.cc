@@ -147,6 +147,58 @@ int PcdValueBytes(const pcl::PCLPointField& field) {
   }
 }
 
+// Where each attribute of a point lies in a PCD record (null: absent); every field is checked to
+// lie inside the record.
+struct PcdFields {
+  PcdFields(const std::string& path, const pcl::PCLPointCloud2& blob) {
+    const auto find = [&](std::initializer_list<const char*> names) -> const pcl::PCLPointField* {
+      for (const char* name : names) {
+        for (const auto& f : blob.fields) {
+          if (f.name == name) return &f;
+        }
+      }
+      return nullptr;
+    };
+    x = find({"x"}), y = find({"y"}), z = find({"z"});
+    if (!x || !y || !z) Fail(path, "no x, y, z fields");
+    intensity = find({"intensity"});
+    time = find({"t", "time", "timestamp"});
+    nx = find({"normal_x"}), ny = find({"normal_y"}), nz = find({"normal_z"});
+    rgb = find({"rgb", "rgba"});
+    for (const pcl::PCLPointField* field : {x, y, z, intensity, time, nx, ny, nz, rgb}) {
+      if (field &&
+          field->offset + std::max(PcdValueBytes(*field), field == rgb ? 4 : 0) > blob.point_step) {
+        Fail(path, "field '" + field->name + "' lies outside the point record");
+      }
+    }
+  }
+  bool HasNormals() const { return nx && ny && nz; }
+
+  const pcl::PCLPointField *x, *y, *z, *intensity, *time, *nx, *ny, *nz, *rgb;
+};
+
+// The point of the PCD record at `record` into `builder`.
+void AddPcdPoint(const PcdFields& fields, const uint8_t* record, CloudBuilder* builder) {
+  const auto value = [&](const pcl::PCLPointField* field) {
+    return ReadPcdValue(*field, record + field->offset);
+  };
+  const Eigen::Vector3d point(value(fields.x), value(fields.y), value(fields.z));
+  const Eigen::Vector3d normal =
+      fields.HasNormals() ? Eigen::Vector3d(value(fields.nx), value(fields.ny), value(fields.nz))
+                          : Eigen::Vector3d::Zero();
+  Color3ub color(0, 0, 0);
+  if (fields.rgb) {
+    uint32_t rgb;
+    std::memcpy(&rgb, record + fields.rgb->offset, 4);
+    color = Color3ub((rgb >> 16) & 0xff, (rgb >> 8) & 0xff, rgb & 0xff);
+  }
+  builder->Add(point,
+               normal,
+               color,
+               fields.intensity ? static_cast<float>(value(fields.intensity)) : 0.f,
+               fields.time ? value(fields.time) : 0.0);
+}
+
 PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
   // Our own check first: PCL's reader trusts the header (random bytes crash it).
   const PcdHeader header = ReadPcdHeader(path);
@@ -162,56 +214,17 @@ PointCloud ReadPcd(const std::string& path, CloudReadStats* stats) {
   if (status < 0) {
     Fail(path, "PCL's PCD reader rejected it (truncated or malformed; see the message above)");
   }
-  auto find = [&](const std::string& name) -> const pcl::PCLPointField* {
-    for (const auto& f : blob.fields) {
-      if (f.name == name) return &f;
-    }
-    return nullptr;
-  };
-  const pcl::PCLPointField* fx = find("x");
-  const pcl::PCLPointField* fy = find("y");
-  const pcl::PCLPointField* fz = find("z");
-  if (!fx || !fy || !fz) Fail(path, "no x, y, z fields");
-  const pcl::PCLPointField* fi = find("intensity");
-  const pcl::PCLPointField* ft = find("t");
-  if (!ft) ft = find("time");
-  if (!ft) ft = find("timestamp");
-  const pcl::PCLPointField* fnx = find("normal_x");
-  const pcl::PCLPointField* fny = find("normal_y");
-  const pcl::PCLPointField* fnz = find("normal_z");
-  const pcl::PCLPointField* frgb = find("rgb");
-  if (!frgb) frgb = find("rgba");
-  for (const pcl::PCLPointField* field : {fx, fy, fz, fi, ft, fnx, fny, fnz, frgb}) {
-    if (field &&
-        field->offset + std::max(PcdValueBytes(*field), field == frgb ? 4 : 0) > blob.point_step) {
-      Fail(path, "field '" + field->name + "' lies outside the point record");
-    }
-  }
-  const bool normals = fnx && fny && fnz;
+  const PcdFields fields(path, blob);
   const size_t num_points = static_cast<size_t>(blob.width) * blob.height;
   if (num_points != header.num_points || blob.data.size() < num_points * blob.point_step) {
     Fail(path, "truncated data section");
   }
-  CloudBuilder builder(normals, frgb != nullptr, fi != nullptr, ft != nullptr);
+  CloudBuilder builder(fields.HasNormals(),
+                       fields.rgb != nullptr,
+                       fields.intensity != nullptr,
+                       fields.time != nullptr);
   for (size_t i = 0; i < num_points; ++i) {
-    const uint8_t* p = blob.data.data() + i * blob.point_step;
-    const Eigen::Vector3d point(ReadPcdValue(*fx, p + fx->offset),
-                                ReadPcdValue(*fy, p + fy->offset),
-                                ReadPcdValue(*fz, p + fz->offset));
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-    if (normals) {
-      normal = Eigen::Vector3d(ReadPcdValue(*fnx, p + fnx->offset),
-                               ReadPcdValue(*fny, p + fny->offset),
-                               ReadPcdValue(*fnz, p + fnz->offset));
-    }
-    Color3ub color(0, 0, 0);
-    if (frgb) {
-      uint32_t rgb;
-      std::memcpy(&rgb, p + frgb->offset, 4);
-      color = Color3ub((rgb >> 16) & 0xff, (rgb >> 8) & 0xff, rgb & 0xff);
-    }
-    const float intensity = fi ? static_cast<float>(ReadPcdValue(*fi, p + fi->offset)) : 0.f;
-    builder.Add(point, normal, color, intensity, ft ? ReadPcdValue(*ft, p + ft->offset) : 0.0);
+    AddPcdPoint(fields, blob.data.data() + i * blob.point_step, &builder);
   }
   return builder.Finish(path, stats);
 }
