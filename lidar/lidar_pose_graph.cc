@@ -115,19 +115,6 @@ std::vector<StationPair> BridgePairs(const std::vector<std::vector<double>>& his
   return {pairs.begin(), pairs.end()};
 }
 
-// Symmetric square root of the edge's information: the ICP Hessian scaled so that its best-held
-// translation direction has information 1 / sigma^2 (sigma: the pair's ICP RMSE), keeping its shape,
-// so a degenerate direction enters the graph with the little information it has.
-Eigen::Matrix<double, 6, 6> SqrtInformation(const PairRegistration& r) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> translation(
-      r.hessian.bottomRightCorner<3, 3>());
-  const double sigma = std::max(r.rmse, 1e-4);
-  const double scale = 1 / (std::max(translation.eigenvalues()(2), 1e-12) * sigma * sigma);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(scale * r.hessian);
-  const Eigen::Matrix<double, 6, 1> roots = eigen.eigenvalues().cwiseMax(0).cwiseSqrt();
-  return eigen.eigenvectors() * roots.asDiagonal() * eigen.eigenvectors().transpose();
-}
-
 // Pairs registered and sorted into accepted and refused edges; progress counts from `done_before`.
 void RegisterPairs(const std::vector<const StationCloud*>& stations,
                    const std::vector<StationPair>& pairs,
@@ -230,7 +217,7 @@ void SolveLidarPoseGraph(size_t n, const LidarGraphOptions& options, LidarGraph*
   std::vector<RelativePoseEdge> edges;
   for (const LidarEdge& e : graph->edges) {
     edges.push_back(
-        {e.target, e.source, e.target_from_source, e.Weight(), SqrtInformation(e.registration)});
+        {e.target, e.source, e.target_from_source, e.Weight(), EdgeSqrtInformation(e.registration)});
   }
   PoseGraphOptions pose_graph;
   pose_graph.refine = options.refine;
@@ -245,6 +232,16 @@ void SolveLidarPoseGraph(size_t n, const LidarGraphOptions& options, LidarGraph*
 }
 
 }  // namespace
+
+Eigen::Matrix<double, 6, 6> EdgeSqrtInformation(const PairRegistration& r) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> translation(
+      r.hessian.bottomRightCorner<3, 3>());
+  const double sigma = std::max(r.rmse, 1e-4);
+  const double scale = 1 / (std::max(translation.eigenvalues()(2), 1e-12) * sigma * sigma);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(scale * r.hessian);
+  const Eigen::Matrix<double, 6, 1> roots = eigen.eigenvalues().cwiseMax(0).cwiseSqrt();
+  return eigen.eigenvectors() * roots.asDiagonal() * eigen.eigenvectors().transpose();
+}
 
 double LidarEdge::Weight() const {
   const PairRegistration& r = registration;

@@ -28,6 +28,12 @@ struct LidarEdge {
   double Weight() const;
 };
 
+// Symmetric square root of an edge's information for the pose graph ([omega, t] in the target frame):
+// the ICP Hessian scaled so that its best-held translation direction has information 1 / sigma^2
+// (sigma: the pair's ICP RMSE), keeping its shape, so that a degenerate direction enters with the
+// little information it has.
+Eigen::Matrix<double, 6, 6> EdgeSqrtInformation(const PairRegistration& registration);
+
 struct LidarGraphOptions {
   PairRegistrationOptions pair;
   // 0: register every pair. Otherwise each station is registered with its `max_neighbors` most

@@ -10,6 +10,7 @@
 #include "lidar/lidar_pose_graph.h"
 #include "lidar/odometry_registration.h"
 #include "lidar/preprocessing.h"
+#include "lidar/revisit_closure.h"
 #include "lidar/sweep_deskew.h"
 
 #include "colmap/controllers/option_manager.h"
@@ -129,7 +130,7 @@ bool LidarRegistratorStepOptions::Check() {
   CHECK_OPTION_GE(remove_moving_points, -1);
   CHECK_OPTION_LE(remove_moving_points, 1);
   CHECK_OPTION(method == "auto" || method == "pairwise" || method == "odometry");
-  return sweep_timing.Check() && moving.Check() && odometry.Check();
+  return sweep_timing.Check() && moving.Check() && odometry.Check() && revisit.Check();
 }
 
 void AddLidarRegistratorOptions(const std::string& prefix,
@@ -192,6 +193,19 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("odometry_point_to_plane",
           &options->odometry.icp.point_to_plane,
           "distance to the map's local plane where it is one (0: point-to-point, KISS-ICP)");
+  add.Add("revisits",
+          &options->revisits,
+          "odometry: register keyframes that revisit a place, accepted within the drift");
+  add.Add("revisit_radius_m", &options->revisit.search_radius_m, "keyframes nearer than this");
+  add.Add("revisit_min_path_m",
+          &options->revisit.min_path_gap_m,
+          "and at least this far apart along the path");
+  add.Add("odometry_drift",
+          &options->revisit.drift_translation,
+          "the odometry's translation drift per metre travelled (1 sigma)");
+  add.Add("odometry_drift_deg_per_m",
+          &options->revisit.drift_rotation_deg_per_m,
+          "the odometry's rotation drift (1 sigma)");
 }
 
 namespace {
@@ -407,6 +421,36 @@ LidarGraph RegisterByOdometry(const std::vector<fs::path>& files,
   return result.graph;
 }
 
+// Revisit edges of the odometry's trajectory (lidar/revisit_closure.h) between the clouds of
+// `cloud_paths`; prints each revisit and returns the summary's lines.
+std::string CloseOdometryRevisits(const std::vector<std::string>& cloud_paths,
+                                  const std::vector<fs::path>& files,
+                                  const LidarRegistratorStepOptions& options,
+                                  LidarGraph* graph) {
+  RevisitOptions revisit = options.revisit;
+  revisit.cloud = options.cloud;
+  revisit.pair = options.graph.pair;
+  const RevisitClosure closure = CloseRevisits(cloud_paths, revisit, graph);
+  const auto print = [&](const RevisitEdge& r, const char* verdict) {
+    std::cout << "lidar_registrator: revisit " << files[r.edge.source].stem().string() << " -> "
+              << files[r.edge.target].stem().string() << " " << verdict;
+    if (r.chi2 >= 0) std::cout << " (chi2 " << r.chi2 << ", bound " << revisit.max_chi2 << ")";
+    if (!r.edge.registration.accepted) std::cout << ": " << r.edge.registration.reason;
+    std::cout << std::endl;
+  };
+  for (const RevisitEdge& r : closure.accepted) print(r, "accepted");
+  for (const RevisitEdge& r : closure.refused) print(r, "refused");
+  std::cout << "lidar_registrator: " << closure.num_candidates << " revisit candidates among "
+            << closure.num_keyframes << " keyframes, " << closure.accepted.size() << " accepted ["
+            << std::fixed << std::setprecision(1) << closure.seconds << " s]" << std::defaultfloat
+            << std::setprecision(6) << std::endl;
+  std::ostringstream lines;
+  lines << "revisit_keyframes " << closure.num_keyframes << "\nrevisit_candidates "
+        << closure.num_candidates << "\nrevisit_edges " << closure.accepted.size()
+        << "\nrevisit_edges_refused " << closure.refused.size() << "\n";
+  return lines.str();
+}
+
 // The registration by the chosen method, then (sweeps) de-skewing with its motion: the odometry's
 // poses stand; the pairwise path registers the de-skewed sweeps again.
 LidarGraph RegisterStations(const std::vector<fs::path>& files,
@@ -438,6 +482,16 @@ LidarGraph RegisterStations(const std::vector<fs::path>& files,
     } else {
       graph = RegisterClouds(files, options, &motions, deskewed_path.string(), frames, start);
     }
+  }
+  if (odometry && options.revisits) {
+    std::vector<std::string> cloud_paths;
+    for (const fs::path& file : files) {
+      cloud_paths.push_back(
+          options.deskew_sweeps
+              ? (fs::path(output_path) / "deskewed" / (file.stem().string() + ".pcd")).string()
+              : file.string());
+    }
+    *method_line += CloseOdometryRevisits(cloud_paths, files, options, &graph);
   }
   return graph;
 }

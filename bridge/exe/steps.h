@@ -25,6 +25,7 @@
 #include "lidar/lidar_pose_graph.h"
 #include "lidar/model_evaluation.h"
 #include "lidar/moving_points.h"
+#include "lidar/revisit_closure.h"
 #include "lidar/station_cloud.h"
 #include "lidar/sweep_deskew.h"
 
@@ -112,6 +113,11 @@ struct LidarRegistratorStepOptions {
   std::string method = "auto";
   bool moving_platform = false;  // the dataset's rig.json says so
   LidarOdometryOptions odometry;
+  // Odometry: revisit edges between keyframes near in space, far along the path, registered by BSC
+  // + RANSAC + ICP and accepted within the odometry's drift (lidar/revisit_closure.h); `revisit`'s
+  // cloud and pair options are this step's `cloud` and `graph.pair`.
+  bool revisits = true;
+  RevisitOptions revisit;
   // After registration, flag the points of moving objects by free space (lidar/moving_points.h) and
   // write each cloud without them to OUTPUT/static/<station>.pcd (and all flagged points, in the
   // first station's frame, to OUTPUT/moving_points.ply); the later steps of `pipeline` use them.

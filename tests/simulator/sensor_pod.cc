@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -38,9 +39,13 @@ Motion MotionFromName(const std::string& name) {
   if (name == "one_axis") return Motion::kOneAxis;
   if (name == "fixed_rotation") return Motion::kFixedRotation;
   if (name == "drive") return Motion::kDrive;
-  throw std::invalid_argument("Unknown --motion '" + name +
-                              "'; expected two_axes, one_axis, fixed_rotation or drive");
+  if (name == "drive_return") return Motion::kDriveReturn;
+  throw std::invalid_argument(
+      "Unknown --motion '" + name +
+      "'; expected two_axes, one_axis, fixed_rotation, drive or drive_return");
 }
+
+bool IsDrive(Motion motion) { return motion == Motion::kDrive || motion == Motion::kDriveReturn; }
 
 namespace {
 
@@ -111,6 +116,69 @@ colmap::Rigid3d CamLookingAt(const Eigen::Vector3d& eye,
       eye);
 }
 
+namespace {
+
+// The return drive's lanes: out along y = -1.8 m, back along y = +1.8 m.
+constexpr double kReturnLane = 1.8;
+
+// Heading at path length s of the return drive whose turn starts at `length` and is `turn` long:
+// 0 out, pi back; in the turn the curvature rises and falls as sin^2 (a driver steering in and out
+// of a U-turn), so that the heading is pi (u - sin(2 pi u) / (2 pi)) at the turn's fraction u.
+double ReturnHeading(double s, double length, double turn) {
+  const double u = std::clamp((s - length) / turn, 0.0, 1.0);
+  return M_PI * (u - std::sin(2 * M_PI * u) / (2 * M_PI));
+}
+
+// The turn's length that takes the car from one lane to the other (the lateral offset of the
+// turn scales with its length).
+double ReturnTurnLength() {
+  constexpr int kSteps = 10000;
+  double offset_per_metre = 0;
+  for (int k = 0; k < kSteps; ++k) {
+    offset_per_metre += std::sin(ReturnHeading((k + 0.5) / kSteps, 0, 1)) / kSteps;
+  }
+  return 2 * kReturnLane / offset_per_metre;
+}
+
+// The step at path length s: 1.0-1.5 m per frame (`unit` in [0, 1)), slowing to a quarter within
+// 4 m of the turn (a platform that turns around at walking pace).
+double ReturnStep(double s, double length, double turn, double unit) {
+  const double to_turn = std::max({0.0, length - s, s - length - turn});
+  return (1.0 + 0.5 * unit) * (0.25 + 0.75 * std::min(1.0, to_turn / 4.0));
+}
+
+// Out along one lane, a U-turn at the far end, back along the other lane; the way's straight part
+// such that the frames at their mean step cover it. Heading along the path.
+std::vector<colmap::Rigid3d> ReturnDriveStations(int num_stations, std::mt19937_64* rng) {
+  const double turn = ReturnTurnLength();
+  const auto frames_to_cover = [turn](double length) {
+    int frames = 1;
+    for (double s = 0; s < 2 * length + turn; ++frames) s += ReturnStep(s, length, turn, 0.5);
+    return frames;
+  };
+  double length = 0;
+  while (frames_to_cover(length + 0.5) <= num_stations) length += 0.5;
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<colmap::Rigid3d> stations;
+  Eigen::Vector2d position(0, -kReturnLane);
+  double s = 0;  // path length
+  for (int i = 0; i < num_stations; ++i) {
+    const double heading = ReturnHeading(s, length, turn);
+    stations.push_back(CamFromWorld(WorldFromCamRotation(heading, 0, 0),
+                                    Eigen::Vector3d(position.x(), position.y(), 1.65)));
+    const double step = ReturnStep(s, length, turn, unit(*rng));
+    constexpr int kSubsteps = 100;
+    for (int k = 0; k < kSubsteps; ++k) {
+      const double h = ReturnHeading(s + (k + 0.5) * step / kSubsteps, length, turn);
+      position += step / kSubsteps * Eigen::Vector2d(std::cos(h), std::sin(h));
+    }
+    s += step;
+  }
+  return stations;
+}
+
+}  // namespace
+
 std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
                                           int num_stations,
                                           Motion motion,
@@ -123,6 +191,7 @@ std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
   const double ring_pitch = -4 * kDegToRad;  // the same for all tripod stations
   std::vector<colmap::Rigid3d> stations;
 
+  if (motion == Motion::kDriveReturn) return ReturnDriveStations(num_stations, &rng);
   if (motion == Motion::kDrive) {
     // 0.5-1 m per frame; a lane change (1.6 m over ~25 m) and a swerve, heading along the path.
     auto lateral = [](double x) {

@@ -20,9 +20,14 @@ enum class Motion {
   kOneAxis,  // every relative rotation about the vertical axis: T_e translation along it unobservable
   kFixedRotation,  // pure translations: T_e translation unobservable
   kDrive,  // a car driving along world x, 0.5-1 m per frame (10 Hz), with a lane change and a swerve
+  // a car driving along world x in the right lane, 1-1.5 m per frame, slowing for a U-turn at the
+  // far end and returning in the other lane: it passes every place of its way out again (revisits)
+  kDriveReturn,
 };
-// "two_axes", "one_axis", "fixed_rotation", "drive"
+// "two_axes", "one_axis", "fixed_rotation", "drive", "drive_return"
 Motion MotionFromName(const std::string& name);
+// The motions of a car (frames of one sweep each, in the street).
+bool IsDrive(Motion motion);
 
 // Frame period of the driving motion [s]: one LiDAR sweep per frame.
 constexpr double kDriveFramePeriod = 0.1;
@@ -47,7 +52,8 @@ colmap::Rigid3d CamLookingAt(const Eigen::Vector3d& eye,
                              double roll_deg);
 
 // cam_from_world of the left camera of each station, 2-3 m from the structure and looking at it; for
-// kDrive, of the forward camera at 1.65 m above the street at each frame's mid-sweep time.
+// kDrive and kDriveReturn, of the forward camera at 1.65 m above the street at each frame's
+// mid-sweep time.
 std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
                                           int num_stations,
                                           Motion motion,

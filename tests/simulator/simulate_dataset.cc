@@ -99,7 +99,7 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
   }
   if (!options.mono) fs::create_directories(partial / "images/right");
 
-  const bool drive = motion == Motion::kDrive;
+  const bool drive = IsDrive(motion);
   StationRig rig = drive ? MakeDriveRig(options.image_scale) : MakeStereoRig(options.image_scale);
   const colmap::Rigid3d cam_from_lidar = TrueCamFromLidar();
   if (options.write_guess) {

@@ -19,7 +19,7 @@ int RunSimulateDataset(int argc, char** argv) {
                            "t_specimen | square_pillar | cylinder_pillar | bridge_pier | street");
   manager.AddDefaultOption("num_stations", &options.num_stations);
   manager.AddDefaultOption(
-      "motion", &options.motion, "two_axes | one_axis | fixed_rotation | drive");
+      "motion", &options.motion, "two_axes | one_axis | fixed_rotation | drive | drive_return");
   manager.AddDefaultOption(
       "sweep_motion", &options.sweep_motion, "drive: the pod moves during each sweep");
   manager.AddDefaultOption(
