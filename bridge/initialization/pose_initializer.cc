@@ -54,28 +54,25 @@ StationImages ReadStationImages(const std::string& database_path, const StationD
   return images;
 }
 
-// COLMAP's two-view rotations and translation directions paired with the LiDAR motions of the same
-// station pairs (a monocular rig's hand-eye input).
+// COLMAP's two-view rotations and translation directions paired with the LiDAR motions between the
+// same stations, from the LiDAR trajectory (its largest component): every image pair, not only the
+// pairs the registration joined (an odometry joins consecutive frames, which hardly rotate).
+// A monocular rig's hand-eye input.
 std::vector<HandEyeMotion> PairDirectionMotions(const std::string& database_path,
                                                 const StationDataset& dataset,
                                                 const std::string& registration_path) {
-  const std::map<std::string, colmap::image_t> image_of_station =
-      ReadStationImages(database_path, dataset).image_of_station;
+  const StationImages images = ReadStationImages(database_path, dataset);
+  const std::map<std::string, colmap::Rigid3d> world_from_lidar =
+      LargestComponentLidarPoses(registration_path);
   const colmap::Database database(database_path);
-  std::map<std::pair<colmap::image_t, colmap::image_t>, colmap::Rigid3d> directions;
-  for (const ImagePairPose& pair : EstimateImagePairDirections(database, 15)) {
-    directions[{pair.image_i, pair.image_j}] = pair.cam_i_from_cam_j;
-    directions[{pair.image_j, pair.image_i}] = colmap::Inverse(pair.cam_i_from_cam_j);
-  }
   std::vector<HandEyeMotion> motions;
-  for (const LidarPairRecord& pair :
-       ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string())) {
-    if (!image_of_station.count(pair.target) || !image_of_station.count(pair.source)) continue;
-    const auto direction =
-        directions.find({image_of_station.at(pair.target), image_of_station.at(pair.source)});
-    if (direction != directions.end()) {
-      motions.push_back({direction->second, pair.target_from_source});
-    }
+  for (const ImagePairPose& pair : EstimateImagePairDirections(database, 15)) {
+    if (!images.names.count(pair.image_i) || !images.names.count(pair.image_j)) continue;
+    const std::string target = fs::path(images.names.at(pair.image_i)).stem().string();
+    const std::string source = fs::path(images.names.at(pair.image_j)).stem().string();
+    if (!world_from_lidar.count(target) || !world_from_lidar.count(source)) continue;
+    motions.push_back({pair.cam_i_from_cam_j,
+                       colmap::Inverse(world_from_lidar.at(target)) * world_from_lidar.at(source)});
   }
   return motions;
 }
