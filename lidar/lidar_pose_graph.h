@@ -24,6 +24,9 @@ struct LidarEdge {
   size_t source = 0;                                                     // j
   Eigen::Isometry3d target_from_source = Eigen::Isometry3d::Identity();  // lidar_i_from_lidar_j
   PairRegistration registration;
+  // An odometry's edge between consecutive frames: in a sweep pose graph it is weighted by the
+  // odometry's drift model as well as by its registration (lidar/sweep_pose_graph.h).
+  bool odometry = false;
   // Preference in the spanning tree: overlap * sqrt(constraint ratio) / RMSE.
   double Weight() const;
 };

@@ -27,6 +27,7 @@ LidarEdge OdometryEdge(const std::vector<OdometryFrame>& frames, size_t k) {
   registration.constraints = frame.constraints;
   registration.degenerate = frame.degenerate;
   registration.accepted = true;
+  edge.odometry = true;
   return edge;
 }
 

@@ -2,8 +2,8 @@
 
 #include "lidar/check_option.h"
 #include "lidar/cloud_io.h"
-#include "lidar/pose_graph.h"
 #include "lidar/relative_pose_error.h"
+#include "lidar/sweep_pose_graph.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -45,25 +45,6 @@ Matrix6d Adjoint(const Eigen::Isometry3d& target_from_source) {
   return adjoint;
 }
 
-// The drift per metre travelled as a diagonal covariance [omega, t].
-Matrix6d DriftPerMetre(const RevisitOptions& options) {
-  const double rotation = options.drift_rotation_deg_per_m * M_PI / 180.0;
-  Vector6d variance;
-  variance << Eigen::Vector3d::Constant(rotation * rotation),
-      Eigen::Vector3d::Constant(options.drift_translation * options.drift_translation);
-  return variance.asDiagonal();
-}
-
-// The registration's covariance from its pose-graph information (EdgeSqrtInformation); directions
-// without information get a variance far above any drift instead of an infinite one.
-Matrix6d RegistrationCovariance(const PairRegistration& registration) {
-  const Matrix6d root = EdgeSqrtInformation(registration);
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(root.transpose() * root);
-  const double floor = std::max(eigen.eigenvalues().maxCoeff(), 1e-30) * 1e-12;
-  const Vector6d variances = eigen.eigenvalues().cwiseMax(floor).cwiseInverse();
-  return eigen.eigenvectors() * variances.asDiagonal() * eigen.eigenvectors().transpose();
-}
-
 // [2 vec(q_e); t_e] of E = T_pred T_meas^-1 (lidar/relative_pose_error.h, unwhitened).
 Vector6d RelativePoseDifference(const Eigen::Isometry3d& world_from_target,
                                 const Eigen::Isometry3d& world_from_source,
@@ -75,41 +56,6 @@ Vector6d RelativePoseDifference(const Eigen::Isometry3d& world_from_target,
   Vector6d residual;
   error(q_i.coeffs().data(), t_i.data(), q_j.coeffs().data(), t_j.data(), residual.data());
   return residual;
-}
-
-// A trajectory edge's square-root information: its step's drift plus its registration's covariance.
-Matrix6d StepSqrtInformation(const LidarEdge& edge, const RevisitOptions& options) {
-  const double step_m = edge.target_from_source.translation().norm();
-  const Matrix6d covariance =
-      step_m * step_m * DriftPerMetre(options) + RegistrationCovariance(edge.registration);
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(covariance);
-  return eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().cwiseSqrt().asDiagonal() *
-         eigen.eigenvectors().transpose();
-}
-
-// The trajectory's edges (preferred by the spanning tree: the start is the odometry's) and the
-// accepted revisits in one robust pose graph.
-void SolveWithRevisits(const std::vector<RevisitEdge>& revisits,
-                       const RevisitOptions& options,
-                       LidarGraph* graph) {
-  std::vector<RelativePoseEdge> edges;
-  for (const LidarEdge& e : graph->edges) {
-    edges.push_back(
-        {e.target, e.source, e.target_from_source, 1.0, StepSqrtInformation(e, options)});
-  }
-  for (const RevisitEdge& revisit : revisits) {
-    const LidarEdge& e = revisit.edge;
-    edges.push_back(
-        {e.target, e.source, e.target_from_source, 0.0, EdgeSqrtInformation(e.registration)});
-    graph->edges.push_back(e);
-  }
-  PoseGraphSolution solution =
-      SolvePoseGraph(graph->world_from_lidar.size(), edges, PoseGraphOptions());
-  graph->world_from_lidar = std::move(solution.world_from_node);
-  graph->component = std::move(solution.component);
-  graph->num_components = solution.num_components;
-  graph->refinement_initial_cost = solution.initial_cost;
-  graph->refinement_final_cost = solution.final_cost;
 }
 
 // The keyframes' prepared clouds, read when first needed and released after their last pair.
@@ -175,10 +121,8 @@ bool RevisitOptions::Check() const {
   LIDAR_CHECK_OPTION_GT(keyframe_spacing_m, 0);
   LIDAR_CHECK_OPTION_GT(search_radius_m, 0);
   LIDAR_CHECK_OPTION_GE(min_path_gap_m, 0);
-  LIDAR_CHECK_OPTION_GT(drift_translation, 0);
-  LIDAR_CHECK_OPTION_GT(drift_rotation_deg_per_m, 0);
   LIDAR_CHECK_OPTION_GT(max_chi2, 0);
-  return cloud.Check() && pair.Check();
+  return drift.Check() && cloud.Check() && pair.Check();
 }
 
 std::vector<std::pair<size_t, size_t>> RevisitCandidates(
@@ -224,7 +168,7 @@ Eigen::Matrix<double, 6, 6> DriftCovariance(const std::vector<Eigen::Isometry3d>
     jacobian += step.translation().norm() * Adjoint(target_from_previous);
     target_from_previous = target_from_previous * step;
   }
-  return jacobian * DriftPerMetre(options) * jacobian.transpose();
+  return jacobian * options.drift.PerMetre() * jacobian.transpose();
 }
 
 double RevisitChi2(const std::vector<Eigen::Isometry3d>& world_from_lidar,
@@ -265,7 +209,10 @@ RevisitClosure CloseRevisits(const std::vector<std::string>& cloud_paths,
     }
     if (progress) progress(p + 1, pairs.size());
   }
-  if (!closure.accepted.empty()) SolveWithRevisits(closure.accepted, options, graph);
+  if (!closure.accepted.empty()) {
+    for (const RevisitEdge& revisit : closure.accepted) graph->edges.push_back(revisit.edge);
+    SolveSweepPoseGraph(options.drift, graph);
+  }
   closure.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return closure;
 }

@@ -8,13 +8,13 @@
 // error per metre travelled in rotation and translation carried along the path (a rotation error
 // early on moves every later position); the per-frame ICP covariances are lower bounds that leave
 // out this correlation. Accepted revisits and the trajectory's edges then enter the robust pose
-// graph (lidar/pose_graph.h), each trajectory edge weighted by the drift of its own step and its
-// ICP covariance.
+// graph (lidar/sweep_pose_graph.h).
 #pragma once
 
 #include "lidar/lidar_pose_graph.h"
 #include "lidar/pair_registration.h"
 #include "lidar/station_cloud.h"
+#include "lidar/sweep_pose_graph.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -33,9 +33,8 @@ struct RevisitOptions {
   double search_radius_m = 10.0;
   // Path between the two keyframes of a revisit: shorter gaps are the odometry's own neighbours.
   double min_path_gap_m = 50.0;
-  // The odometry's drift (1 sigma): translation per metre travelled [m/m] and rotation [deg/m].
-  double drift_translation = 0.01;
-  double drift_rotation_deg_per_m = 0.005;
+  // The odometry's drift: the chi-square test's covariance and the pose graph's weights.
+  OdometryDrift drift;
   // Chi-square bound of an accepted revisit (6 degrees of freedom; 22.46: probability 0.999).
   double max_chi2 = 22.46;
   StationCloudOptions cloud;

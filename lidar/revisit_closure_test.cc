@@ -72,14 +72,14 @@ TEST(DriftCovariance, MatchesSampledSystematicDrifts) {
     poses.back().linear() = Pose(0, 0, yaw).linear();
   }
   RevisitOptions options;
-  options.drift_translation = 0.001;
-  options.drift_rotation_deg_per_m = 0.005;
+  options.drift.translation = 0.001;
+  options.drift.rotation_deg_per_m = 0.005;
   const Matrix6d model = DriftCovariance(poses, 0, 60, options);
   std::mt19937_64 rng(7);
   std::normal_distribution<double> normal;
   Vector6d sigma_per_metre;
-  sigma_per_metre << Eigen::Vector3d::Constant(options.drift_rotation_deg_per_m * M_PI / 180),
-      Eigen::Vector3d::Constant(options.drift_translation);
+  sigma_per_metre << Eigen::Vector3d::Constant(options.drift.rotation_deg_per_m * M_PI / 180),
+      Eigen::Vector3d::Constant(options.drift.translation);
   Matrix6d sampled = Matrix6d::Zero();
   const int kDraws = 4000;
   for (int draw = 0; draw < kDraws; ++draw) {

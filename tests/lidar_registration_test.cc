@@ -556,7 +556,7 @@ TEST(RevisitDriveTest, RevisitsAreRightAndPullADriftedWayBackOntoTheWayOut) {
   }
   RevisitOptions revisit;
   revisit.min_path_gap_m = 30;
-  revisit.drift_rotation_deg_per_m = 0.05;
+  revisit.drift.rotation_deg_per_m = 0.05;
   const RevisitClosure closure = CloseRevisits(deskewed, revisit, &drifted);
   double worst_before_m = 0, worst_after_m = 0;
   for (const RevisitEdge& r : closure.accepted) {

@@ -12,6 +12,7 @@
 #include "lidar/preprocessing.h"
 #include "lidar/revisit_closure.h"
 #include "lidar/sweep_deskew.h"
+#include "lidar/trajectory_refinement.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/scene/reconstruction.h"
@@ -127,6 +128,7 @@ bool LidarRegistratorStepOptions::Check() {
   graph.bridge_neighbors = static_cast<size_t>(bridge_neighbors);
   graph.max_neighbors = static_cast<size_t>(max_neighbors);
   graph.sequential = static_cast<size_t>(sequential);
+  CHECK_OPTION_GE(refine_neighbors, 0);
   CHECK_OPTION_GE(remove_moving_points, -1);
   CHECK_OPTION_LE(remove_moving_points, 1);
   CHECK_OPTION(method == "auto" || method == "pairwise" || method == "odometry");
@@ -193,6 +195,9 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("odometry_point_to_plane",
           &options->odometry.icp.point_to_plane,
           "distance to the map's local plane where it is one (0: point-to-point, KISS-ICP)");
+  add.Add("refine_neighbors",
+          &options->refine_neighbors,
+          "odometry: k > 0 refines the trajectory by ICP between each sweep and its next k sweeps");
   add.Add("revisits",
           &options->revisits,
           "odometry: register keyframes that revisit a place, accepted within the drift");
@@ -201,10 +206,10 @@ void AddLidarRegistratorOptions(const std::string& prefix,
           &options->revisit.min_path_gap_m,
           "and at least this far apart along the path");
   add.Add("odometry_drift",
-          &options->revisit.drift_translation,
+          &options->revisit.drift.translation,
           "the odometry's translation drift per metre travelled (1 sigma)");
   add.Add("odometry_drift_deg_per_m",
-          &options->revisit.drift_rotation_deg_per_m,
+          &options->revisit.drift.rotation_deg_per_m,
           "the odometry's rotation drift (1 sigma)");
 }
 
@@ -421,6 +426,32 @@ LidarGraph RegisterByOdometry(const std::vector<fs::path>& files,
   return result.graph;
 }
 
+// The odometry's trajectory refined by ICP between neighbouring sweeps of `cloud_paths`
+// (lidar/trajectory_refinement.h); prints what it did and returns the summary's lines.
+std::string RefineOdometryTrajectory(const std::vector<std::string>& cloud_paths,
+                                     const LidarRegistratorStepOptions& options,
+                                     LidarGraph* graph) {
+  TrajectoryRefinementOptions refine;
+  refine.neighbors = options.refine_neighbors;
+  refine.cloud = options.cloud;
+  refine.pair = options.graph.pair;
+  refine.drift = options.revisit.drift;
+  const auto progress = [](size_t done, size_t total) {
+    if (done % 50 == 0 || done == total) {
+      std::cout << "lidar_registrator: refining " << done << "/" << total << " frames" << std::endl;
+    }
+  };
+  const TrajectoryRefinement refinement = RefineTrajectory(cloud_paths, refine, graph, progress);
+  std::cout << "lidar_registrator: refined the trajectory with " << refinement.num_accepted
+            << " of " << refinement.num_pairs << " neighbour pairs [" << std::fixed
+            << std::setprecision(1) << refinement.seconds << " s]" << std::defaultfloat
+            << std::setprecision(6) << std::endl;
+  std::ostringstream lines;
+  lines << "refined_pairs " << refinement.num_pairs << "\nrefined_pairs_accepted "
+        << refinement.num_accepted << "\n";
+  return lines.str();
+}
+
 // Revisit edges of the odometry's trajectory (lidar/revisit_closure.h) between the clouds of
 // `cloud_paths`; prints each revisit and returns the summary's lines.
 std::string CloseOdometryRevisits(const std::vector<std::string>& cloud_paths,
@@ -449,6 +480,36 @@ std::string CloseOdometryRevisits(const std::vector<std::string>& cloud_paths,
         << closure.num_candidates << "\nrevisit_edges " << closure.accepted.size()
         << "\nrevisit_edges_refused " << closure.refused.size() << "\n";
   return lines.str();
+}
+
+// After the odometry and its de-skewing: the refinement by neighbouring sweeps (then de-skewing
+// again) and the revisits, on the de-skewed sweeps. Returns the summary's lines.
+std::string RefineAndCloseOdometry(const std::vector<fs::path>& files,
+                                   const std::vector<double>& clock,
+                                   const LidarRegistratorStepOptions& options,
+                                   const std::string& output_path,
+                                   LidarGraph* graph) {
+  const fs::path deskewed_path = fs::path(output_path) / "deskewed";
+  std::vector<std::string> cloud_paths;
+  for (const fs::path& file : files) {
+    cloud_paths.push_back(options.deskew_sweeps
+                              ? (deskewed_path / (file.stem().string() + ".pcd")).string()
+                              : file.string());
+  }
+  std::string lines;
+  if (options.refine_neighbors > 0) {
+    lines += RefineOdometryTrajectory(cloud_paths, options, graph);
+    if (options.deskew_sweeps) {
+      std::cout << "lidar_registrator: de-skewing every sweep again with the refined motion"
+                << std::endl;
+      WriteDeskewedSweeps(files,
+                          SweepMotionsFromPoses(graph->world_from_lidar, clock, graph->component),
+                          options.sweep_timing,
+                          deskewed_path);
+    }
+  }
+  if (options.revisits) lines += CloseOdometryRevisits(cloud_paths, files, options, graph);
+  return lines;
 }
 
 // The registration by the chosen method, then (sweeps) de-skewing with its motion: the odometry's
@@ -483,16 +544,7 @@ LidarGraph RegisterStations(const std::vector<fs::path>& files,
       graph = RegisterClouds(files, options, &motions, deskewed_path.string(), frames, start);
     }
   }
-  if (odometry && options.revisits) {
-    std::vector<std::string> cloud_paths;
-    for (const fs::path& file : files) {
-      cloud_paths.push_back(
-          options.deskew_sweeps
-              ? (fs::path(output_path) / "deskewed" / (file.stem().string() + ".pcd")).string()
-              : file.string());
-    }
-    *method_line += CloseOdometryRevisits(cloud_paths, files, options, &graph);
-  }
+  if (odometry) *method_line += RefineAndCloseOdometry(files, clock, options, output_path, &graph);
   return graph;
 }
 

@@ -26,6 +26,7 @@
 #include "lidar/model_evaluation.h"
 #include "lidar/moving_points.h"
 #include "lidar/revisit_closure.h"
+#include "lidar/trajectory_refinement.h"
 #include "lidar/station_cloud.h"
 #include "lidar/sweep_deskew.h"
 
@@ -118,6 +119,10 @@ struct LidarRegistratorStepOptions {
   // cloud and pair options are this step's `cloud` and `graph.pair`.
   bool revisits = true;
   RevisitOptions revisit;
+  // Odometry: > 0 refines the trajectory by ICP between each de-skewed sweep and its next
+  // `refine_neighbors` sweeps at `cloud`'s resolution (lidar/trajectory_refinement.h), then
+  // de-skews the sweeps again with the refined motion.
+  int refine_neighbors = 0;
   // After registration, flag the points of moving objects by free space (lidar/moving_points.h) and
   // write each cloud without them to OUTPUT/static/<station>.pcd (and all flagged points, in the
   // first station's frame, to OUTPUT/moving_points.ply); the later steps of `pipeline` use them.
