@@ -301,9 +301,9 @@ class StreetDriveTest : public ::testing::Test {
   // Registers with `arguments`, checks every accepted edge against the truth and returns the summary.
   static std::string RegisterAndCheck(const std::string& arguments, double* worst_m) {
     const std::string out = dir_->File("out" + std::to_string(runs_++));
-    const auto result =
-        testing::RunCommand(std::string(COLMAP_LIDAR_CLI_EXE) + " lidar_registrator --lidar_path " +
-                            dir_->File("dataset/lidar") + " --output_path " + out + arguments);
+    const auto result = testing::RunCommand(
+        std::string(COLMAP_LIDAR_CLI_EXE) + " lidar_registrator --lidar_path " +
+        dir_->File("dataset/lidar") + " --output_path " + out + " --method pairwise" + arguments);
     EXPECT_EQ(result.exit_code, 0) << result.output;
     int num_inconsistent = 0;
     *worst_m = 0;
@@ -413,7 +413,7 @@ TEST(StreetDriveSpeedTest, EdgesThatSlidAlongTheStreetAreRegisteredAgainAtTheirN
   const auto run =
       testing::RunCommand(std::string(COLMAP_LIDAR_CLI_EXE) + " lidar_registrator --lidar_path " +
                           dir.File("dataset/lidar") + " --output_path " + dir.File("out") +
-                          " --max_neighbors 4 --deskew_sweeps 1");
+                          " --method pairwise --max_neighbors 4 --deskew_sweeps 1");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::cout << run.output.substr(run.output.find("stations"));
   EXPECT_GE(SummaryValue(run.output, "speed_reregistered"), 1);

@@ -188,7 +188,7 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("method",
           &options->method,
           "auto | pairwise (BSC + RANSAC + ICP per pair) | odometry (sweeps: frame-to-map ICP); "
-          "auto: pairwise");
+          "auto: odometry for sweeps, pairwise for stations");
   add.Add("odometry_max_range_m", &options->odometry.max_range_m);
   add.Add("odometry_min_range_m", &options->odometry.min_range_m, "nearer returns: the platform");
   add.Add("odometry_voxel_size_m", &options->odometry.voxel_size_m, "0: max range / 100");
@@ -334,17 +334,16 @@ void RemoveMovingPoints(const std::vector<std::string>& names,
             << moving_ply.string() << ")" << std::endl;
 }
 
-// Odometry when asked for (--method odometry); auto: the pairwise path. The odometry's edges join
-// consecutive frames only, whose rotations are too small for the hand-eye's motion pairs on a
-// gently turning drive: the pipeline's initialisation is built on the pairwise path's longer edges.
+// The method asked for; auto: the odometry for the sweeps of a moving platform (de-skewed, or
+// rig.json says the platform moves), the pairwise path for tripod stations. Says which and why.
 bool UseOdometry(const LidarRegistratorStepOptions& options) {
   if (options.method != "auto") return options.method == "odometry";
-  std::cout << "lidar_registrator: pairwise registration (BSC + RANSAC + ICP)"
-            << (options.deskew_sweeps || options.moving_platform
-                    ? "; --method odometry registers the frames of a moving platform faster"
-                    : "")
-            << std::endl;
-  return false;
+  const bool sweeps = options.deskew_sweeps || options.moving_platform;
+  std::cout << "lidar_registrator: "
+            << (sweeps ? "odometry (frame-to-map ICP): the clouds are sweeps of a moving platform"
+                       : "pairwise registration (BSC + RANSAC + ICP): the clouds are stations")
+            << " (--method auto)" << std::endl;
+  return sweeps;
 }
 
 void WriteDeskewedSweeps(const std::vector<fs::path>& files,

@@ -109,8 +109,7 @@ struct LidarRegistratorStepOptions {
   std::vector<double> station_times;
   // auto | pairwise | odometry. Pairwise: BSC + RANSAC + ICP over station pairs (tripod stations,
   // any prior). Odometry: sequential frame-to-map ICP (lidar/lidar_odometry.h) for the sweeps of a
-  // moving platform. Auto: pairwise (the odometry does not yet start from a moving platform whose
-  // first motion the geometry leaves open).
+  // moving platform. Auto: odometry for sweeps (deskew_sweeps or moving_platform), else pairwise.
   std::string method = "auto";
   bool moving_platform = false;  // the dataset's rig.json says so
   LidarOdometryOptions odometry;
@@ -119,10 +118,10 @@ struct LidarRegistratorStepOptions {
   // cloud and pair options are this step's `cloud` and `graph.pair`.
   bool revisits = true;
   RevisitOptions revisit;
-  // Odometry: > 0 refines the trajectory by ICP between each de-skewed sweep and its next
+  // Odometry: k > 0 refines the trajectory by ICP between each de-skewed sweep and its next
   // `refine_neighbors` sweeps at `cloud`'s resolution (lidar/trajectory_refinement.h), then
   // de-skews the sweeps again with the refined motion.
-  int refine_neighbors = 0;
+  int refine_neighbors = 2;
   // After registration, flag the points of moving objects by free space (lidar/moving_points.h) and
   // write each cloud without them to OUTPUT/static/<station>.pcd (and all flagged points, in the
   // first station's frame, to OUTPUT/moving_points.ply); the later steps of `pipeline` use them.
