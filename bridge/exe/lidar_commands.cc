@@ -135,6 +135,41 @@ bool LidarRegistratorStepOptions::Check() {
   return sweep_timing.Check() && moving.Check() && odometry.Check() && revisit.Check();
 }
 
+namespace {
+
+// The method's choice and the odometry's options (refinement, revisits) of lidar_registrator.
+void AddOdometryOptions(PrefixedOptions* options_of, LidarRegistratorStepOptions* options) {
+  PrefixedOptions& add = *options_of;
+  add.Add("method",
+          &options->method,
+          "auto | pairwise (BSC + RANSAC + ICP per pair) | odometry (sweeps: frame-to-map ICP); "
+          "auto: odometry for sweeps, pairwise for stations");
+  add.Add("odometry_max_range_m", &options->odometry.max_range_m);
+  add.Add("odometry_min_range_m", &options->odometry.min_range_m, "nearer returns: the platform");
+  add.Add("odometry_voxel_size_m", &options->odometry.voxel_size_m, "0: max range / 100");
+  add.Add("odometry_point_to_plane",
+          &options->odometry.icp.point_to_plane,
+          "distance to the map's local plane where it is one (0: point-to-point, KISS-ICP)");
+  add.Add("refine_neighbors",
+          &options->refine_neighbors,
+          "odometry: k > 0 refines the trajectory by ICP between each sweep and its next k sweeps");
+  add.Add("revisits",
+          &options->revisits,
+          "odometry: register keyframes that revisit a place, accepted within the drift");
+  add.Add("revisit_radius_m", &options->revisit.search_radius_m, "keyframes nearer than this");
+  add.Add("revisit_min_path_m",
+          &options->revisit.min_path_gap_m,
+          "and at least this far apart along the path");
+  add.Add("odometry_drift",
+          &options->revisit.drift.translation,
+          "the odometry's translation drift per metre travelled (1 sigma)");
+  add.Add("odometry_drift_deg_per_m",
+          &options->revisit.drift.rotation_deg_per_m,
+          "the odometry's rotation drift (1 sigma)");
+}
+
+}  // namespace
+
 void AddLidarRegistratorOptions(const std::string& prefix,
                                 colmap::OptionManager* manager,
                                 LidarRegistratorStepOptions* options) {
@@ -185,32 +220,7 @@ void AddLidarRegistratorOptions(const std::string& prefix,
           "clouds compared on each side (name order)");
   add.Add("moving_margin_m", &options->moving.margin_m, "plus moving_margin_ratio x range");
   add.Add("moving_margin_ratio", &options->moving.margin_ratio);
-  add.Add("method",
-          &options->method,
-          "auto | pairwise (BSC + RANSAC + ICP per pair) | odometry (sweeps: frame-to-map ICP); "
-          "auto: odometry for sweeps, pairwise for stations");
-  add.Add("odometry_max_range_m", &options->odometry.max_range_m);
-  add.Add("odometry_min_range_m", &options->odometry.min_range_m, "nearer returns: the platform");
-  add.Add("odometry_voxel_size_m", &options->odometry.voxel_size_m, "0: max range / 100");
-  add.Add("odometry_point_to_plane",
-          &options->odometry.icp.point_to_plane,
-          "distance to the map's local plane where it is one (0: point-to-point, KISS-ICP)");
-  add.Add("refine_neighbors",
-          &options->refine_neighbors,
-          "odometry: k > 0 refines the trajectory by ICP between each sweep and its next k sweeps");
-  add.Add("revisits",
-          &options->revisits,
-          "odometry: register keyframes that revisit a place, accepted within the drift");
-  add.Add("revisit_radius_m", &options->revisit.search_radius_m, "keyframes nearer than this");
-  add.Add("revisit_min_path_m",
-          &options->revisit.min_path_gap_m,
-          "and at least this far apart along the path");
-  add.Add("odometry_drift",
-          &options->revisit.drift.translation,
-          "the odometry's translation drift per metre travelled (1 sigma)");
-  add.Add("odometry_drift_deg_per_m",
-          &options->revisit.drift.rotation_deg_per_m,
-          "the odometry's rotation drift (1 sigma)");
+  AddOdometryOptions(&add, options);
 }
 
 namespace {
