@@ -6,7 +6,6 @@
 #include "lidar/sweep_pose_graph.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 
 #include <chrono>
 #include <cmath>
