@@ -140,7 +140,7 @@ std::vector<std::pair<size_t, size_t>> RevisitCandidates(
   for (const size_t later : keyframes) {
     double nearest = options.search_radius_m;
     std::optional<size_t> match;
-    for (const size_t earlier : keyframes) {
+    for (size_t earlier = 0; earlier < later; ++earlier) {
       if (path[later] - path[earlier] < options.min_path_gap_m) break;
       const double distance =
           (world_from_lidar[later].translation() - world_from_lidar[earlier].translation()).norm();

@@ -1,7 +1,7 @@
 // Revisit (loop-closure) edges for a LiDAR odometry trajectory. Keyframes are taken every
-// `keyframe_spacing_m` of path; a keyframe near an earlier one in space (within `search_radius_m` by
-// the odometry's positions) but far from it along the path (at least `min_path_gap_m`) is registered
-// to it by BSC + RANSAC + ICP (lidar/pair_registration.h), independently of the odometry. The
+// `keyframe_spacing_m` of path; a keyframe near an earlier frame in space (within `search_radius_m`
+// by the odometry's positions) but far from it along the path (at least `min_path_gap_m`) is
+// registered to the nearest such frame by BSC + RANSAC + ICP (lidar/pair_registration.h), independently of the odometry. The
 // registration is accepted only when it agrees with the odometry within the odometry's drift: a
 // chi-square test (6 degrees of freedom) of the difference between the two relative poses against
 // the sum of their covariances. The odometry's covariance comes from a drift model, a systematic
@@ -55,8 +55,8 @@ struct RevisitClosure {
   double seconds = 0;
 };
 
-// Keyframe pairs (earlier, later) to register: each keyframe with its nearest earlier keyframe
-// within the search radius and at least min_path_gap_m back along the path. `num_keyframes`
+// Frame pairs (earlier, later) to register: each keyframe with its nearest earlier frame within the
+// search radius and at least min_path_gap_m back along the path. `num_keyframes`
 // (optional) receives the number of keyframes.
 std::vector<std::pair<size_t, size_t>> RevisitCandidates(
     const std::vector<Eigen::Isometry3d>& world_from_lidar,

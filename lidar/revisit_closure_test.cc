@@ -56,10 +56,10 @@ TEST(RevisitCandidates, PairsTheWayBackWithTheWayOutFarAlongThePath) {
     EXPECT_GT(later, 40u);
     EXPECT_LE((poses[later].translation() - poses[earlier].translation()).norm(), 10.0);
   }
-  // The last keyframe back (x = 4) is nearest to the keyframe at x = 5 of the way out; the first
-  // pair (x = 19 back, x = 10 out) is the first within 10 m that is 50 m back along the path.
-  EXPECT_EQ(pairs.back(), std::make_pair(size_t{5}, size_t{77}));
-  EXPECT_EQ(pairs.front(), std::make_pair(size_t{10}, size_t{62}));
+  // The last keyframe back (x = 4) is nearest to the frame at x = 4 of the way out; the first pair
+  // (x = 19 back, x = 14 out) is the first within 10 m that is 50 m back along the path.
+  EXPECT_EQ(pairs.back(), std::make_pair(size_t{4}, size_t{77}));
+  EXPECT_EQ(pairs.front(), std::make_pair(size_t{14}, size_t{62}));
 }
 
 // The drift model's covariance against the spread of the relative pose over sampled drifts, on a
