@@ -216,8 +216,11 @@ void RemoveInconsistentEdges(const std::vector<const StationCloud*>& stations,
 void SolveLidarPoseGraph(size_t n, const LidarGraphOptions& options, LidarGraph* graph) {
   std::vector<RelativePoseEdge> edges;
   for (const LidarEdge& e : graph->edges) {
-    edges.push_back(
-        {e.target, e.source, e.target_from_source, e.Weight(), EdgeSqrtInformation(e.registration)});
+    edges.push_back({e.target,
+                     e.source,
+                     e.target_from_source,
+                     e.Weight(),
+                     EdgeSqrtInformation(e.registration)});
   }
   PoseGraphOptions pose_graph;
   pose_graph.refine = options.refine;

@@ -573,7 +573,7 @@ TEST(RevisitDriveTest, RevisitsAreRightAndPullADriftedWayBackOntoTheWayOut) {
         truth.at(dataset.stations[e.target]).inverse() * truth.at(dataset.stations[e.source]);
     return (true_edge.inverse() * e.target_from_source).translation().norm();
   };
-  for (const RevisitEdge& r : closure.accepted) EXPECT_LT(registration_error_m(r.edge), 0.1);
+  for (const RevisitEdge& r : closure.accepted) EXPECT_LT(registration_error_m(r.edge), 0.01);
   for (const RevisitEdge& r : closure.refused) {
     std::cout << "refused " << r.edge.source << " -> " << r.edge.target << " ("
               << registration_error_m(r.edge) << " m off the truth): " << r.edge.registration.reason

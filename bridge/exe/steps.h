@@ -26,9 +26,9 @@
 #include "lidar/model_evaluation.h"
 #include "lidar/moving_points.h"
 #include "lidar/revisit_closure.h"
-#include "lidar/trajectory_refinement.h"
 #include "lidar/station_cloud.h"
 #include "lidar/sweep_deskew.h"
+#include "lidar/trajectory_refinement.h"
 
 #include "colmap/controllers/option_manager.h"
 
