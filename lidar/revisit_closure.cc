@@ -57,12 +57,13 @@ Vector6d RelativePoseDifference(const Eigen::Isometry3d& world_from_target,
   return residual;
 }
 
-// The keyframes' prepared clouds, read when first needed and released after their last pair.
-class KeyframeClouds {
+// The prepared clouds of the candidates' frames, read when first needed and released after their
+// last pair.
+class CandidateClouds {
  public:
-  KeyframeClouds(const std::vector<std::string>& cloud_paths,
-                 const std::vector<std::pair<size_t, size_t>>& pairs,
-                 const StationCloudOptions& options)
+  CandidateClouds(const std::vector<std::string>& cloud_paths,
+                  const std::vector<std::pair<size_t, size_t>>& pairs,
+                  const StationCloudOptions& options)
       : cloud_paths_(cloud_paths), options_(options) {
     for (size_t p = 0; p < pairs.size(); ++p) {
       last_use_[pairs[p].first] = p;
@@ -193,7 +194,7 @@ RevisitClosure CloseRevisits(const std::vector<std::string>& cloud_paths,
   const std::vector<std::pair<size_t, size_t>> pairs =
       RevisitCandidates(graph->world_from_lidar, options, &closure.num_keyframes);
   closure.num_candidates = pairs.size();
-  KeyframeClouds clouds(cloud_paths, pairs, options.cloud);
+  CandidateClouds clouds(cloud_paths, pairs, options.cloud);
   for (size_t p = 0; p < pairs.size(); ++p) {
     const StationCloud& earlier = clouds.Get(pairs[p].first);
     const StationCloud& later = clouds.Get(pairs[p].second);
