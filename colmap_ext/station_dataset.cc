@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -342,6 +343,29 @@ void ReadOptionalTimes(StationDataset* dataset) {
 }
 
 }  // namespace
+
+StationDataset RestrictToStations(StationDataset dataset, const std::vector<std::string>& kept) {
+  const std::set<std::string> wanted(kept.begin(), kept.end());
+  for (const std::string& name : wanted) {
+    if (std::find(dataset.stations.begin(), dataset.stations.end(), name) ==
+        dataset.stations.end()) {
+      throw std::runtime_error(dataset.root + ": no station " + name);
+    }
+  }
+  StationDataset restricted = dataset;
+  restricted.stations.clear();
+  restricted.cloud_paths.clear();
+  restricted.frame_times.clear();
+  restricted.sweep_times.clear();
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    if (wanted.count(dataset.stations[i]) == 0) continue;
+    restricted.stations.push_back(dataset.stations[i]);
+    restricted.cloud_paths.push_back(dataset.cloud_paths[i]);
+    if (!dataset.frame_times.empty()) restricted.frame_times.push_back(dataset.frame_times[i]);
+    if (!dataset.sweep_times.empty()) restricted.sweep_times.push_back(dataset.sweep_times[i]);
+  }
+  return restricted;
+}
 
 StationDataset ReadStationDataset(const std::string& root) {
   if (!fs::is_directory(root)) Fail(root, "dataset directory does not exist");

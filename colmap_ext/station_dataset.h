@@ -91,6 +91,10 @@ struct StationDataset {
 // std::runtime_error naming the missing or bad file.
 StationDataset ReadStationDataset(const std::string& root);
 
+// `dataset` with only the stations named in `kept` (in the dataset's order; the per-station lists
+// follow). Throws std::runtime_error naming a station that the dataset does not have.
+StationDataset RestrictToStations(StationDataset dataset, const std::vector<std::string>& kept);
+
 // "<station> t" per line (timestamps.txt), stations in the order given.
 void WriteStationTimes(const std::string& path,
                        const std::vector<std::string>& stations,

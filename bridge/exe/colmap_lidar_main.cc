@@ -65,6 +65,10 @@ const std::vector<Command>& Commands() {
       {"lidar_registrator",
        &RunLidarRegistrator,
        "Register all station clouds and build the LiDAR pose graph"},
+      {"select_frames",
+       &RunSelectFrames,
+       "Choose the frames of a drive that go on to the camera steps (spacing by distance and "
+       "turn)"},
       {"deskew_sweeps",
        &RunDeskewSweeps,
        "De-skew the sweeps of a moving platform with a model's trajectory and cam_from_lidar"},

@@ -31,6 +31,8 @@ int RunDepthPriorExtractor(int argc, char** argv);
 // pairs.txt, lidar_poses.txt and summary.txt.
 int RunLidarRegistrator(int argc, char** argv);
 int RunDeskewSweeps(int argc, char** argv);
+// The frames of a drive that go on to the camera steps, as a registration folder of their own.
+int RunSelectFrames(int argc, char** argv);
 
 // The joint problem (reprojection + depth priors + LiDAR point-to-plane + cam_from_lidar) inside COLMAP's
 // bundle adjuster on a sparse model; writes the refined model, cam_from_lidar.txt, report.json, plots.

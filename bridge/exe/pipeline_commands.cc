@@ -7,8 +7,10 @@
 #include "bridge/initialization/lidar_registration_files.h"
 #include "bridge/initialization/model_completion.h"
 #include "bridge/initialization/pose_initializer.h"
+#include "bridge/initialization/selected_frames.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
+#include "lidar/check_option.h"
 
 #include "colmap/controllers/option_manager.h"
 
@@ -231,6 +233,8 @@ struct PipelineOptions {
   JointAdjusterStepOptions joint;
   DensifierOptions densifier;
   ModelEvaluationOptions evaluation;
+  // Which frames of a moving platform's drive go on to the camera steps (select_frames).
+  FrameSelectionOptions selection;
   // Import.matcher auto: COLMAP's exhaustive matcher up to this many stations; beyond, the spatial
   // matcher on the LiDAR registration's station positions (each image with its
   // SpatialMatching.max_num_neighbors nearest), so that image pairs grow as N, not N^2.
@@ -265,6 +269,7 @@ void AddPipelineOptions(colmap::OptionManager* manager, PipelineOptions* options
   AddJointAdjusterOptions("JointAdjuster.", manager, &options->joint);
   AddDensifierOptions("Densifier.", manager, &options->densifier);
   AddModelEvaluationOptions("EvaluateModel.", manager, &options->evaluation);
+  AddFrameSelectionOptions("FrameSelection.", manager, &options->selection);
 }
 
 struct PipelineStep {
@@ -272,19 +277,25 @@ struct PipelineStep {
   std::function<void()> run;
 };
 
-// The workspace layout WS/{database.db, stereo, lidar, sparse/initial, sparse/joint, dense,
-// evaluation}.
+// The workspace layout WS/{database.db, stereo, lidar, lidar_selected, sparse/initial,
+// sparse/joint, dense, evaluation}.
 struct WorkspacePaths {
   explicit WorkspacePaths(const fs::path& ws)
       : database((ws / "database.db").string()),
         stereo((ws / "stereo").string()),
         lidar((ws / "lidar").string()),
+        selected((ws / "lidar_selected").string()),
         initial((ws / "sparse" / "initial").string()),
         joint((ws / "sparse" / "joint").string()),
         dense((ws / "dense").string()),
         evaluation((ws / "evaluation").string()) {}
-  std::string database, stereo, lidar, initial, joint, dense, evaluation;
+  std::string database, stereo, lidar, selected, initial, joint, dense, evaluation;
 };
+
+// Frames of a moving platform are selected for the camera steps; tripod stations are each meant.
+bool SelectsFrames(const StationDataset& dataset, const PipelineOptions& options) {
+  return dataset.rig.IsMovingPlatform() || options.registrator.deskew_sweeps;
+}
 
 // The LiDAR trajectory (lidar_poses.txt, against the reference moved to the LiDAR by the reference
 // extrinsic) and the joint model's camera poses against the dataset's reference trajectory.
@@ -362,6 +373,13 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
                     &initial = paths.initial, &joint = paths.joint, &dense = paths.dense;
   // A monocular rig has no stereo steps and no stereo depth for the densifier.
   const bool stereo_rig = dataset.rig.IsStereo();
+  // With frame selection the camera steps see the selected frames and their registration folder
+  // (read when they run: the selection is made by a step before them).
+  const bool select = SelectsFrames(dataset, options);
+  const std::string registration = select ? paths.selected : lidar;
+  const std::function<StationDataset()> camera_dataset = [=, &dataset] {
+    return select ? RestrictToStations(dataset, ReadSelectedFrames(paths.selected)) : dataset;
+  };
   const PipelineStep registrator = {
       "lidar_registrator", [=, &dataset] {
         RunLidarRegistratorStep(
@@ -369,33 +387,38 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
       }};
   // The spatial matcher matches only images of stations near in the LiDAR registration: the LiDAR
   // registration runs first (no N^2 image pairs on large surveys).
-  const bool lidar_first = options.import.import.matcher == "spatial";
+  const bool lidar_first = options.import.import.matcher == "spatial" || select;
   std::vector<PipelineStep> steps;
   if (lidar_first) steps.push_back(registrator);
+  if (select) {
+    steps.push_back(
+        {"select_frames", [=] { RunSelectFramesStep(lidar, paths.selected, options.selection); }});
+  }
   steps.push_back(
-      {"import_dataset", [=, &dataset] { RunImportStep(dataset, database, options.import); }});
+      {"import_dataset", [=] { RunImportStep(camera_dataset(), database, options.import); }});
   if (stereo_rig) {
     steps.push_back(
-        {"stereo_depth", [=, &dataset] { RunStereoDepthStep(dataset, stereo, options.stereo); }});
+        {"stereo_depth", [=] { RunStereoDepthStep(camera_dataset(), stereo, options.stereo); }});
     steps.push_back({"depth_prior_extractor",
                      [=] { RunDepthPriorStep(database, stereo, options.depth_prior); }});
   }
   if (!lidar_first) steps.push_back(registrator);
   std::vector<PipelineStep> back_end = {
       {"pose_initializer",
-       [=, &dataset] {
-         RunPoseInitializerStep(WithRegistratorClouds(dataset, lidar),
-                                {database, lidar, "", initial, stereo_rig ? stereo : ""},
+       [=] {
+         RunPoseInitializerStep(WithRegistratorClouds(camera_dataset(), lidar),
+                                {database, registration, "", initial, stereo_rig ? stereo : ""},
                                 options.initializer);
        }},
       {"joint_adjuster",
-       [=, &dataset] {
-         RunJointAdjusterStep(
-             WithRegistratorClouds(dataset, lidar), {database, initial, "", joint}, options.joint);
+       [=] {
+         RunJointAdjusterStep(WithRegistratorClouds(camera_dataset(), lidar),
+                              {database, initial, "", joint},
+                              options.joint);
        }},
       {"densifier",
-       [=, &dataset] {
-         RunDensifierStep(WithRegistratorClouds(dataset, lidar),
+       [=] {
+         RunDensifierStep(WithRegistratorClouds(camera_dataset(), lidar),
                           {joint, "", stereo_rig ? stereo : "", dense},
                           options.densifier);
        }},
@@ -466,6 +489,18 @@ void RunSteps(const std::vector<PipelineStep>& steps, const fs::path& ws, bool o
   }
 }
 
+// Import.matcher spatial without a registration path: the pipeline's own LiDAR registration (of
+// the selected frames), which then runs before the import (PipelineSteps).
+void SetSpatialMatchingRegistration(const StationDataset& dataset, PipelineOptions* pipeline) {
+  if (pipeline->import.import.matcher != "spatial" ||
+      !pipeline->import.lidar_registration_path.empty()) {
+    return;
+  }
+  const WorkspacePaths paths(pipeline->workspace_path);
+  pipeline->import.lidar_registration_path =
+      SelectsFrames(dataset, *pipeline) ? paths.selected : paths.lidar;
+}
+
 }  // namespace
 
 // Import.matcher auto (see PipelineOptions::max_exhaustive_stations).
@@ -500,14 +535,10 @@ int RunPipeline(int argc, char** argv) {
   THROW_CHECK(pipeline.initializer.Check());
   THROW_CHECK(pipeline.joint.Check());
   THROW_CHECK(pipeline.densifier.Check());
+  ThrowUnlessValid(pipeline.selection, "FrameSelection");
   const StationDataset dataset = ReadStationDataset(pipeline.dataset_path);
   ResolveAutoMatcher(dataset.stations.size(), &pipeline);
-  if (pipeline.import.import.matcher == "spatial" &&
-      pipeline.import.lidar_registration_path.empty()) {
-    // The pipeline's own LiDAR registration, run before the import (PipelineSteps).
-    pipeline.import.lidar_registration_path =
-        (fs::path(pipeline.workspace_path) / "lidar").string();
-  }
+  SetSpatialMatchingRegistration(dataset, &pipeline);
   THROW_CHECK(pipeline.import.Check());
   if (!dataset.rig.IsStereo() && pipeline.mode == "stereo_only") {
     throw std::invalid_argument("--mode stereo_only needs a stereo rig; " + dataset.root +

@@ -13,6 +13,7 @@
 #include "bridge/dense/densifier.h"
 #include "bridge/evaluation/trajectory_evaluation.h"
 #include "bridge/initialization/pose_initializer.h"
+#include "bridge/initialization/selected_frames.h"
 #include "bridge/joint/joint_adjuster.h"
 #include "bridge/joint/joint_problem_data.h"
 #include "colmap_ext/dataset_import.h"
@@ -141,6 +142,15 @@ std::vector<double> SweepClock(const StationDataset& dataset);
 void RunLidarRegistratorStep(const std::string& lidar_path,
                              const std::string& output_path,
                              LidarRegistratorStepOptions options);
+
+// select_frames: the frames of a drive that go on to the camera steps (selected_frames.h), from
+// lidar_registrator's output folder into OUTPUT.
+void AddFrameSelectionOptions(const std::string& prefix,
+                              colmap::OptionManager* manager,
+                              FrameSelectionOptions* options);
+void RunSelectFramesStep(const std::string& registration_path,
+                         const std::string& output_path,
+                         const FrameSelectionOptions& options);
 
 // pose_initializer: initial poses, cam_from_lidar and landmarks; or an existing model rescaled.
 void AddPoseInitializerOptions(const std::string& prefix,

@@ -1,0 +1,67 @@
+// select_frames: the frames of a drive that go on to the camera steps (SIFT matching, the joint
+// problem, the densifier), written as a registration folder of their own
+// (bridge/initialization/selected_frames.h).
+#include "bridge/exe/commands.h"
+#include "bridge/exe/steps.h"
+#include "lidar/check_option.h"
+
+#include "colmap/controllers/option_manager.h"
+
+#include <iomanip>
+#include <iostream>
+
+namespace colmap_lidar {
+
+void AddFrameSelectionOptions(const std::string& prefix,
+                              colmap::OptionManager* manager,
+                              FrameSelectionOptions* options) {
+  PrefixedOptions add(manager, prefix);
+  add.Add("min_distance_m",
+          &options->min_distance_m,
+          "a frame goes on when the platform moved this far since the last one that did (0: "
+          "distance selects none; with min_rotation_deg 0 too: every frame)");
+  add.Add("min_rotation_deg", &options->min_rotation_deg, "... or turned this much");
+  add.Add("max_frames",
+          &options->max_frames,
+          "at most this many frames: both spacings grow by one factor until they fit (0: no cap)");
+}
+
+void RunSelectFramesStep(const std::string& registration_path,
+                         const std::string& output_path,
+                         const FrameSelectionOptions& options) {
+  const SelectedFramesSummary summary =
+      WriteSelectedFrames(registration_path, output_path, options);
+  std::cout << "select_frames: " << summary.num_kept << " of " << summary.num_frames
+            << " frames go on to the camera steps (each at least " << std::setprecision(3)
+            << summary.spacing_factor * options.min_distance_m << " m or "
+            << summary.spacing_factor * options.min_rotation_deg
+            << " deg from the kept frame before it";
+  if (summary.spacing_factor > 1) {
+    std::cout << ": the spacings grown by " << summary.spacing_factor << " to keep at most "
+              << options.max_frames;
+  }
+  std::cout << "); " << summary.num_composed_edges
+            << " edges of the trajectory join kept frames across frames left out. Frames left out "
+               "keep their poses in "
+            << registration_path << "/lidar_poses.txt; the choice is in " << output_path
+            << "/selected_frames.txt" << std::endl;
+}
+
+int RunSelectFrames(int argc, char** argv) {
+  std::string registration_path, output_path;
+  FrameSelectionOptions options;
+  colmap::OptionManager manager;
+  manager.AddRequiredOption(
+      "registration_path", &registration_path, "lidar_registrator's output folder");
+  manager.AddRequiredOption("output_path",
+                            &output_path,
+                            "folder for lidar_poses.txt, pairs.txt and selected_frames.txt of "
+                            "the selected frames");
+  AddFrameSelectionOptions("", &manager, &options);
+  manager.Parse(argc, argv);
+  ThrowUnlessValid(options, "FrameSelectionOptions");
+  RunSelectFramesStep(registration_path, output_path, options);
+  return EXIT_SUCCESS;
+}
+
+}  // namespace colmap_lidar
