@@ -4,7 +4,9 @@
 
 #include <Eigen/Geometry>
 
+#include <cmath>
 #include <filesystem>
+#include <vector>
 
 namespace colmap_lidar {
 
@@ -15,6 +17,42 @@ double RotationErrorDeg(const colmap::Rigid3d& a, const colmap::Rigid3d& b) {
 std::string StationOfImageName(const std::string& image_name) {
   return std::filesystem::path(image_name).stem().string();
 }
+
+namespace {
+
+// The spread of `centers` about their centroid (RMS distance), 1 if they coincide.
+double CenterSpread(const Eigen::Matrix3Xd& centers) {
+  const double spread =
+      std::sqrt((centers.colwise() - centers.rowwise().mean()).colwise().squaredNorm().mean());
+  return spread > 0 ? spread : 1;
+}
+
+// Umeyama on each camera's centre and the tips of its three axes at the centres' spread: the
+// centres alone leave the rotation about their line free when they are collinear (a straight
+// drive), the axes fix it.
+Eigen::Matrix4d AlignCameraFrames(const Eigen::Matrix3Xd& estimated_centers,
+                                  const std::vector<Eigen::Matrix3d>& estimated_world_from_cam,
+                                  const Eigen::Matrix3Xd& true_centers,
+                                  const std::vector<Eigen::Matrix3d>& true_world_from_cam,
+                                  bool similarity) {
+  const double true_lever = CenterSpread(true_centers);
+  const double estimated_lever = similarity ? CenterSpread(estimated_centers) : true_lever;
+  const Eigen::Index n = estimated_centers.cols();
+  Eigen::Matrix3Xd estimated(3, 4 * n), truth(3, 4 * n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    estimated.col(4 * i) = estimated_centers.col(i);
+    truth.col(4 * i) = true_centers.col(i);
+    for (int axis = 0; axis < 3; ++axis) {
+      estimated.col(4 * i + 1 + axis) =
+          estimated_centers.col(i) + estimated_lever * estimated_world_from_cam[i].col(axis);
+      truth.col(4 * i + 1 + axis) =
+          true_centers.col(i) + true_lever * true_world_from_cam[i].col(axis);
+    }
+  }
+  return Eigen::umeyama(estimated, truth, similarity);
+}
+
+}  // namespace
 
 CalibrationEvaluation EvaluateCalibration(
     const colmap::Rigid3d& true_cam_from_lidar,
@@ -54,13 +92,21 @@ CalibrationEvaluation EvaluateCalibration(
   THROW_CHECK_GE(names.size(), 3) << "Fewer than 3 stations of the ground "
                                      "truth are registered in the model";
   Eigen::Matrix3Xd estimated_centers(3, names.size()), true_centers(3, names.size());
+  std::vector<Eigen::Matrix3d> estimated_world_from_cam, true_world_from_cam;
   for (size_t i = 0; i < names.size(); ++i) {
     estimated_centers.col(i) = images[i]->ProjectionCenter();
-    true_centers.col(i) = colmap::Inverse(true_cam_from_world.at(names[i])).translation;
+    estimated_world_from_cam.push_back(
+        images[i]->CamFromWorld().rotation.toRotationMatrix().transpose());
+    const colmap::Rigid3d& cam_from_world = true_cam_from_world.at(names[i]);
+    true_centers.col(i) = colmap::Inverse(cam_from_world).translation;
+    true_world_from_cam.push_back(cam_from_world.rotation.toRotationMatrix().transpose());
   }
-  // true_world_from_model_world, by Umeyama on the camera centres.
-  const Eigen::Matrix4d alignment =
-      Eigen::umeyama(estimated_centers, true_centers, similarity_alignment);
+  // true_world_from_model_world, by Umeyama on the camera frames (centres and axis tips).
+  const Eigen::Matrix4d alignment = AlignCameraFrames(estimated_centers,
+                                                      estimated_world_from_cam,
+                                                      true_centers,
+                                                      true_world_from_cam,
+                                                      similarity_alignment);
   result.alignment = similarity_alignment ? "similarity" : "rigid";
   const Eigen::Matrix3d scaled_rotation = alignment.topLeftCorner<3, 3>();
   result.alignment_scale = std::cbrt(scaled_rotation.determinant());

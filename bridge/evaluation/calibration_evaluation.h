@@ -1,8 +1,9 @@
 // Accuracy of an estimated cam_from_lidar and of a sparse model's station poses against ground truth.
 //
-// Pose errors are measured after aligning the estimated camera centres to the true ones by a rigid
+// Pose errors are measured after aligning the estimated cameras to the true ones by a rigid
 // transform (rotation + translation, no scale: the model is metric) or, on request, a similarity
-// (for models of unknown scale). Station i is matched by name: the stem of the image name.
+// (for models of unknown scale), fitted to each camera's centre and the tips of its axes (the
+// centres alone leave the rotation about their line free on a straight drive). Station i is matched by name: the stem of the image name.
 #pragma once
 
 #include "colmap/geometry/rigid3.h"
