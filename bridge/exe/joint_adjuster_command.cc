@@ -4,6 +4,7 @@
 #include "bridge/exe/steps.h"
 #include "bridge/exe/vertical_alignment_step.h"
 #include "bridge/initialization/lidar_registration_files.h"
+#include "bridge/joint/association_settling.h"
 #include "bridge/joint/joint_adjuster.h"
 #include "bridge/joint/joint_problem_data.h"
 #include "bridge/joint/start_departure.h"
@@ -226,6 +227,22 @@ nlohmann::json MotionJson(const MotionAnalysis& motion) {
           {"verdict", motion.verdict}};
 }
 
+// NaN (an axis without a sigma) as null.
+nlohmann::json SigmasJson(const std::array<double, 6>& values) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const double v : values)
+    json.push_back(std::isnan(v) ? nlohmann::json() : nlohmann::json(v));
+  return json;
+}
+
+nlohmann::json AssociationSettlingJson(const AssociationSettling& settling) {
+  return {{"settled", settling.settled},
+          {"rounds", settling.rounds},
+          {"last_round_move_deg_mm", settling.last_move},
+          {"last_round_move_sigmas", SigmasJson(settling.last_move_sigmas)},
+          {"warnings", settling.warnings}};
+}
+
 nlohmann::json StartDepartureJson(const StartDeparture& departure) {
   return {{"move_deg_mm", departure.move},
           {"allowed_deg_mm", departure.allowed},
@@ -266,6 +283,7 @@ void WriteReport(const std::string& directory,
   report["extrinsic_measurements"] = MeasurementsJson(loaded.data.extrinsic_measurements, refined);
   report["start_departure"] =
       StartDepartureJson(CheckStartDeparture(initial, refined, loaded.data, summary));
+  report["association"] = AssociationSettlingJson(CheckAssociationSettling(summary));
   if (!summary.lidar_free_axis_in_cam.isZero()) {
     const Eigen::Vector3d& axis = summary.lidar_free_axis_in_cam;
     report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
@@ -434,7 +452,8 @@ constexpr char kGatesFixed[] = "the outlier gates are fixed (docs/joint_adjuster
 constexpr char kNoLoss[] =
     "no robust loss: the outlier gates remove outliers (docs/joint_adjuster.md)";
 constexpr char kRoundsFixed[] =
-    "the association rounds run until cam_from_lidar stops moving (docs/joint_adjuster.md)";
+    "the association rounds run until cam_from_lidar stops moving, at most 10; report.json "
+    "'association' says whether they settled (docs/joint_adjuster.md)";
 constexpr char kSamplingFixed[] =
     "the LiDAR association's sampling is fixed (docs/joint_adjuster.md)";
 constexpr char kCovarianceFixed[] =
@@ -669,8 +688,11 @@ bool DecideFromMotion(const StationDataset& dataset,
   return degenerate_motion;
 }
 
-void PrintWarnings(const StartDeparture& departure) {
+void PrintWarnings(const StartDeparture& departure, const AssociationSettling& settling) {
   for (const std::string& warning : departure.warnings) {
+    std::cout << "WARNING: cam_from_lidar " << warning << std::endl;
+  }
+  for (const std::string& warning : settling.warnings) {
     std::cout << "WARNING: cam_from_lidar " << warning << std::endl;
   }
 }
@@ -743,7 +765,8 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   }
   partial.Commit();
   PrintUncertainty(summary, caveat);
-  PrintWarnings(CheckStartDeparture(initial, cam_from_lidar, loaded->data, summary));
+  PrintWarnings(CheckStartDeparture(initial, cam_from_lidar, loaded->data, summary),
+                CheckAssociationSettling(summary));
   std::cout << "Wrote " << paths.output_path << " (" << SecondsSince(start) << " s)" << std::endl;
 }
 

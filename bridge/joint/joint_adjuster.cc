@@ -7,6 +7,7 @@
 #include "bridge/joint/landmark_lidar_term.h"
 #include "bridge/joint/lidar_pair_cost.h"
 #include "bridge/joint/lidar_point_to_plane_cost.h"
+#include "bridge/joint/start_departure.h"
 #include "colmap_ext/depth_prior_cost.h"
 #include "colmap_ext/elapsed.h"
 #include "colmap_ext/logging.h"
@@ -1048,6 +1049,7 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
       summary.variance_components = UpdateVarianceFactors(&state, associations, &factors_changed);
     }
     summary.extrinsic_change_per_round.push_back(ExtrinsicChange(before, *cam_from_lidar));
+    summary.last_round_move = ExtrinsicAxisMove(before, *cam_from_lidar);
     if (state.UsesExtrinsic()) {
       std::cout << "  round " << round + 1 << " moved cam_from_lidar by "
                 << summary.extrinsic_change_per_round.back()[0] << " deg, "
@@ -1055,6 +1057,8 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
     }
   }
 
+  summary.association_settled =
+      !state.UsesExtrinsic() || (!RoundMovedExtrinsic(options_, summary) && !factors_changed);
   // The uncertainty and the perturbation curves are evaluated on a problem rebuilt from the final
   // state: the last solve's problem may hold residuals of observations (even landmarks) removed after
   // it.

@@ -258,6 +258,10 @@ struct JointAdjustmentSummary {
   double lidar_free_angle_deg = 0;
   // Per association round of the (last) pass: how far it moved T_e, {deg, mm}.
   std::vector<std::array<double, 2>> extrinsic_change_per_round;
+  // The last round's move of T_e per camera axis (rx ry rz [deg], tx ty tz [mm]), and whether the
+  // rounds ended because T_e stopped moving (false: max_association_rounds ended them).
+  std::array<double, 6> last_round_move{};
+  bool association_settled = true;
   // The variance factors in force at the end, and the last estimate's components (empty without
   // estimate_variance_components).
   VarianceFactors variance_factors;

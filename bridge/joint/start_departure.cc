@@ -52,18 +52,27 @@ std::optional<std::array<double, 6>> PriorSigma(const JointProblemData& data) {
 
 }  // namespace
 
+std::array<double, 6> ExtrinsicAxisMove(const colmap::Rigid3d& from, const colmap::Rigid3d& to) {
+  const Eigen::AngleAxisd rotation(to.rotation * from.rotation.inverse());
+  const Eigen::Vector3d rotation_deg = kRadToDeg * rotation.angle() * rotation.axis();
+  const Eigen::Vector3d translation_mm = 1000 * (to.translation - from.translation);
+  return {rotation_deg(0),
+          rotation_deg(1),
+          rotation_deg(2),
+          translation_mm(0),
+          translation_mm(1),
+          translation_mm(2)};
+}
+
 StartDeparture CheckStartDeparture(const colmap::Rigid3d& start,
                                    const colmap::Rigid3d& result,
                                    const JointProblemData& data,
                                    const JointAdjustmentSummary& summary) {
   const std::optional<std::array<double, 6>> start_sigma = PriorSigma(data);
   StartDeparture departure;
-  const Eigen::AngleAxisd rotation(result.rotation * start.rotation.inverse());
-  const Eigen::Vector3d rotation_deg = kRadToDeg * rotation.angle() * rotation.axis();
-  const Eigen::Vector3d translation_mm = 1000 * (result.translation - start.translation);
+  departure.move = ExtrinsicAxisMove(start, result);
   const std::string evidence = Evidence(summary);
   for (int k = 0; k < 6; ++k) {
-    departure.move[k] = k < 3 ? rotation_deg(k) : translation_mm(k - 3);
     departure.allowed[k] = start_sigma ? kAllowedSigmas * (*start_sigma)[k]
                                        : (k < 3 ? kAllowedRotationDeg : kAllowedTranslationMm);
     departure.beyond[k] =

@@ -27,6 +27,9 @@ struct StartDeparture {
   std::vector<std::string> warnings;
 };
 
+// rx ry rz [deg] (rotation vector of `to` * inverse(`from`) about the camera axes), tx ty tz [mm].
+std::array<double, 6> ExtrinsicAxisMove(const colmap::Rigid3d& from, const colmap::Rigid3d& to);
+
 // `data`: its prior on cam_from_lidar (ExtrinsicMeasurement::prior; covariance in rad and m about
 // and along the camera axes), if any, gives the start's sigma per axis.
 StartDeparture CheckStartDeparture(const colmap::Rigid3d& start,
