@@ -249,6 +249,23 @@ nlohmann::json StartDepartureJson(const StartDeparture& departure) {
           {"warnings", departure.warnings}};
 }
 
+// One sentence on what the adjustment could determine of cam_from_lidar.
+std::string ObservabilityVerdict(const JointAdjusterOptions& options,
+                                 const JointAdjustmentSummary& summary) {
+  const ExtrinsicUncertainty& u = summary.uncertainty;
+  if (options.mode != JointMode::kJoint) {
+    return "cam_from_lidar held constant (" + JointModeName(options.mode) + ")";
+  }
+  if (u.unobservable.empty() && summary.motion.unique) return "cam_from_lidar is observable";
+  // A degenerate motion whose directions the data observe all the same (a car through the
+  // landmark-to-LiDAR-plane term): say both, not "unobservable" against the uncertainty.
+  if (!u.unobservable.empty()) return u.unobservable.front();
+  return "cam_from_lidar is observable by its uncertainty" +
+         std::string(options.landmark_lidar_weight > 0 ? " (with the landmark-to-LiDAR-plane term)"
+                                                       : "") +
+         ", though the motion alone is degenerate: " + summary.motion.verdict;
+}
+
 void WriteReport(const std::string& directory,
                  const JointAdjusterOptions& options,
                  const LoadedJointData& loaded,
@@ -299,23 +316,7 @@ void WriteReport(const std::string& directory,
                                {"rotation_deg", options.hold_rotation_deg},
                                {"translation_mm", options.hold_translation_mm}};
   report["motion"] = MotionJson(summary.motion);
-  std::string verdict;
-  if (options.mode != JointMode::kJoint) {
-    verdict = "cam_from_lidar held constant (" + JointModeName(options.mode) + ")";
-  } else if (u.unobservable.empty() && summary.motion.unique) {
-    verdict = "cam_from_lidar is observable";
-  } else {
-    // A degenerate motion whose directions the data observe all the same (a car through the
-    // landmark-to-LiDAR-plane term): say both, not "unobservable" against the uncertainty.
-    verdict = !u.unobservable.empty()
-                  ? u.unobservable.front()
-                  : "cam_from_lidar is observable by its uncertainty" +
-                        std::string(options.landmark_lidar_weight > 0
-                                        ? " (with the landmark-to-LiDAR-plane term)"
-                                        : "") +
-                        ", though the motion alone is degenerate: " + summary.motion.verdict;
-  }
-  report["observability_verdict"] = verdict;
+  report["observability_verdict"] = ObservabilityVerdict(options, summary);
   nlohmann::json curves = nlohmann::json::array();
   for (const PerturbationCurve& curve : summary.perturbation) {
     curves.push_back(
