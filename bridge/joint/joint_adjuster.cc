@@ -922,6 +922,24 @@ std::array<double, 2> ExtrinsicChange(const colmap::Rigid3d& before, const colma
 }
 
 // Whether the last round still moved T_e (so that another round at the final gate is due).
+// The state's free LiDAR rotation, variance factors and clock offset into `summary`, printed.
+void RecordFinalState(const RunState& state,
+                      const JointProblemData& data,
+                      JointAdjustmentSummary* summary) {
+  if (state.LidarHasFreeAxis()) {
+    summary->lidar_free_axis_in_cam = state.lidar_free_axis;
+    summary->lidar_free_angle_deg = *state.lidar_free_angle * 180 / M_PI;
+    std::cout << "E_l's own rotation about the driving direction: " << summary->lidar_free_angle_deg
+              << " deg from cam_from_lidar" << std::endl;
+  }
+  summary->variance_factors = state.factors;
+  if (state.options.estimate_time_offset) {
+    summary->time_offset = *state.time_offset;
+    std::cout << "LiDAR clock offset from the cameras (E_m): " << *state.time_offset
+              << (data.image_times.empty() ? " frames" : " s") << std::endl;
+  }
+}
+
 bool RoundMovedExtrinsic(const JointAdjusterOptions& options,
                          const JointAdjustmentSummary& summary) {
   if (summary.extrinsic_change_per_round.empty()) return false;
@@ -1063,18 +1081,7 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
   // state: the last solve's problem may hold residuals of observations (even landmarks) removed after
   // it.
   summary.motion = AnalyseMotion(*reconstruction, options_.observability);
-  if (state.LidarHasFreeAxis()) {
-    summary.lidar_free_axis_in_cam = state.lidar_free_axis;
-    summary.lidar_free_angle_deg = *state.lidar_free_angle * 180 / M_PI;
-    std::cout << "E_l's own rotation about the driving direction: " << summary.lidar_free_angle_deg
-              << " deg from cam_from_lidar" << std::endl;
-  }
-  summary.variance_factors = state.factors;
-  if (options_.estimate_time_offset) {
-    summary.time_offset = *state.time_offset;
-    std::cout << "LiDAR clock offset from the cameras (E_m): " << *state.time_offset
-              << (data.image_times.empty() ? " frames" : " s") << std::endl;
-  }
+  RecordFinalState(state, data, &summary);
   const std::unique_ptr<JointProblem> final_problem = BuildProblem(state, associations);
   summary.final_reprojection_residuals = final_problem->reprojection_ids.size();
   summary.final_depth_residuals = final_problem->depth_ids.size();
