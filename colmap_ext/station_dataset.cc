@@ -345,25 +345,20 @@ void ReadOptionalTimes(StationDataset* dataset) {
 }  // namespace
 
 StationDataset RestrictToStations(StationDataset dataset, const std::vector<std::string>& kept) {
-  const std::set<std::string> wanted(kept.begin(), kept.end());
-  for (const std::string& name : wanted) {
-    if (std::find(dataset.stations.begin(), dataset.stations.end(), name) ==
-        dataset.stations.end()) {
-      throw std::runtime_error(dataset.root + ": no station " + name);
-    }
-  }
+  std::set<std::string> wanted(kept.begin(), kept.end());
   StationDataset restricted = dataset;
   restricted.stations.clear();
   restricted.cloud_paths.clear();
   restricted.frame_times.clear();
   restricted.sweep_times.clear();
   for (size_t i = 0; i < dataset.stations.size(); ++i) {
-    if (wanted.count(dataset.stations[i]) == 0) continue;
+    if (wanted.erase(dataset.stations[i]) == 0) continue;
     restricted.stations.push_back(dataset.stations[i]);
     restricted.cloud_paths.push_back(dataset.cloud_paths[i]);
     if (!dataset.frame_times.empty()) restricted.frame_times.push_back(dataset.frame_times[i]);
     if (!dataset.sweep_times.empty()) restricted.sweep_times.push_back(dataset.sweep_times[i]);
   }
+  if (!wanted.empty()) throw std::runtime_error(dataset.root + ": no station " + *wanted.begin());
   return restricted;
 }
 

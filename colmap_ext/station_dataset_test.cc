@@ -212,5 +212,24 @@ TEST_F(StationDatasetTest, PoseFilesRoundTripWithWFirst) {
   EXPECT_THROW(ReadNamedPoses(dir_.File("twice.txt")), std::runtime_error);
 }
 
+TEST(RestrictToStationsTest, KeepsTheNamedStationsWithTheirListsAndNamesAnUnknownOne) {
+  StationDataset dataset;
+  dataset.root = "/data";
+  dataset.stations = {"000", "001", "002", "003"};
+  dataset.cloud_paths = {"a", "b", "c", "d"};
+  dataset.frame_times = {0.0, 0.1, 0.2, 0.3};
+  const StationDataset restricted = RestrictToStations(dataset, {"003", "001"});
+  EXPECT_EQ(restricted.stations, (std::vector<std::string>{"001", "003"}));
+  EXPECT_EQ(restricted.cloud_paths, (std::vector<std::string>{"b", "d"}));
+  EXPECT_EQ(restricted.frame_times, (std::vector<double>{0.1, 0.3}));
+  EXPECT_TRUE(restricted.sweep_times.empty());
+  try {
+    RestrictToStations(dataset, {"001", "007"});
+    FAIL() << "an unknown station was accepted";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("no station 007"), std::string::npos) << error.what();
+  }
+}
+
 }  // namespace
 }  // namespace colmap_lidar
