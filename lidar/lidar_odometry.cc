@@ -14,6 +14,11 @@ namespace {
 constexpr double kMapVoxelFactor = 0.5;
 constexpr double kSourceVoxelFactor = 1.5;
 
+// Graduated non-convexity for the frame without a predicted motion: the Geman-McClure kernel's
+// scale in units of the threshold's sigma, stage by stage, each from the last stage's pose; the
+// final stage is every frame's kernel sigma / 3.
+constexpr double kStartKernelFactors[] = {3.0, 1.0};
+
 std::vector<Eigen::Vector3d> Transformed(const Eigen::Isometry3d& pose,
                                          const std::vector<Eigen::Vector3d>& points) {
   std::vector<Eigen::Vector3d> out;
@@ -134,9 +139,15 @@ const OdometryFrame& LidarOdometry::RegisterFrame(const PointCloud& sweep, doubl
     frame.prediction = last * ScaleMotion(velocity_, clock - last_clock_);
     const double sigma = threshold_.Sigma();
     frame.threshold_m = 3.0 * sigma;
-    FinishFrame(
-        AlignFrameToMap(source, &map_, frame.prediction, 3.0 * sigma, sigma / 3.0, options_.icp),
-        &frame);
+    Eigen::Isometry3d start = frame.prediction;
+    if (frames_.size() == 1) {
+      for (const double factor : kStartKernelFactors) {
+        start = AlignFrameToMap(source, &map_, start, 3.0 * sigma, factor * sigma, options_.icp)
+                    .world_from_lidar;
+      }
+    }
+    FinishFrame(AlignFrameToMap(source, &map_, start, 3.0 * sigma, sigma / 3.0, options_.icp),
+                &frame);
     const Eigen::Isometry3d motion = last.inverse() * frame.world_from_lidar;
     threshold_.Update(frame.prediction.inverse() * frame.world_from_lidar, motion);
     velocity_ = ScaleMotion(motion, 1.0 / (clock - last_clock_));

@@ -10,9 +10,11 @@
 //      threshold (lidar/adaptive_threshold.h);
 //   5. the map updated with the registered frame, far voxels dropped.
 // The first motion has no velocity to predict it: the second frame starts from rest with the
-// initial threshold (tau = 3 initial_sigma_m), whose basin holds the motion of a platform already
-// moving at driving speed (the residuals leave the scanner's sampling pattern out,
-// lidar/frame_to_map_icp.h). Every frame gets a pose. Its information is measured point-to-plane
+// initial threshold (tau = 3 initial_sigma_m) and graduated non-convexity (Black & Rangarajan,
+// IJCV 1996; Yang et al., RA-L 2020): its ICP runs with the kernel's scale at 3 sigma, then sigma,
+// then the sigma / 3 of every frame, each from the last. With only the narrow kernel, the points
+// that show a platform already moving at driving speed (poles, the ends of parked cars) sit in the
+// kernel's tail, and along a street whose facades hold the travel weakly the ICP stops near rest. Every frame gets a pose. Its information is measured point-to-plane
 // against the map; a frame whose weakest constrained direction is below `degenerate_ratio` of its
 // strongest (a tunnel, a street of bare facades) is flagged with that direction, never silently
 // accepted.
