@@ -2,15 +2,17 @@
 # Fails when a layer includes (or links) what it must not:
 #   lidar/       no COLMAP, no colmap_ext/bridge/tests; its public headers (.h) include only Eigen and std
 #   colmap_ext/  no lidar/, bridge/ or tests/
-#   bridge/      no tests/ (only the CLI main, bridge/exe/colmap_lidar_main.cc, links the simulator);
-#                its concern folders (initialization, joint, dense, baselines, evaluation) include
-#                none of each other
-#   bridge/exe/  the commands: nothing outside it includes bridge/exe/ (algorithms never include a
-#                command), and the bridge library's sources list none of its files
+#   bridge/      no tests/; no source file outside its folders; the folders in levels, each including
+#                only folders of lower levels:
+#                  1  simulation (the simulator), initialization, joint, dense, baselines, evaluation
+#                  2  survey (the survey planner: the joint problem on the simulator's worlds)
+#                  3  exe (the commands; nothing outside it includes it, and the bridge library's
+#                     sources list none of its files)
 #   all layers   no struct or class name defined in two headers (one namespace: an ODR violation)
 # Prints every violation as file:line and exits 1 if there is any.
+#   scripts/check_layering.sh [ROOT]   checks the tree at ROOT (default: this repository)
 set -uo pipefail
-cd "$(dirname "$0")/.."
+cd "${1:-$(dirname "$0")/..}"
 status=0
 violation() { echo "layering: $1"; status=1; }
 
@@ -25,15 +27,27 @@ check_includes() {  # folder, regex of forbidden includes, what
 check_includes lidar 'colmap/|colmap_ext/|bridge/|tests/' "COLMAP, colmap_ext, bridge or tests"
 check_includes colmap_ext 'lidar/|bridge/|tests/' "lidar, bridge or tests"
 hits=$(grep -rnE '^\s*#\s*include\s*"tests/' --include='*.h' --include='*.cc' bridge |
-       grep -v '^bridge/exe/colmap_lidar_main.cc:' |
        grep -vE '_test\.cc:[0-9]+:\s*#\s*include\s*"tests/testing/' || true)
-[ -z "$hits" ] || violation "the bridge library must not include tests/:"$'\n'"$hits"
+[ -z "$hits" ] || violation "bridge/ must not include tests/:"$'\n'"$hits"
 
-# bridge/'s concern folders stand side by side: none includes another's headers.
-for concern in initialization joint dense baselines evaluation; do
-  others=$(echo initialization joint dense baselines evaluation | tr ' ' '\n' | grep -vx "$concern" |
-           paste -sd'|')
-  check_includes "bridge/$concern" "bridge/($others)/" "another concern folder of bridge/"
+hits=$(find bridge -maxdepth 1 -type f \( -name '*.h' -o -name '*.cc' \) | sort)
+[ -z "$hits" ] || violation "sources directly in bridge/ (they belong in a concern folder):"$'\n'"$hits"
+
+# bridge/'s folders by level: a folder includes only folders of lower levels.
+declare -A level=([simulation]=1 [initialization]=1 [joint]=1 [dense]=1 [baselines]=1
+                  [evaluation]=1 [survey]=2 [exe]=3)
+folders=$(printf '%s\n' "${!level[@]}" | sort)
+for folder in $folders; do
+  [ -d "bridge/$folder" ] || violation "bridge/$folder is missing (the levels name it)"
+  above=$(for other in $folders; do
+            [[ $other != "$folder" && ${level[$other]} -ge ${level[$folder]} ]] && echo "$other"
+          done | paste -sd'|')
+  [ -z "$above" ] ||
+    check_includes "bridge/$folder" "bridge/($above)/" "a bridge/ folder of its level or above"
+done
+for dir in bridge/*/; do
+  name=$(basename "$dir")
+  [[ -n "${level[$name]:-}" ]] || violation "bridge/$name has no level in scripts/check_layering.sh"
 done
 
 # Commands apart from algorithms: only bridge/exe/ includes bridge/exe/.

@@ -3,7 +3,7 @@
 // exit without a signal, exactly one "ERROR:" line naming the file (and the key or line where it
 // applies), no output left behind, and every input file byte-for-byte unchanged.
 #include "lidar/cloud_io.h"
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

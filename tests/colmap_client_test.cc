@@ -2,7 +2,7 @@
 // COLMAP's own SIFT pipeline finds and verifies matches between neighbouring simulated stations.
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/station_dataset.h"
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

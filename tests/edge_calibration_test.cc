@@ -2,7 +2,7 @@
 // Its accuracy is checked on real data (tests/kitti_sample_test.cc): on the simulator's textured
 // surfaces the edge objective is flat (docs/edge_calibration.md).
 #include "colmap_ext/station_dataset.h"
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

@@ -3,7 +3,7 @@
 // triangulated by the real `colmap point_triangulator`) -> joint_adjuster; accuracy against ground truth.
 #include "bridge/evaluation/calibration_evaluation.h"
 #include "colmap_ext/station_dataset.h"
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/file_bytes.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"

@@ -6,7 +6,7 @@
 // cam_from_lidar within the run-to-run spread of COLMAP's feature matching (our own steps are
 // deterministic; docs/reliability.md).
 #include "colmap_ext/station_dataset.h"
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

@@ -5,8 +5,8 @@
 // drives naming the file, leaving nothing behind. The real sample is in kitti_sample_test.cc.
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
-#include "tests/simulator/sensor_pod.h"
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/sensor_pod.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

@@ -7,7 +7,7 @@
 #include "lidar/pair_registration.h"
 #include "lidar/revisit_closure.h"
 #include "lidar/station_cloud.h"
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

@@ -4,7 +4,7 @@
 // alignment (each station's stereo depth against its own LiDAR cloud, no motion needed) gives the
 // start, and the joint adjustment refines it. Evaluated against the simulator's truth.
 #include "colmap_ext/station_dataset.h"
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/pipeline_fixture.h"
 #include "tests/testing/scoped_temp_dir.h"
 

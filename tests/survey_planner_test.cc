@@ -3,8 +3,8 @@
 // plans are refused with the file named and nothing written.
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
-#include "tests/simulator/scene.h"
-#include "tests/simulator/sensor_pod.h"
+#include "bridge/simulation/scene.h"
+#include "bridge/simulation/sensor_pod.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

@@ -1,8 +1,8 @@
 // The colmap-lidar command-line dispatcher: `colmap-lidar COMMAND [--options]`, as COLMAP's `colmap`.
 // This executable (not the bridge library) is the only place that links the simulator.
 #include "bridge/exe/commands.h"
-#include "tests/simulator/simulator_commands.h"
-#include "tests/simulator/survey_planner_command.h"
+#include "bridge/exe/simulator_commands.h"
+#include "bridge/exe/survey_planner_command.h"
 
 #include "colmap/util/logging.h"
 #include "colmap/util/version.h"

@@ -3,7 +3,7 @@
 // each writing into folders of its own, so that they run in parallel after it.
 #pragma once
 
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 
 #include <nlohmann/json.hpp>

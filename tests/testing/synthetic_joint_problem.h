@@ -1,7 +1,7 @@
-// Test helpers around the synthetic joint problem (tests/simulator/synthetic_joint_problem.h).
+// Test helpers around the synthetic joint problem (bridge/survey/synthetic_joint_problem.h).
 #pragma once
 
-#include "tests/simulator/synthetic_joint_problem.h"
+#include "bridge/survey/synthetic_joint_problem.h"
 
 #include "colmap/geometry/rigid3.h"
 

@@ -5,9 +5,9 @@
 #include "lidar/kd_tree.h"
 #include "lidar/model_evaluation.h"
 #include "lidar/statistics.h"
-#include "tests/simulator/renderer.h"
-#include "tests/simulator/scene.h"
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/renderer.h"
+#include "bridge/simulation/scene.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/scoped_temp_dir.h"
 
 #include "colmap/mvs/depth_map.h"

@@ -1,14 +1,14 @@
-// plan_survey: arguments, the printed table and the report files around tests/simulator/survey_planner.h.
+// plan_survey: arguments, the printed table and the report files around bridge/survey/survey_planner.h.
 // Files written (atomically, as one folder): report.json (quaternions w first), best_plan.txt (the
 // plan's stations and the best candidate, "<name> qw qx qy qz tx ty tz" cam_from_world per line) and
 // candidates.txt (every candidate, best first).
-#include "tests/simulator/survey_planner_command.h"
+#include "bridge/exe/survey_planner_command.h"
 
 #include "colmap_ext/atomic_file.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
-#include "tests/simulator/survey_planner.h"
+#include "bridge/survey/survey_planner.h"
 
 #include "colmap/controllers/option_manager.h"
 

@@ -1,8 +1,8 @@
-#include "tests/simulator/survey_planner.h"
+#include "bridge/survey/survey_planner.h"
 
 #include "colmap_ext/logging.h"
-#include "tests/simulator/sensor_pod.h"
-#include "tests/simulator/surface_world.h"
+#include "bridge/simulation/sensor_pod.h"
+#include "bridge/survey/surface_world.h"
 
 #include <algorithm>
 #include <cmath>

@@ -5,7 +5,7 @@
 
 #include "colmap_ext/pose_perturbation.h"
 #include "colmap_ext/station_dataset.h"
-#include "tests/simulator/scene.h"
+#include "bridge/simulation/scene.h"
 
 #include "colmap/geometry/rigid3.h"
 

@@ -10,9 +10,9 @@
 #include "colmap_ext/station_dataset.h"
 #include "lidar/point_cloud.h"
 #include "lidar/station_cloud.h"
-#include "tests/simulator/renderer.h"
-#include "tests/simulator/scene.h"
-#include "tests/simulator/sensor_pod.h"
+#include "bridge/simulation/renderer.h"
+#include "bridge/simulation/scene.h"
+#include "bridge/simulation/sensor_pod.h"
 
 #include "colmap/scene/reconstruction.h"
 

@@ -1,11 +1,11 @@
 // The point-surface world (plan_survey --surface) against the ray-cast scene it was sampled from.
-#include "tests/simulator/surface_world.h"
+#include "bridge/survey/surface_world.h"
 
 #include "lidar/kd_tree.h"
-#include "tests/simulator/renderer.h"
-#include "tests/simulator/scene.h"
-#include "tests/simulator/sensor_pod.h"
-#include "tests/simulator/survey_planner.h"
+#include "bridge/simulation/renderer.h"
+#include "bridge/simulation/scene.h"
+#include "bridge/simulation/sensor_pod.h"
+#include "bridge/survey/survey_planner.h"
 
 #include <gtest/gtest.h>
 

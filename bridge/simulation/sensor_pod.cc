@@ -1,4 +1,4 @@
-#include "tests/simulator/sensor_pod.h"
+#include "bridge/simulation/sensor_pod.h"
 
 #include "colmap/sensor/models.h"
 

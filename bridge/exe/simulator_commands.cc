@@ -1,6 +1,6 @@
-#include "tests/simulator/simulator_commands.h"
+#include "bridge/exe/simulator_commands.h"
 
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 
 #include "colmap/controllers/option_manager.h"
 

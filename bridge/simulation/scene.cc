@@ -1,4 +1,4 @@
-#include "tests/simulator/scene.h"
+#include "bridge/simulation/scene.h"
 
 #include <Eigen/Geometry>
 

@@ -3,7 +3,7 @@
 //
 // For the planned station poses, the capture is simulated with the sensor pod's model (keypoints
 // with pixel noise, depth priors with noise of their own sigma_d, LiDAR scans with range noise; no
-// images, no SIFT: tests/simulator/synthetic_joint_problem.h) and the joint problem is solved at the
+// images, no SIFT: bridge/survey/synthetic_joint_problem.h) and the joint problem is solved at the
 // true poses. What is reported is the joint adjuster's own uncertainty of T_e (its cluster-robust
 // covariance, whose 2-sigma coverage over seeded draws is 88-98 % per axis:
 // tests/joint_adjuster_coverage_test.cc), its unobservable directions in words, and the motion test
@@ -18,8 +18,8 @@
 #include "bridge/joint/extrinsic_observability.h"
 #include "bridge/joint/joint_adjuster.h"
 #include "lidar/point_cloud.h"
-#include "tests/simulator/scene.h"
-#include "tests/simulator/synthetic_joint_problem.h"
+#include "bridge/simulation/scene.h"
+#include "bridge/survey/synthetic_joint_problem.h"
 
 #include "colmap/geometry/rigid3.h"
 

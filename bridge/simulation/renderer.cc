@@ -1,4 +1,4 @@
-#include "tests/simulator/renderer.h"
+#include "bridge/simulation/renderer.h"
 
 #include <Eigen/Geometry>
 

@@ -1,7 +1,7 @@
-#include "tests/simulator/synthetic_joint_problem.h"
+#include "bridge/survey/synthetic_joint_problem.h"
 
 #include "colmap_ext/depth_prior_extractor.h"
-#include "tests/simulator/renderer.h"
+#include "bridge/simulation/renderer.h"
 
 #include <random>
 

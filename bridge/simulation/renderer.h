@@ -2,7 +2,7 @@
 #pragma once
 
 #include "lidar/point_cloud.h"
-#include "tests/simulator/scene.h"
+#include "bridge/simulation/scene.h"
 
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/camera.h"

@@ -1,12 +1,12 @@
-#include "tests/simulator/simulate_dataset.h"
+#include "bridge/simulation/simulate_dataset.h"
 
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
-#include "tests/simulator/kitti_layout.h"
-#include "tests/simulator/renderer.h"
-#include "tests/simulator/scene.h"
-#include "tests/simulator/sensor_pod.h"
+#include "bridge/simulation/kitti_layout.h"
+#include "bridge/simulation/renderer.h"
+#include "bridge/simulation/scene.h"
+#include "bridge/simulation/sensor_pod.h"
 
 #include "colmap/mvs/depth_map.h"
 

@@ -7,7 +7,7 @@
 #pragma once
 
 #include "lidar/point_cloud.h"
-#include "tests/simulator/synthetic_joint_problem.h"
+#include "bridge/survey/synthetic_joint_problem.h"
 
 #include <memory>
 

@@ -24,7 +24,7 @@ struct SimulationOptions {
   // One camera: rig.json without "right", no images/right/ (a monocular dataset).
   bool mono = false;
   // dataset (docs/dataset_format.md) | kitti (KITTI raw's layout and calibration files, with a
-  // rectified right camera; tests/simulator/kitti_layout.h)
+  // rectified right camera; bridge/simulation/kitti_layout.h)
   std::string layout = "dataset";
   // LiDAR rays per station
   size_t lidar_points = 1600000;

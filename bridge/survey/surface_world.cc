@@ -1,4 +1,4 @@
-#include "tests/simulator/surface_world.h"
+#include "bridge/survey/surface_world.h"
 
 #include "lidar/kd_tree.h"
 #include "lidar/spherical_range_image.h"
