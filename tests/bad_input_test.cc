@@ -2,8 +2,8 @@
 // the way a user's capture breaks, runs the real CLI on it and checks what the user gets: a non-zero
 // exit without a signal, exactly one "ERROR:" line naming the file (and the key or line where it
 // applies), no output left behind, and every input file byte-for-byte unchanged.
-#include "lidar/cloud_io.h"
 #include "bridge/simulation/simulate_dataset.h"
+#include "lidar/cloud_io.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 
@@ -142,6 +142,62 @@ TEST_P(BadInputTest, OneClearErrorNoOutputInputsUnchanged) {
 void CutCloud(const fs::path& dataset, const std::string& file, size_t bytes) {
   const fs::path path = dataset / "lidar" / file;
   fs::resize_file(path, fs::file_size(path) - bytes);
+}
+
+// lidar/FILE rewritten as an ASCII PCD with a per-point time field: the cloud's own points, the
+// i-th timed by `time(i, n)`.
+std::function<void(const fs::path&)> TimeCloud(const std::string& file,
+                                               std::function<double(size_t, size_t)> time) {
+  return [=](const fs::path& d) {
+    const PointCloud cloud = ReadPointCloud((d / "lidar" / file).string());
+    std::ostringstream pcd;
+    pcd << "VERSION 0.7\nFIELDS x y z t\nSIZE 4 4 4 8\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH "
+        << cloud.Size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << cloud.Size()
+        << "\nDATA ascii\n";
+    for (size_t i = 0; i < cloud.Size(); ++i) {
+      const Eigen::Vector3d& p = cloud.points[i];
+      pcd << p.x() << " " << p.y() << " " << p.z() << " " << time(i, cloud.Size()) << "\n";
+    }
+    WriteBytes(d / "lidar" / file, pcd.str());
+  };
+}
+
+// The sweeps of a moving platform (LiDAR odometry): the third frame is the first one de-skewed,
+// by its per-point times.
+std::vector<BadInputCase> OdometryCases() {
+  const std::string odometry =
+      "lidar_registrator --lidar_path {dataset}/lidar --output_path {out} --method odometry "
+      "--deskew_sweeps 1";
+  return {
+      {"odometry_nan_sweep",
+       [](const fs::path& d) {
+         PointCloud cloud;
+         cloud.points.assign(100, Eigen::Vector3d::Constant(std::nan("")));
+         WritePointCloud((d / "lidar/001.pcd").string(), cloud);
+       },
+       odometry,
+       {"001.pcd", "NaN"}},
+      {"odometry_sweep_out_of_range",
+       [](const fs::path& d) {
+         PointCloud cloud;
+         cloud.points.assign(100, Eigen::Vector3d(0.5, 0, 0));
+         WritePointCloud((d / "lidar/001.pcd").string(), cloud);
+       },
+       odometry,
+       {"001.pcd", "range"}},
+      {"odometry_sweep_times_all_equal",
+       TimeCloud("002.pcd", [](size_t, size_t) { return 7.0; }),
+       odometry,
+       {"002.pcd", "all equal"}},
+      {"odometry_sweep_times_out_of_range",
+       TimeCloud("002.pcd", [](size_t i, size_t n) { return i % 200 == 0 ? 1000.0 : 0.1 * i / n; }),
+       odometry,
+       {"002.pcd", "out of range"}},
+      {"odometry_sweep_nan_time",
+       TimeCloud("002.pcd", [](size_t i, size_t n) { return i == 7 ? std::nan("") : 0.1 * i / n; }),
+       odometry,
+       {"002.pcd", "time"}},
+  };
 }
 
 // The simulator's clouds are lidar/000.pcd ...; the images images/{left,right}/000.png ...
@@ -381,12 +437,10 @@ TEST(ReadOnlyOutputTest, AnOutputBelowAReadOnlyFolderIsOneClearError) {
   EXPECT_TRUE(fs::is_empty(read_only)) << "output left in " << read_only;
 }
 
-INSTANTIATE_TEST_SUITE_P(Matrix,
-                         BadInputTest,
-                         ::testing::ValuesIn(Cases()),
-                         [](const ::testing::TestParamInfo<BadInputCase>& info) {
-                           return info.param.name;
-                         });
+std::string CaseName(const ::testing::TestParamInfo<BadInputCase>& info) { return info.param.name; }
+
+INSTANTIATE_TEST_SUITE_P(Matrix, BadInputTest, ::testing::ValuesIn(Cases()), CaseName);
+INSTANTIATE_TEST_SUITE_P(Odometry, BadInputTest, ::testing::ValuesIn(OdometryCases()), CaseName);
 
 }  // namespace
 }  // namespace colmap_lidar
