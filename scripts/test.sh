@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what is missing (scripts/setup.sh), builds colmap-lidar and runs every test: the layering
-# check, the unit tests beside the sources and the integration tests under tests/.
+# and function size checks, the unit tests beside the sources and the integration tests under tests/.
 #   scripts/test.sh           every test (CTest labels unit, integration, slow), then the unit and
 #                             integration tests again under ASan + UBSan (scripts/sanitize.sh)
 #   scripts/test.sh --quick   without the slow ones (ctest -LE slow) nor the sanitizer pass: a few minutes
@@ -28,6 +28,8 @@ fi
 readonly kBuildDir="${BUILD_DIR:-build}"
 echo "[test] layering check"
 bash scripts/check_layering.sh
+echo "[test] function size check"
+python3 scripts/check_functions.py
 echo "[test] configuring and building in $kBuildDir"
 source scripts/configure.sh
 configure_build "$kBuildDir"
