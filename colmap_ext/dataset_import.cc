@@ -384,6 +384,43 @@ void CheckStationImages(const StationDataset& dataset) {
   }
 }
 
+namespace {
+
+// Every step of the import into the copy `partial`: camera, SIFT, images, matches, rig and LiDAR
+// frames.
+DatasetImportSummary ImportIntoPartial(const StationDataset& dataset,
+                                       const DatasetImportOptions& options,
+                                       const std::string& partial) {
+  DatasetImportSummary summary;
+  std::vector<std::string> names;
+  for (size_t i = 0; i < dataset.stations.size(); ++i) {
+    names.push_back(options.ImageName(dataset, i));
+  }
+  const std::string image_path = options.image_path.empty()
+                                     ? (fs::path(dataset.root) / "images").string()
+                                     : options.image_path;
+  const bool all_extracted = PrepareCamera(dataset, names, image_path, options, partial, &summary);
+  if (all_extracted) {
+    std::cout << "COLMAP SIFT extraction: every station image has its features" << std::endl;
+  } else {
+    Extract(names, image_path, summary, options, partial);
+  }
+  const std::vector<colmap::image_t> image_ids =
+      ImportedImageIds(dataset, names, summary.camera_id, partial);
+  if (options.matcher == "spatial") WritePosePriors(dataset, image_ids, options, partial);
+  MatchFeatures(options, partial);
+  if (options.matcher == "spatial") {
+    MatchStationsWithoutPosition(dataset, names, options, partial);
+  }
+  WriteRigAndLidarFrames(dataset, summary.camera_id, image_ids, partial);
+  const colmap::Database database(partial);
+  summary.num_images = names.size();
+  summary.num_verified_pairs = database.NumVerifiedImagePairs();
+  return summary;
+}
+
+}  // namespace
+
 DatasetImportSummary ImportDataset(const StationDataset& dataset,
                                    const std::string& database_path,
                                    const DatasetImportOptions& options) {
@@ -413,37 +450,7 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
     CopySqliteDatabase(database_path, partial);
   }
   try {
-    DatasetImportSummary summary;
-    std::vector<std::string> names;
-    for (size_t i = 0; i < dataset.stations.size(); ++i) {
-      names.push_back(options.ImageName(dataset, i));
-    }
-    const std::string image_path = options.image_path.empty()
-                                       ? (fs::path(dataset.root) / "images").string()
-                                       : options.image_path;
-    const bool all_extracted =
-        PrepareCamera(dataset, names, image_path, options, partial, &summary);
-    if (all_extracted) {
-      std::cout << "COLMAP SIFT extraction: every station image has its features" << std::endl;
-    } else {
-      Extract(names, image_path, summary, options, partial);
-    }
-
-    const std::vector<colmap::image_t> image_ids =
-        ImportedImageIds(dataset, names, summary.camera_id, partial);
-
-    if (options.matcher == "spatial") WritePosePriors(dataset, image_ids, options, partial);
-    MatchFeatures(options, partial);
-    if (options.matcher == "spatial") {
-      MatchStationsWithoutPosition(dataset, names, options, partial);
-    }
-
-    WriteRigAndLidarFrames(dataset, summary.camera_id, image_ids, partial);
-    {
-      const colmap::Database database(partial);
-      summary.num_images = names.size();
-      summary.num_verified_pairs = database.NumVerifiedImagePairs();
-    }
+    const DatasetImportSummary summary = ImportIntoPartial(dataset, options, partial);
     // Into the user's database in one transaction (SQLite's backup API: correct with COLMAP's WAL
     // journal, unlike a rename, and it waits for or reports other writers).
     CopySqliteDatabase(partial, database_path);

@@ -87,6 +87,28 @@ std::vector<DepthPrior> ExtractDepthPriors(const colmap::FeatureKeypoints& keypo
   return priors;
 }
 
+namespace {
+
+// The stereo depth map at `map_path`, which must be in `image`'s pixel grid (else every prior
+// would be read at the wrong place).
+colmap::mvs::DepthMap ReadDepthMapOfImage(const std::string& map_path,
+                                          const colmap::Image& image,
+                                          const colmap::Camera& camera) {
+  colmap::mvs::DepthMap depth_map;
+  depth_map.Read(map_path);
+  THROW_CHECK_GT(depth_map.GetWidth(), 0) << "cannot read " << map_path;
+  if (depth_map.GetWidth() != camera.width || depth_map.GetHeight() != camera.height) {
+    throw std::runtime_error(map_path + " is " + std::to_string(depth_map.GetWidth()) + "x" +
+                             std::to_string(depth_map.GetHeight()) + " but image " + image.Name() +
+                             " is " + std::to_string(camera.width) + "x" +
+                             std::to_string(camera.height) +
+                             ": the depth maps belong to another dataset or rig");
+  }
+  return depth_map;
+}
+
+}  // namespace
+
 std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(const std::string& database_path,
                                                              const std::string& depth_path,
                                                              const DepthPriorOptions& options) {
@@ -122,18 +144,8 @@ std::vector<ImageDepthPriorCount> ExtractDatabaseDepthPriors(const std::string& 
     const std::string map_path = StereoDepthMapPath(depth_path, stem);
     count.has_depth_map = fs::is_regular_file(map_path);
     if (count.has_depth_map) {
-      colmap::mvs::DepthMap depth_map;
-      depth_map.Read(map_path);
-      THROW_CHECK_GT(depth_map.GetWidth(), 0) << "cannot read " << map_path;
-      // The map must be in this image's pixel grid, or every prior would be read at the wrong place.
-      const colmap::Camera& camera = cameras.at(image.CameraId());
-      if (depth_map.GetWidth() != camera.width || depth_map.GetHeight() != camera.height) {
-        throw std::runtime_error(map_path + " is " + std::to_string(depth_map.GetWidth()) + "x" +
-                                 std::to_string(depth_map.GetHeight()) + " but image " +
-                                 image.Name() + " is " + std::to_string(camera.width) + "x" +
-                                 std::to_string(camera.height) +
-                                 ": the depth maps belong to another dataset or rig");
-      }
+      const colmap::mvs::DepthMap depth_map =
+          ReadDepthMapOfImage(map_path, image, cameras.at(image.CameraId()));
       std::vector<DepthPrior>& image_priors = priors[image.ImageId()];
       image_priors = ExtractDepthPriors(keypoints.at(image.ImageId()),
                                         depth_map,

@@ -148,6 +148,41 @@ cv::Mat ReadImageOrThrow(const std::string& path) {
   return image;
 }
 
+// OpenCV's semi-global matcher with the options' penalties and checks.
+cv::Ptr<cv::StereoSGBM> MakeSgbm(int min_disparity,
+                                 int num_disparities,
+                                 const StereoDepthOptions& options) {
+  const int area = options.block_size * options.block_size;
+  return cv::StereoSGBM::create(
+      min_disparity,
+      num_disparities,
+      options.block_size,
+      options.p1_factor * area,
+      options.p2_factor * area,
+      /*disp12MaxDiff=*/options.mirrored_left_right_check
+          ? -1
+          : std::max(1, static_cast<int>(std::lround(options.max_left_right_diff_px))),
+      options.pre_filter_cap,
+      options.uniqueness_ratio,
+      options.speckle_window_size,
+      static_cast<int>(std::ceil(options.speckle_range_px)),
+      SgbmMode(options.mode));
+}
+
+void PrintStereoSetup(const StationDataset& dataset,
+                      const StereoRectifier& rectifier,
+                      int min_disparity,
+                      int num_disparities,
+                      const StereoDepthOptions& options) {
+  std::cout << "Stereo depth: " << dataset.stations.size() << " stations, "
+            << rectifier.ImageSize().width << "x" << rectifier.ImageSize().height
+            << ", rectified f " << std::fixed << std::setprecision(1)
+            << rectifier.RectifiedFocalLength() << " px, baseline " << std::setprecision(3)
+            << rectifier.BaselineMeters() << " m, disparities " << min_disparity << ".."
+            << min_disparity + num_disparities - 1 << " px, SGBM mode " << options.mode
+            << std::endl;
+}
+
 }  // namespace
 
 bool StereoDepthOptions::Check() const {
@@ -183,21 +218,7 @@ StereoDepth ComputeStereoDepth(const cv::Mat& left_image,
 
   int min_disparity = 0, num_disparities = 0;
   DisparityRange(rectifier, options, &min_disparity, &num_disparities);
-  const int area = options.block_size * options.block_size;
-  cv::Ptr<cv::StereoSGBM> matcher = cv::StereoSGBM::create(
-      min_disparity,
-      num_disparities,
-      options.block_size,
-      options.p1_factor * area,
-      options.p2_factor * area,
-      /*disp12MaxDiff=*/options.mirrored_left_right_check
-          ? -1
-          : std::max(1, static_cast<int>(std::lround(options.max_left_right_diff_px))),
-      options.pre_filter_cap,
-      options.uniqueness_ratio,
-      options.speckle_window_size,
-      static_cast<int>(std::ceil(options.speckle_range_px)),
-      SgbmMode(options.mode));
+  const cv::Ptr<cv::StereoSGBM> matcher = MakeSgbm(min_disparity, num_disparities, options);
 
   // Left disparity (and, for the mirrored check, the right image's disparity by matching the mirrored
   // pair, the right image as the reference: d_right(x) = d such that right x matches left x + d).
@@ -251,13 +272,7 @@ void ComputeDatasetStereoDepth(const StationDataset& dataset,
       dataset.rig.left, *dataset.rig.right, dataset.rig.right_from_left);
   int min_disparity = 0, num_disparities = 0;
   DisparityRange(rectifier, options, &min_disparity, &num_disparities);
-  std::cout << "Stereo depth: " << dataset.stations.size() << " stations, "
-            << rectifier.ImageSize().width << "x" << rectifier.ImageSize().height
-            << ", rectified f " << std::fixed << std::setprecision(1)
-            << rectifier.RectifiedFocalLength() << " px, baseline " << std::setprecision(3)
-            << rectifier.BaselineMeters() << " m, disparities " << min_disparity << ".."
-            << min_disparity + num_disparities - 1 << " px, SGBM mode " << options.mode
-            << std::endl;
+  PrintStereoSetup(dataset, rectifier, min_disparity, num_disparities, options);
   fs::create_directories(output_path);
   fs::remove(fs::path(output_path) / "stereo.json");  // not complete until rewritten
 

@@ -3,6 +3,7 @@
 #include "colmap_ext/logging.h"
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -39,6 +40,28 @@ void CameraToOpenCv(const colmap::Camera& camera, cv::Mat* camera_matrix, cv::Ma
   *distortion = cv::Mat(coefficients, true).reshape(1, 1);
 }
 
+namespace {
+
+// Every pixel of the original left image in the rectified image (row-major).
+std::vector<cv::Point2f> RectifiedPixelGrid(const cv::Size& size,
+                                            const cv::Mat& camera_matrix,
+                                            const cv::Mat& distortion,
+                                            const cv::Mat& rectification,
+                                            const cv::Mat& projection) {
+  std::vector<cv::Point2f> pixels;
+  pixels.reserve(static_cast<size_t>(size.area()));
+  for (int row = 0; row < size.height; ++row) {
+    for (int col = 0; col < size.width; ++col) {
+      pixels.emplace_back(static_cast<float>(col), static_cast<float>(row));
+    }
+  }
+  std::vector<cv::Point2f> rectified;
+  cv::undistortPoints(pixels, rectified, camera_matrix, distortion, rectification, projection);
+  return rectified;
+}
+
+}  // namespace
+
 StereoRectifier::StereoRectifier(const colmap::Camera& left,
                                  const colmap::Camera& right,
                                  const colmap::Rigid3d& right_from_left) {
@@ -53,18 +76,8 @@ StereoRectifier::StereoRectifier(const colmap::Camera& left,
   CameraToOpenCv(left, &k_left, &d_left);
   CameraToOpenCv(right, &k_right, &d_right);
   cv::Mat rotation, translation;
-  const Eigen::Matrix3d r = right_from_left.rotation.toRotationMatrix();
-  rotation = (cv::Mat_<double>(3, 3) << r(0, 0),
-              r(0, 1),
-              r(0, 2),
-              r(1, 0),
-              r(1, 1),
-              r(1, 2),
-              r(2, 0),
-              r(2, 1),
-              r(2, 2));
-  const Eigen::Vector3d& t = right_from_left.translation;
-  translation = (cv::Mat_<double>(3, 1) << t.x(), t.y(), t.z());
+  cv::eigen2cv(Eigen::Matrix3d(right_from_left.rotation.toRotationMatrix()), rotation);
+  cv::eigen2cv(Eigen::Vector3d(right_from_left.translation), translation);
 
   cv::Mat r1, r2, p1, p2, q;
   // alpha = 1: every original pixel keeps a rectified counterpart; zero disparity at infinity.
@@ -104,15 +117,7 @@ StereoRectifier::StereoRectifier(const colmap::Camera& left,
   cv::initUndistortRectifyMap(
       k_right, d_right, r2, p2, size_, CV_32FC1, right_map_x_, right_map_y_);
 
-  std::vector<cv::Point2f> pixels;
-  pixels.reserve(static_cast<size_t>(size_.area()));
-  for (int row = 0; row < size_.height; ++row) {
-    for (int col = 0; col < size_.width; ++col) {
-      pixels.emplace_back(static_cast<float>(col), static_cast<float>(row));
-    }
-  }
-  std::vector<cv::Point2f> rectified;
-  cv::undistortPoints(pixels, rectified, k_left, d_left, r1, p1);
+  const std::vector<cv::Point2f> rectified = RectifiedPixelGrid(size_, k_left, d_left, r1, p1);
   original_in_rectified_ = cv::Mat(rectified, true).reshape(2, size_.height);
 }
 

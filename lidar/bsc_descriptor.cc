@@ -99,6 +99,49 @@ BscDescriptor Describe(const std::vector<Eigen::Vector3d>& local,  // neighbours
   return descriptor;
 }
 
+// The local reference frame of a keypoint at `center` (Dong et al. 2017): z the normal of the
+// covariance of `neighbors` weighted by R - d, towards the viewpoint (into *z); the x axes to
+// describe with: the axis of largest spread, signed by the majority of the points, its mirror where
+// the sign is ambiguous, and +-y where the two largest spreads are alike. Empty: no frame.
+std::vector<Eigen::Vector3d> LrfCandidates(const PointCloud& cloud,
+                                           const std::vector<size_t>& neighbors,
+                                           const Eigen::Vector3d& center,
+                                           const Eigen::Vector3d& viewpoint,
+                                           const BscOptions& options,
+                                           Eigen::Vector3d* z) {
+  const double R = options.support_radius;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  double weight_sum = 0;
+  for (size_t j : neighbors) {
+    const Eigen::Vector3d d = cloud.points[j] - center;
+    const double w = R - d.norm();
+    covariance += w * d * d.transpose();
+    weight_sum += w;
+  }
+  if (weight_sum <= 0) return {};
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance / weight_sum);
+  *z = solver.eigenvectors().col(0);
+  Eigen::Vector3d x = solver.eigenvectors().col(2);
+  if (z->dot(viewpoint - center) < 0) *z = -*z;
+  double majority = 0, magnitude = 0;
+  for (size_t j : neighbors) {
+    const Eigen::Vector3d d = cloud.points[j] - center;
+    const double projection = (R - d.norm()) * x.dot(d);
+    majority += projection;
+    magnitude += std::abs(projection);
+  }
+  if (majority < 0) x = -x;
+  std::vector<Eigen::Vector3d> x_axes = {x};
+  if (std::abs(majority) < options.sign_ambiguity * magnitude) x_axes.push_back(-x);
+  const Eigen::Vector3d ascending = solver.eigenvalues().cwiseMax(0);
+  if (ascending(2) > 0 && ascending(1) / ascending(2) > options.ambiguity_ratio) {
+    const Eigen::Vector3d y = z->cross(x);
+    x_axes.push_back(y);
+    x_axes.push_back(-y);
+  }
+  return x_axes;
+}
+
 }  // namespace
 
 bool BscOptions::Check() const {
@@ -124,41 +167,15 @@ std::vector<BscFeature> ComputeBscFeatures(const PointCloud& cloud,
   {
     std::vector<size_t> neighbors;
     std::vector<Eigen::Vector3d> local;
+    Eigen::Vector3d z;
 #pragma omp for schedule(dynamic, 16)
     for (size_t k = 0; k < keypoints.size(); ++k) {
       const Eigen::Vector3d center = cloud.points.at(keypoints[k]);
       tree.RadiusSearch(center, R, &neighbors);
       if (static_cast<int>(neighbors.size()) < options.min_neighbors) continue;
-      // LRF: covariance about the keypoint with weights R - d.
-      Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-      double weight_sum = 0;
-      for (size_t j : neighbors) {
-        const Eigen::Vector3d d = cloud.points[j] - center;
-        const double w = R - d.norm();
-        covariance += w * d * d.transpose();
-        weight_sum += w;
-      }
-      if (weight_sum <= 0) continue;
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance / weight_sum);
-      Eigen::Vector3d z = solver.eigenvectors().col(0);
-      Eigen::Vector3d x = solver.eigenvectors().col(2);
-      if (z.dot(viewpoint - center) < 0) z = -z;
-      double majority = 0, magnitude = 0;
-      for (size_t j : neighbors) {
-        const Eigen::Vector3d d = cloud.points[j] - center;
-        const double projection = (R - d.norm()) * x.dot(d);
-        majority += projection;
-        magnitude += std::abs(projection);
-      }
-      if (majority < 0) x = -x;
-      std::vector<Eigen::Vector3d> x_axes = {x};
-      if (std::abs(majority) < options.sign_ambiguity * magnitude) x_axes.push_back(-x);
-      const Eigen::Vector3d ascending = solver.eigenvalues().cwiseMax(0);
-      if (ascending(2) > 0 && ascending(1) / ascending(2) > options.ambiguity_ratio) {
-        const Eigen::Vector3d y = z.cross(x);
-        x_axes.push_back(y);
-        x_axes.push_back(-y);
-      }
+      const std::vector<Eigen::Vector3d> x_axes =
+          LrfCandidates(cloud, neighbors, center, viewpoint, options, &z);
+      if (x_axes.empty()) continue;
       BscFeature& feature = features[k];
       feature.point_index = keypoints[k];
       feature.position = center;

@@ -61,42 +61,6 @@ IndexImage Splat(const LidarSurface& surface,
 
 enum class FillVerdict { kFill, kNoLayer, kEdge, kSparse, kViewAngle, kCurvature };
 
-FillVerdict JudgeFill(const std::vector<int>& layer,
-                      size_t window_size,
-                      const std::vector<Eigen::Vector2d>& xy,
-                      const Eigen::Vector2d& centre,
-                      const Eigen::Vector3d& normal,
-                      const Eigen::Vector3d& unit_ray,
-                      double layer_curvature,
-                      double min_view_cos,
-                      const LidarDepthRefinementOptions& options) {
-  if (static_cast<int>(layer.size()) < options.min_fill_samples) {
-    return FillVerdict::kSparse;
-  }
-  if (std::abs(normal.dot(unit_ray)) < min_view_cos) {
-    return FillVerdict::kViewAngle;
-  }
-  int quadrants = 0;
-  for (int s : layer) {
-    const Eigen::Vector2d d = xy[s] - centre;
-    if (d.squaredNorm() < 0.25) {
-      quadrants = 0xF;
-    } else {
-      quadrants |= 1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3) : (d.y() >= 0 ? 1 : 2));
-    }
-  }
-  int num_quadrants = 0;
-  for (int q = 0; q < 4; ++q) num_quadrants += (quadrants >> q) & 1;
-  if (layer.size() != window_size && num_quadrants < 4) {
-    return FillVerdict::kEdge;
-  }
-  if (num_quadrants < options.min_fill_quadrants) return FillVerdict::kSparse;
-  if (layer_curvature > options.max_fill_curvature) {
-    return FillVerdict::kCurvature;
-  }
-  return FillVerdict::kFill;
-}
-
 int AutomaticWindowRadius(const LidarSurface& surface,
                           const std::vector<Eigen::Vector2d>& xy,
                           const PinholeIntrinsics& intrinsics) {
@@ -186,24 +150,33 @@ struct Layer {
   double lidar_z = 0;       // the plane's depth along the pixel's ray
 };
 
+// One pixel's window: the visible samples around it, the sample owning the pixel (-1: none), the
+// pixel's centre and its ray (z = 1).
+struct PixelWindow {
+  const std::vector<int>& window;
+  int owner;
+  Eigen::Vector2d centre;
+  Eigen::Vector3d ray;
+};
+
+// The layer of the window's samples on the plane of the sample nearest the pixel (within
+// plane_tolerance_m of it, normals within the angle whose cosine is min_normal_cos).
 void FitLayer(const LidarSurface& surface,
               const std::vector<Eigen::Vector2d>& xy,
-              const std::vector<int>& window,
-              int owner,
-              const Eigen::Vector2d& centre,
-              const Eigen::Vector3d& ray,
+              const PixelWindow& pixel,
               double min_normal_cos,
               double plane_tolerance_m,
               Layer* layer) {
+  const std::vector<int>& window = pixel.window;
   layer->samples.clear();
   layer->has_plane = false;
   layer->curvature = 0;
   if (window.empty()) return;
-  int nearest = owner;
+  int nearest = pixel.owner;
   if (nearest < 0) {
     double best = std::numeric_limits<double>::infinity();
     for (int s : window) {
-      const double d = (xy[s] - centre).squaredNorm();
+      const double d = (xy[s] - pixel.centre).squaredNorm();
       if (d < best) best = d, nearest = s;
     }
   }
@@ -224,10 +197,46 @@ void FitLayer(const LidarSurface& surface,
   centroid /= double(layer->samples.size());
   layer->plane_offset = layer->normal.dot(centroid);
   static const double kMinRayCos = std::cos(DegToRad(85));
-  if (std::abs(layer->normal.dot(ray.normalized())) > kMinRayCos) {
-    layer->lidar_z = layer->plane_offset / layer->normal.dot(ray);
+  if (std::abs(layer->normal.dot(pixel.ray.normalized())) > kMinRayCos) {
+    layer->lidar_z = layer->plane_offset / layer->normal.dot(pixel.ray);
     layer->has_plane = layer->lidar_z > 0;
   }
+}
+
+// Fold 2's verdict at one pixel (paper, mapping step (2)): fill only inside one flat,
+// well-observed LiDAR layer that surrounds the pixel. With a second surface in the window (a depth
+// edge or a crease) the layer must surround the pixel on all four sides: a pixel beyond the layer's
+// border, on the other surface, never has layer samples on the other surface's side.
+FillVerdict JudgeFill(const Layer& layer,
+                      const PixelWindow& pixel,
+                      const std::vector<Eigen::Vector2d>& xy,
+                      double min_view_cos,
+                      const LidarDepthRefinementOptions& options) {
+  if (static_cast<int>(layer.samples.size()) < options.min_fill_samples) {
+    return FillVerdict::kSparse;
+  }
+  if (std::abs(layer.normal.dot(pixel.ray.normalized())) < min_view_cos) {
+    return FillVerdict::kViewAngle;
+  }
+  int quadrants = 0;
+  for (int s : layer.samples) {
+    const Eigen::Vector2d d = xy[s] - pixel.centre;
+    if (d.squaredNorm() < 0.25) {
+      quadrants = 0xF;
+    } else {
+      quadrants |= 1 << (d.x() >= 0 ? (d.y() >= 0 ? 0 : 3) : (d.y() >= 0 ? 1 : 2));
+    }
+  }
+  int num_quadrants = 0;
+  for (int q = 0; q < 4; ++q) num_quadrants += (quadrants >> q) & 1;
+  if (layer.samples.size() != pixel.window.size() && num_quadrants < 4) {
+    return FillVerdict::kEdge;
+  }
+  if (num_quadrants < options.min_fill_quadrants) return FillVerdict::kSparse;
+  if (layer.curvature > options.max_fill_curvature) {
+    return FillVerdict::kCurvature;
+  }
+  return FillVerdict::kFill;
 }
 
 void AddStats(const LidarDepthRefinementStats& local, LidarDepthRefinementStats* stats) {
@@ -315,6 +324,43 @@ PixelDepth FillHole(const Layer& layer, FillVerdict verdict, LidarDepthRefinemen
   return {};
 }
 
+// What every pixel's refinement reads.
+struct PixelContext {
+  const DepthImage& stereo;
+  const LidarSurface& surface;
+  const PinholeIntrinsics& intrinsics;
+  const LidarDepthRefinementOptions& options;
+  const std::vector<Eigen::Vector2d>& xy;  // the samples' image positions
+  const IndexImage& index;
+  const SampleGrid& grid;
+  double min_normal_cos;
+  double min_view_cos;
+};
+
+// One pixel: the LiDAR layer of its window (`window`, `layer`: scratch), then its stereo depth
+// checked against the layer (fold 1) or its hole filled from it (fold 2).
+PixelDepth RefinePixel(const PixelContext& c,
+                       int row,
+                       int col,
+                       std::vector<int>* window,
+                       Layer* layer,
+                       LidarDepthRefinementStats* stats) {
+  const float stereo_z = c.stereo(row, col);
+  const bool has_stereo = stereo_z > 0 && std::isfinite(stereo_z);
+  stats->stereo_pixels += has_stereo;
+  c.grid.Window(col, row, window);
+  const PixelWindow pixel{*window,
+                          c.index(row, col),
+                          Eigen::Vector2d(col + 0.5, row + 0.5),
+                          c.intrinsics.PixelRay(col, row)};
+  FitLayer(c.surface, c.xy, pixel, c.min_normal_cos, c.options.plane_tolerance_m, layer);
+  const FillVerdict verdict = layer->has_plane && c.options.fill_holes
+                                  ? JudgeFill(*layer, pixel, c.xy, c.min_view_cos, c.options)
+                                  : FillVerdict::kNoLayer;
+  return has_stereo ? JudgeStereo(stereo_z, pixel.ray, *layer, verdict, c.options, stats)
+                    : FillHole(*layer, verdict, stats);
+}
+
 }  // namespace
 
 bool LidarDepthRefinementOptions::Check() const {
@@ -346,8 +392,15 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
   // Footprints reach at most half the window: a sample never hides a whole window.
   const IndexImage index = Splat(surface, xy, intrinsics, std::max(1, radius / 2));
   const SampleGrid grid(xy, index, radius, width, height);
-  const double min_normal_cos = std::cos(DegToRad(options.max_normal_angle_deg));
-  const double min_view_cos = std::cos(DegToRad(options.max_fill_view_angle_deg));
+  const PixelContext context{stereo,
+                             surface,
+                             intrinsics,
+                             options,
+                             xy,
+                             index,
+                             grid,
+                             std::cos(DegToRad(options.max_normal_angle_deg)),
+                             std::cos(DegToRad(options.max_fill_view_angle_deg))};
 
   RefinedDepth result;
   result.depth = DepthImage::Zero(height, width);
@@ -361,39 +414,7 @@ RefinedDepth RefineDepthWithLidar(const DepthImage& stereo,
 #pragma omp for schedule(dynamic, 8)
     for (int row = 0; row < height; ++row) {
       for (int col = 0; col < width; ++col) {
-        const float stereo_z = stereo(row, col);
-        const bool has_stereo = stereo_z > 0 && std::isfinite(stereo_z);
-        local.stereo_pixels += has_stereo;
-        grid.Window(col, row, &window);
-        const Eigen::Vector2d centre(col + 0.5, row + 0.5);
-        const Eigen::Vector3d ray = intrinsics.PixelRay(col, row);
-        FitLayer(surface,
-                 xy,
-                 window,
-                 index(row, col),
-                 centre,
-                 ray,
-                 min_normal_cos,
-                 options.plane_tolerance_m,
-                 &layer);
-        // Fold 2's verdict (paper, mapping step (2)): only inside one flat, well-observed LiDAR
-        // layer that surrounds the pixel. With a second surface in the window (a depth edge or a
-        // crease) the layer must surround the pixel on all four sides: a pixel beyond the layer's
-        // border, on the other surface, never has layer samples on the other surface's side.
-        const FillVerdict verdict = layer.has_plane && options.fill_holes
-                                        ? JudgeFill(layer.samples,
-                                                    window.size(),
-                                                    xy,
-                                                    centre,
-                                                    layer.normal,
-                                                    ray.normalized(),
-                                                    layer.curvature,
-                                                    min_view_cos,
-                                                    options)
-                                        : FillVerdict::kNoLayer;
-        const PixelDepth pixel = has_stereo
-                                     ? JudgeStereo(stereo_z, ray, layer, verdict, options, &local)
-                                     : FillHole(layer, verdict, &local);
+        const PixelDepth pixel = RefinePixel(context, row, col, &window, &layer, &local);
         const size_t k = size_t(row) * width + col;
         result.depth(row, col) = pixel.depth;
         result.source[k] = pixel.source;

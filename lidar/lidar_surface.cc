@@ -48,23 +48,29 @@ double Curvature(const Pca& pca) {
 
 // A sparse sample's neighbourhood: 1.5x the distance to its min_neighbors-th nearest sample
 // (`kth_distance`), doubled while it is a line (one scan line: it must span the next one), up to
-// max_radius_m. Returns the radius; `valid` says whether a plane was found.
-double GrownNeighbourhood(const std::vector<Eigen::Vector3d>& samples,
-                          const KdTree3& tree,
-                          size_t i,
-                          double kth_distance,
-                          const LidarSurfaceOptions& options,
-                          std::vector<size_t>* indices,
-                          Pca* pca,
-                          char* valid) {
-  double r = std::min(options.max_radius_m, std::max(options.radius_m, 1.5 * kth_distance));
+// max_radius_m: its radius, its PCA and whether that is a plane.
+struct GrownPca {
+  double radius = 0;
+  Pca pca;
+  bool valid = false;
+};
+
+GrownPca GrownNeighbourhood(const std::vector<Eigen::Vector3d>& samples,
+                            const KdTree3& tree,
+                            size_t i,
+                            double kth_distance,
+                            const LidarSurfaceOptions& options,
+                            std::vector<size_t>* indices) {
+  GrownPca grown;
+  double& r = grown.radius;
+  r = std::min(options.max_radius_m, std::max(options.radius_m, 1.5 * kth_distance));
   for (;;) {
     tree.RadiusSearch(samples[i], r, indices);
     if (static_cast<int>(indices->size()) >= options.min_neighbors) {
-      *pca = NeighbourhoodPca(samples, *indices, options.max_neighbors);
-      *valid = pca->eigenvalues(1) >= options.min_planarity * pca->eigenvalues(2);
+      grown.pca = NeighbourhoodPca(samples, *indices, options.max_neighbors);
+      grown.valid = grown.pca.eigenvalues(1) >= options.min_planarity * grown.pca.eigenvalues(2);
     }
-    if (*valid || r >= options.max_radius_m) return r;
+    if (grown.valid || r >= options.max_radius_m) return grown;
     r = std::min(options.max_radius_m, 2 * r);
   }
 }
@@ -101,16 +107,20 @@ void NeighbourDistances(const std::vector<Eigen::Vector3d>& samples,
 // Each sample's PCA radius and its neighbourhood plane (`valid` false with fewer than min_neighbors
 // samples in the radius, or a line): radius_m, or with grow_sparse_neighbourhoods a sample with too
 // few grows its own (GrownNeighbourhood).
-void OwnNeighbourhoods(const std::vector<Eigen::Vector3d>& samples,
-                       const KdTree3& tree,
-                       const LidarSurfaceOptions& options,
-                       const std::vector<double>& kth_distance,
-                       std::vector<Pca>* pcas,
-                       std::vector<char>* valid,
-                       std::vector<double>* radius) {
-  pcas->assign(samples.size(), Pca());
-  valid->assign(samples.size(), 0);
-  radius->assign(samples.size(), options.radius_m);
+struct OwnPcas {
+  std::vector<Pca> pcas;
+  std::vector<char> valid;
+  std::vector<double> radius;
+};
+
+OwnPcas OwnNeighbourhoods(const std::vector<Eigen::Vector3d>& samples,
+                          const KdTree3& tree,
+                          const LidarSurfaceOptions& options,
+                          const std::vector<double>& kth_distance) {
+  OwnPcas own;
+  own.pcas.assign(samples.size(), Pca());
+  own.valid.assign(samples.size(), 0);
+  own.radius.assign(samples.size(), options.radius_m);
 #pragma omp parallel
   {
     std::vector<size_t> indices;
@@ -118,14 +128,53 @@ void OwnNeighbourhoods(const std::vector<Eigen::Vector3d>& samples,
     for (size_t i = 0; i < samples.size(); ++i) {
       tree.RadiusSearch(samples[i], options.radius_m, &indices);
       if (static_cast<int>(indices.size()) >= options.min_neighbors) {
-        (*pcas)[i] = NeighbourhoodPca(samples, indices, options.max_neighbors);
-        (*valid)[i] = 1;
+        own.pcas[i] = NeighbourhoodPca(samples, indices, options.max_neighbors);
+        own.valid[i] = 1;
       } else if (options.grow_sparse_neighbourhoods) {
-        (*radius)[i] = GrownNeighbourhood(
-            samples, tree, i, kth_distance[i], options, &indices, &(*pcas)[i], &(*valid)[i]);
+        const GrownPca grown =
+            GrownNeighbourhood(samples, tree, i, kth_distance[i], options, &indices);
+        own.radius[i] = grown.radius;
+        own.pcas[i] = grown.pca;
+        own.valid[i] = grown.valid;
       }
     }
   }
+  return own;
+}
+
+// The thinned samples with their search tree and own neighbourhoods' PCA (valid: enough
+// neighbours).
+struct SampleNeighbourhoods {
+  const std::vector<Eigen::Vector3d>& samples;
+  const KdTree3& tree;
+  const std::vector<Pca>& own;
+  const std::vector<char>& valid;
+};
+
+// Neighbourhood shifting: besides sample i's own neighbourhood, those centred on samples half a
+// radius away; the flattest. Near a corner that is a neighbourhood on the sample's own face, so the
+// corner stays sharp instead of being rounded off by a radius. `indices`: scratch.
+const Pca* FlattestShiftedNeighbourhood(const SampleNeighbourhoods& n,
+                                        double radius,
+                                        size_t i,
+                                        const LidarSurfaceOptions& options,
+                                        std::vector<size_t>* indices) {
+  const std::vector<Eigen::Vector3d>& samples = n.samples;
+  n.tree.RadiusSearch(samples[i], radius, indices);
+  std::vector<size_t> candidates;
+  for (size_t j : *indices) {
+    const double d = (samples[j] - samples[i]).norm();
+    if (d > 0.35 * radius && d < 0.65 * radius) candidates.push_back(j);
+  }
+  const size_t stride = std::max<size_t>(1, candidates.size() / options.num_shifted_neighbourhoods);
+  const Pca* pca = &n.own[i];
+  double best = Curvature(*pca);
+  for (size_t k = 0; k < candidates.size(); k += stride) {
+    if (!n.valid[candidates[k]]) continue;
+    const double c = Curvature(n.own[candidates[k]]);
+    if (c < best) best = c, pca = &n.own[candidates[k]];
+  }
+  return pca;
 }
 
 }  // namespace
@@ -153,44 +202,28 @@ LidarSurface BuildLidarSurface(const std::vector<Eigen::Vector3d>& points_in_cam
   const std::vector<Eigen::Vector3d>& samples = thinned.points;
   const KdTree3 tree(samples);
   // Every neighbourhood once: a shifted neighbourhood centred on sample j is sample j's own.
-  std::vector<Pca> own;
-  std::vector<char> valid;
   std::vector<float> spacing;
-  std::vector<double> kth_distance, radius;
+  std::vector<double> kth_distance;
   NeighbourDistances(samples, tree, options, &spacing, &kth_distance);
-  OwnNeighbourhoods(samples, tree, options, kth_distance, &own, &valid, &radius);
+  const OwnPcas own_pcas = OwnNeighbourhoods(samples, tree, options, kth_distance);
+  const std::vector<Pca>& own = own_pcas.pcas;
+  const std::vector<char>& valid = own_pcas.valid;
+  const std::vector<double>& radius = own_pcas.radius;
+  const SampleNeighbourhoods neighbourhoods{samples, tree, own, valid};
 
   std::vector<Eigen::Vector3d> points(samples.size());
   std::vector<Eigen::Vector3d> normals(samples.size());
   std::vector<float> curvature(samples.size(), -1.f);  // -1: dropped
 #pragma omp parallel
   {
-    std::vector<size_t> indices, candidates;
+    std::vector<size_t> indices;
 #pragma omp for schedule(dynamic, 256)
     for (size_t i = 0; i < samples.size(); ++i) {
       if (!valid[i]) continue;
-      const Pca* pca = &own[i];
-      if (options.num_shifted_neighbourhoods > 0) {
-        // Neighbourhood shifting: also take the neighbourhoods centred on samples half a radius
-        // away and keep the flattest. Near a corner that is a neighbourhood on the sample's own face,
-        // so the corner stays sharp instead of being rounded off by a radius.
-        tree.RadiusSearch(samples[i], radius[i], &indices);
-        candidates.clear();
-        for (size_t j : indices) {
-          const double d = (samples[j] - samples[i]).norm();
-          if (d > 0.35 * radius[i] && d < 0.65 * radius[i]) {
-            candidates.push_back(j);
-          }
-        }
-        const size_t stride =
-            std::max<size_t>(1, candidates.size() / options.num_shifted_neighbourhoods);
-        double best = Curvature(*pca);
-        for (size_t k = 0; k < candidates.size(); k += stride) {
-          if (!valid[candidates[k]]) continue;
-          const double c = Curvature(own[candidates[k]]);
-          if (c < best) best = c, pca = &own[candidates[k]];
-        }
-      }
+      const Pca* pca =
+          options.num_shifted_neighbourhoods > 0
+              ? FlattestShiftedNeighbourhood(neighbourhoods, radius[i], i, options, &indices)
+              : &own[i];
       Eigen::Vector3d normal = pca->normal;
       if (normal.dot(samples[i]) > 0) normal = -normal;  // face the camera
       points[i] = samples[i] - normal * normal.dot(samples[i] - pca->mean);

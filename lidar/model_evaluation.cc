@@ -85,14 +85,11 @@ class NearTruthVoxels {
   std::unordered_set<uint64_t> keys_;
 };
 
-// Rigid point-to-plane ICP of the model points near the structure (within the crop distance).
-void AlignByIcp(const PointCloud& model,
-                const PointCloud& truth,
-                const KdTree3& truth_tree,
-                double spacing,
-                const NearTruthVoxels& near_truth,
-                const ModelEvaluationOptions& options,
-                ModelEvaluation* result) {
+// The model points within the crop distance of the structure.
+PointCloud PointsNearTruth(const PointCloud& model,
+                           const KdTree3& truth_tree,
+                           const NearTruthVoxels& near_truth,
+                           double crop_distance_m) {
   std::vector<char> near(model.Size());
 #pragma omp parallel for schedule(static)
   for (int64_t i = 0; i < static_cast<int64_t>(model.Size()); ++i) {
@@ -100,12 +97,22 @@ void AlignByIcp(const PointCloud& model,
     size_t index;
     double squared;
     truth_tree.Nearest(model.points[i], &index, &squared);
-    near[i] = squared <= options.crop_distance_m * options.crop_distance_m;
+    near[i] = squared <= crop_distance_m * crop_distance_m;
   }
   PointCloud cropped;
   for (size_t i = 0; i < model.Size(); ++i) {
     if (near[i]) cropped.points.push_back(model.points[i]);
   }
+  return cropped;
+}
+
+// Rigid point-to-plane ICP of the model points near the structure (`cropped`).
+void AlignByIcp(const PointCloud& cropped,
+                const PointCloud& truth,
+                const KdTree3& truth_tree,
+                double spacing,
+                const ModelEvaluationOptions& options,
+                ModelEvaluation* result) {
   if (cropped.Size() < 6) return;
   IcpOptions icp;
   icp.max_iterations = std::max(1, options.icp_max_iterations);
@@ -189,7 +196,12 @@ ModelEvaluation EvaluateModel(const PointCloud& model,
   const double spacing = TruthSpacing(truth, truth_tree);
   const NearTruthVoxels near_truth(truth, options.crop_distance_m, spacing);
   if (options.align_icp) {
-    AlignByIcp(model, truth, truth_tree, spacing, near_truth, options, &result);
+    AlignByIcp(PointsNearTruth(model, truth_tree, near_truth, options.crop_distance_m),
+               truth,
+               truth_tree,
+               spacing,
+               options,
+               &result);
   }
   // After alignment, evaluate all model points within the crop distance.
   std::vector<double> distances(model.Size());

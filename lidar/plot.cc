@@ -35,80 +35,112 @@ void WritePngAtomically(const std::string& path, const cv::Mat& canvas) {
 
 }  // namespace
 
-void WriteLinePlotPng(const std::string& path,
-                      const std::vector<PlotSeries>& series,
-                      const LinePlotOptions& options) {
-  constexpr int kWidth = 800, kHeight = 500, kLeft = 80, kRight = 150, kTop = 50, kBottom = 60;
-  const int plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
-  cv::Mat canvas(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
-  const auto y_value = [&](double y) { return options.log_y ? std::log10(y) : y; };
+namespace {
+
+constexpr int kLineWidth = 800, kLineHeight = 500, kLineLeft = 80, kLineRight = 150, kLineTop = 50,
+              kLineBottom = 60;
+constexpr int kLinePlotW = kLineWidth - kLineLeft - kLineRight;
+constexpr int kLinePlotH = kLineHeight - kLineTop - kLineBottom;
+
+// The data's extent on the plot's axes (y in log10 with log_y; non-positive y then left out),
+// widened to 2 where it is a point.
+struct LinePlotRange {
+  bool log_y = false;
   double x_min = INFINITY, x_max = -INFINITY, y_min = INFINITY, y_max = -INFINITY;
+
+  double Y(double y) const { return log_y ? std::log10(y) : y; }
+  cv::Point Pixel(double x, double y) const {
+    return cv::Point(
+        kLineLeft + static_cast<int>((x - x_min) / (x_max - x_min) * kLinePlotW),
+        kLineTop + kLinePlotH - static_cast<int>((Y(y) - y_min) / (y_max - y_min) * kLinePlotH));
+  }
+};
+
+LinePlotRange RangeOf(const std::vector<PlotSeries>& series, bool log_y) {
+  LinePlotRange range;
+  range.log_y = log_y;
   for (const PlotSeries& s : series) {
     for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if (options.log_y && s.y[i] <= 0) continue;
-      x_min = std::min(x_min, s.x[i]);
-      x_max = std::max(x_max, s.x[i]);
-      y_min = std::min(y_min, y_value(s.y[i]));
-      y_max = std::max(y_max, y_value(s.y[i]));
+      if (log_y && s.y[i] <= 0) continue;
+      range.x_min = std::min(range.x_min, s.x[i]);
+      range.x_max = std::max(range.x_max, s.x[i]);
+      range.y_min = std::min(range.y_min, range.Y(s.y[i]));
+      range.y_max = std::max(range.y_max, range.Y(s.y[i]));
     }
   }
-  if (!(x_max > x_min)) {
-    x_min = std::isfinite(x_min) ? x_min - 1 : 0;
-    x_max = x_min + 2;
+  if (!(range.x_max > range.x_min)) {
+    range.x_min = std::isfinite(range.x_min) ? range.x_min - 1 : 0;
+    range.x_max = range.x_min + 2;
   }
-  if (!(y_max > y_min)) {
-    y_min = std::isfinite(y_min) ? y_min - 1 : 0;
-    y_max = y_min + 2;
+  if (!(range.y_max > range.y_min)) {
+    range.y_min = std::isfinite(range.y_min) ? range.y_min - 1 : 0;
+    range.y_max = range.y_min + 2;
   }
-  const auto to_pixel = [&](double x, double y) {
-    return cv::Point(
-        kLeft + static_cast<int>((x - x_min) / (x_max - x_min) * plot_w),
-        kTop + plot_h - static_cast<int>((y_value(y) - y_min) / (y_max - y_min) * plot_h));
-  };
+  return range;
+}
+
+// The frame and six ticks per axis.
+void DrawLinePlotAxes(const LinePlotRange& range, cv::Mat* canvas) {
   const cv::Scalar black(0, 0, 0);
-  cv::rectangle(canvas, {kLeft, kTop}, {kLeft + plot_w, kTop + plot_h}, black);
+  cv::rectangle(
+      *canvas, {kLineLeft, kLineTop}, {kLineLeft + kLinePlotW, kLineTop + kLinePlotH}, black);
   for (int tick = 0; tick <= 5; ++tick) {
-    const int x = kLeft + tick * plot_w / 5;
-    const int y = kTop + plot_h - tick * plot_h / 5;
-    cv::putText(canvas,
-                Format(x_min + tick * (x_max - x_min) / 5),
-                {x - 15, kTop + plot_h + 22},
+    const int x = kLineLeft + tick * kLinePlotW / 5;
+    const int y = kLineTop + kLinePlotH - tick * kLinePlotH / 5;
+    cv::putText(*canvas,
+                Format(range.x_min + tick * (range.x_max - range.x_min) / 5),
+                {x - 15, kLineTop + kLinePlotH + 22},
                 cv::FONT_HERSHEY_SIMPLEX,
                 0.45,
                 black);
-    const double y_tick = y_min + tick * (y_max - y_min) / 5;
-    cv::putText(canvas,
-                Format(options.log_y ? std::pow(10, y_tick) : y_tick),
+    const double y_tick = range.y_min + tick * (range.y_max - range.y_min) / 5;
+    cv::putText(*canvas,
+                Format(range.log_y ? std::pow(10, y_tick) : y_tick),
                 {5, y + 5},
                 cv::FONT_HERSHEY_SIMPLEX,
                 0.45,
                 black);
   }
-  for (size_t k = 0; k < series.size(); ++k) {
-    const Color3ub c = ErrorColor(static_cast<double>(k), std::max<double>(1, series.size() - 1));
-    const cv::Scalar colour(0.8 * c[2], 0.8 * c[1], 0.8 * c[0]);
-    const PlotSeries& s = series[k];
-    bool has_previous = false;
-    cv::Point previous;
-    for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if (options.log_y && s.y[i] <= 0) continue;
-      const cv::Point p = to_pixel(s.x[i], s.y[i]);
-      if (has_previous) cv::line(canvas, previous, p, colour, 2, cv::LINE_AA);
-      cv::circle(canvas, p, 2, colour, cv::FILLED);
-      previous = p;
-      has_previous = true;
-    }
-    const int legend_y = kTop + 15 + 22 * static_cast<int>(k);
-    cv::line(canvas,
-             {kLeft + plot_w + 10, legend_y - 4},
-             {kLeft + plot_w + 35, legend_y - 4},
-             colour,
-             2);
-    PutText(&canvas, s.label, {kLeft + plot_w + 40, legend_y}, 0.45);
+}
+
+// Series k of `num_series` as a line with dots, and its legend entry.
+void DrawLineSeries(
+    const PlotSeries& s, size_t k, size_t num_series, const LinePlotRange& range, cv::Mat* canvas) {
+  const Color3ub c = ErrorColor(static_cast<double>(k), std::max<double>(1, num_series - 1));
+  const cv::Scalar colour(0.8 * c[2], 0.8 * c[1], 0.8 * c[0]);
+  bool has_previous = false;
+  cv::Point previous;
+  for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+    if (range.log_y && s.y[i] <= 0) continue;
+    const cv::Point p = range.Pixel(s.x[i], s.y[i]);
+    if (has_previous) cv::line(*canvas, previous, p, colour, 2, cv::LINE_AA);
+    cv::circle(*canvas, p, 2, colour, cv::FILLED);
+    previous = p;
+    has_previous = true;
   }
-  PutText(&canvas, options.title, {kLeft, 30}, 0.6);
-  PutText(&canvas, options.x_label, {kLeft + plot_w / 2 - 60, kHeight - 12}, 0.5);
-  PutText(&canvas, options.y_label + (options.log_y ? " (log)" : ""), {5, kTop - 10}, 0.45);
+  const int legend_y = kLineTop + 15 + 22 * static_cast<int>(k);
+  cv::line(*canvas,
+           {kLineLeft + kLinePlotW + 10, legend_y - 4},
+           {kLineLeft + kLinePlotW + 35, legend_y - 4},
+           colour,
+           2);
+  PutText(canvas, s.label, {kLineLeft + kLinePlotW + 40, legend_y}, 0.45);
+}
+
+}  // namespace
+
+void WriteLinePlotPng(const std::string& path,
+                      const std::vector<PlotSeries>& series,
+                      const LinePlotOptions& options) {
+  cv::Mat canvas(kLineHeight, kLineWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+  const LinePlotRange range = RangeOf(series, options.log_y);
+  DrawLinePlotAxes(range, &canvas);
+  for (size_t k = 0; k < series.size(); ++k) {
+    DrawLineSeries(series[k], k, series.size(), range, &canvas);
+  }
+  PutText(&canvas, options.title, {kLineLeft, 30}, 0.6);
+  PutText(&canvas, options.x_label, {kLineLeft + kLinePlotW / 2 - 60, kLineHeight - 12}, 0.5);
+  PutText(&canvas, options.y_label + (options.log_y ? " (log)" : ""), {5, kLineTop - 10}, 0.45);
   WritePngAtomically(path, canvas);
 }
 

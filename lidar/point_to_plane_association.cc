@@ -82,8 +82,9 @@ std::vector<PointToPlaneObservation> AssociatePointToPlane(
     const KdTree3& target_tree,
     const Eigen::Isometry3d& target_from_source,
     const AssociationOptions& options,
-    const std::vector<double>* target_curvature,
-    const std::vector<double>* source_curvature) {
+    const AssociationCurvatures& curvatures) {
+  const std::vector<double>* target_curvature = curvatures.target;
+  const std::vector<double>* source_curvature = curvatures.source;
   ThrowUnlessValid(options, "AssociationOptions");
   if (!target.HasNormals())
     throw std::invalid_argument("AssociatePointToPlane: target needs normals");

@@ -39,15 +39,21 @@ struct AssociationOptions {
   bool Check() const;
 };
 
-// `target` needs normals; `target_curvature` may be null (no planarity filter). `source_curvature`
-// (may be null) restricts normal-space sampling to planar source points, whose normals are reliable.
+// Per-point curvatures of the clouds of an association, each may be null: the target's keep only
+// planar target neighbourhoods (none: no planarity filter); the source's restrict normal-space
+// sampling to planar source points, whose normals are reliable.
+struct AssociationCurvatures {
+  const std::vector<double>* target = nullptr;
+  const std::vector<double>* source = nullptr;
+};
+
+// `target` needs normals.
 std::vector<PointToPlaneObservation> AssociatePointToPlane(
     const PointCloud& source,
     const PointCloud& target,
     const KdTree3& target_tree,
     const Eigen::Isometry3d& target_from_source,
     const AssociationOptions& options,
-    const std::vector<double>* target_curvature = nullptr,
-    const std::vector<double>* source_curvature = nullptr);
+    const AssociationCurvatures& curvatures = {});
 
 }  // namespace colmap_lidar

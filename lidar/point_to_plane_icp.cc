@@ -31,25 +31,34 @@ struct NormalEquations {
 };
 
 // Linearised about the current pose: r = n^T (p' - q), d r / d[omega, t] = [p' x n, n]. Target points
-// above `max_curvature` (if `curvature` is given) count towards the overlap only.
-NormalEquations BuildNormalEquations(const PointCloud& source,
-                                     const PointCloud& target,
-                                     const KdTree3& tree,
+// above the curvature bound (with curvatures) count towards the overlap only.
+// The clouds of one ICP phase: the source used every `stride`-th point, the target with its tree
+// and, for the planar phase, the target's curvature (nullptr: every target point) with its bound.
+struct IcpClouds {
+  const PointCloud& source;
+  const PointCloud& target;
+  const KdTree3& tree;
+  size_t stride;
+  const std::vector<double>* curvature;
+  double max_curvature;
+};
+
+NormalEquations BuildNormalEquations(const IcpClouds& clouds,
                                      const Eigen::Isometry3d& target_from_source,
-                                     size_t stride,
-                                     double gate,
-                                     const std::vector<double>* curvature,
-                                     double max_curvature) {
+                                     double gate) {
+  const PointCloud& source = clouds.source;
+  const PointCloud& target = clouds.target;
+  const size_t stride = clouds.stride;
   const long num = static_cast<long>((source.Size() + stride - 1) / stride);
   return ChunkedSum<NormalEquations>(num, [&](long k, NormalEquations* sum) {
     const Eigen::Vector3d p = target_from_source * source.points[k * stride];
     size_t index;
     double squared;
-    if (!tree.Nearest(p, &index, &squared) || squared > gate * gate) return;
+    if (!clouds.tree.Nearest(p, &index, &squared) || squared > gate * gate) return;
     const Eigen::Vector3d& n = target.normals[index];
     if (n.squaredNorm() < 0.5) return;  // no normal estimated there
     ++sum->count_in_gate;
-    if (curvature && (*curvature)[index] > max_curvature) return;
+    if (clouds.curvature && (*clouds.curvature)[index] > clouds.max_curvature) return;
     const double r = n.dot(p - target.points[index]);
     Eigen::Matrix<double, 6, 1> J;
     J << p.cross(n), n;
@@ -90,26 +99,15 @@ enum class IcpRun { kConverged, kStopped, kTooFewCorrespondences };
 
 // Gauss-Newton iterations from *target_from_source until converged or options.max_iterations
 // (kStopped), or kTooFewCorrespondences when fewer than 6 remain. *gate and *iterations carry on
-// from their values. With `target_curvature`, only the planar target points give residuals and the
-// gate stays.
-IcpRun IterateIcp(const PointCloud& source,
-                  const PointCloud& target,
-                  const KdTree3& target_tree,
-                  size_t stride,
-                  const std::vector<double>* target_curvature,
+// from their values. With curvatures, only the planar target points give residuals and the gate
+// stays.
+IcpRun IterateIcp(const IcpClouds& clouds,
                   const IcpOptions& options,
                   Eigen::Isometry3d* target_from_source,
                   double* gate,
                   int* iterations) {
   for (int it = 0; it < options.max_iterations; ++it) {
-    const NormalEquations eq = BuildNormalEquations(source,
-                                                    target,
-                                                    target_tree,
-                                                    *target_from_source,
-                                                    stride,
-                                                    *gate,
-                                                    target_curvature,
-                                                    options.max_target_curvature);
+    const NormalEquations eq = BuildNormalEquations(clouds, *target_from_source, *gate);
     ++*iterations;
     if (eq.count < 6) return IcpRun::kTooFewCorrespondences;
     const Eigen::Matrix<double, 6, 1> x = eq.H.ldlt().solve(-eq.g);
@@ -119,7 +117,7 @@ IcpRun IterateIcp(const PointCloud& source,
                             x.tail<3>().norm() < options.convergence_translation_m;
     // With curvatures the gate stays where the first phase left it: the planar residuals' smaller
     // RMS would shrink it, and the overlap (which picks among hypotheses) with it.
-    const double next_gate = target_curvature ? *gate
+    const double next_gate = clouds.curvature ? *gate
                                               : NextIcpGate(*gate,
                                                             std::sqrt(eq.squared_error / eq.count),
                                                             options.min_correspondence_distance);
@@ -130,14 +128,12 @@ IcpRun IterateIcp(const PointCloud& source,
   return IcpRun::kStopped;
 }
 
-}  // namespace
-
-IcpResult PointToPlaneIcp(const PointCloud& source,
-                          const PointCloud& target,
-                          const KdTree3& target_tree,
-                          const Eigen::Isometry3d& initial_target_from_source,
-                          const IcpOptions& options,
-                          const std::vector<double>* target_curvature) {
+// Throws std::invalid_argument for invalid options or inputs that do not fit together.
+void CheckIcpInputs(const PointCloud& source,
+                    const PointCloud& target,
+                    const KdTree3& target_tree,
+                    const IcpOptions& options,
+                    const std::vector<double>* target_curvature) {
   ThrowUnlessValid(options, "IcpOptions");
   if (source.Empty() || target.Empty()) throw std::invalid_argument("PointToPlaneIcp: empty cloud");
   if (!target.HasNormals())
@@ -148,6 +144,17 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
   if (target_curvature && target_curvature->size() != target.Size()) {
     throw std::invalid_argument("PointToPlaneIcp: one curvature per target point expected");
   }
+}
+
+}  // namespace
+
+IcpResult PointToPlaneIcp(const PointCloud& source,
+                          const PointCloud& target,
+                          const KdTree3& target_tree,
+                          const Eigen::Isometry3d& initial_target_from_source,
+                          const IcpOptions& options,
+                          const std::vector<double>* target_curvature) {
+  CheckIcpInputs(source, target, target_tree, options, target_curvature);
   const size_t stride = std::max<size_t>(1, source.Size() / options.max_source_points);
   const size_t num_used = (source.Size() + stride - 1) / stride;
   IcpResult result;
@@ -156,27 +163,18 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
   // Converge on every point first (edges and thin cylinders widen the basin), then, with
   // curvatures, on the planar ones only (their residuals are not biased at the true pose). Too few
   // planar correspondences (a scene of trees and poles): the first phase's result stands.
-  result.converged = IterateIcp(source,
-                                target,
-                                target_tree,
-                                stride,
-                                nullptr,
-                                options,
-                                &result.target_from_source,
-                                &gate,
-                                &result.iterations) == IcpRun::kConverged;
+  const IcpClouds every_point{
+      source, target, target_tree, stride, nullptr, options.max_target_curvature};
+  result.converged =
+      IterateIcp(every_point, options, &result.target_from_source, &gate, &result.iterations) ==
+      IcpRun::kConverged;
   const std::vector<double>* used_curvature = nullptr;
   if (result.converged && target_curvature) {
     const Eigen::Isometry3d converged_on_every_point = result.target_from_source;
-    const IcpRun planar = IterateIcp(source,
-                                     target,
-                                     target_tree,
-                                     stride,
-                                     target_curvature,
-                                     options,
-                                     &result.target_from_source,
-                                     &gate,
-                                     &result.iterations);
+    const IcpClouds planar_points{
+        source, target, target_tree, stride, target_curvature, options.max_target_curvature};
+    const IcpRun planar =
+        IterateIcp(planar_points, options, &result.target_from_source, &gate, &result.iterations);
     if (planar == IcpRun::kTooFewCorrespondences) {
       result.target_from_source = converged_on_every_point;
     } else {
@@ -184,14 +182,10 @@ IcpResult PointToPlaneIcp(const PointCloud& source,
       result.converged = planar == IcpRun::kConverged;
     }
   }
-  const NormalEquations final_eq = BuildNormalEquations(source,
-                                                        target,
-                                                        target_tree,
-                                                        result.target_from_source,
-                                                        stride,
-                                                        gate,
-                                                        used_curvature,
-                                                        options.max_target_curvature);
+  const IcpClouds final_points{
+      source, target, target_tree, stride, used_curvature, options.max_target_curvature};
+  const NormalEquations final_eq =
+      BuildNormalEquations(final_points, result.target_from_source, gate);
   result.num_inliers = final_eq.count;
   result.overlap_ratio = static_cast<double>(final_eq.count_in_gate) / num_used;
   result.rmse = final_eq.count ? std::sqrt(final_eq.squared_error / final_eq.count) : 0;

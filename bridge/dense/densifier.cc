@@ -169,18 +169,115 @@ cv::Mat ReadImageDepth(const std::string& depth_path,
   return stereo;
 }
 
+// The points of `cloud` (LiDAR frame) in the camera frame that project into the image (with a
+// margin of 5 % of its width) within the depth range.
+std::vector<Eigen::Vector3d> LidarPointsInView(const PointCloud& cloud,
+                                               const colmap::Rigid3d& cam_from_lidar,
+                                               const PinholeIntrinsics& intrinsics,
+                                               const DensifierOptions& options) {
+  std::vector<Eigen::Vector3d> in_view;
+  const double margin = 0.05 * intrinsics.width;
+  for (const Eigen::Vector3d& point_in_lidar : cloud.points) {
+    const Eigen::Vector3d point_in_cam = cam_from_lidar * point_in_lidar;
+    Eigen::Vector2d xy;
+    if (point_in_cam.z() < options.min_depth_m || point_in_cam.z() > options.max_depth_m ||
+        !intrinsics.Project(point_in_cam, &xy)) {
+      continue;
+    }
+    if (xy.x() < -margin || xy.y() < -margin || xy.x() > intrinsics.width + margin ||
+        xy.y() > intrinsics.height + margin) {
+      continue;
+    }
+    in_view.push_back(point_in_cam);
+  }
+  return in_view;
+}
+
+// Folds 1 and 2 (lidar/lidar_depth_refinement.h) on one station's stereo depth with its LiDAR
+// points in view; without refine_with_lidar the stereo depth as it is.
+RefinedDepth RefineStationDepth(const Eigen::Map<const DepthImage>& stereo_depth,
+                                const std::vector<Eigen::Vector3d>& in_view,
+                                const PinholeIntrinsics& intrinsics,
+                                const StationDataset& dataset,
+                                bool has_image_depth,
+                                const DensifierOptions& options) {
+  RefinedDepth refined;
+  if (options.refine_with_lidar) {
+    LidarSurfaceOptions surface_options = options.surface;
+    // The samples of a sparse sweep grow their neighbourhoods instead of being dropped where the
+    // LiDAR is the only depth (a monocular rig) and on a moving platform (rig.json's clouds are
+    // sweeps), whose stereo is decimetres off at 10-30 m. Tripod stations, whose dense clouds cover
+    // the stereo, keep the strict neighbourhoods.
+    surface_options.grow_sparse_neighbourhoods |=
+        !has_image_depth || dataset.rig.IsMovingPlatform();
+    const LidarSurface surface = BuildLidarSurface(in_view, surface_options);
+    return RefineDepthWithLidar(stereo_depth, surface, intrinsics, options.refinement);
+  }
+  refined.depth = stereo_depth;
+  refined.normals = NormalsFromDepth(refined.depth, intrinsics);
+  refined.source.assign(refined.depth.size(), DepthSource::kNone);
+  for (Eigen::Index k = 0; k < refined.depth.size(); ++k) {
+    if (refined.depth.data()[k] > 0) {
+      refined.source[k] = DepthSource::kStereo;
+      ++refined.stats.stereo_pixels;
+      ++refined.stats.stereo_without_lidar;
+    }
+  }
+  return refined;
+}
+
+// One station's refined depth and normal maps, its (undistorted) image and the preview of where
+// each pixel's depth came from, into the workspace.
+void WriteStationMaps(const StationView& view,
+                      const StationDataset& dataset,
+                      const DenseWorkspace& workspace,
+                      const CameraUndistorter* undistorter,
+                      RefinedDepth* refined) {
+  const std::string& station = dataset.stations[view.station];
+  const int height = static_cast<int>(refined->depth.rows());
+  const int width = static_cast<int>(refined->depth.cols());
+  const cv::Mat depth_mat(height, width, CV_32F, refined->depth.data());
+  workspace.WriteDepthMap(view.image_name, depth_mat);
+  workspace.WriteNormalMap(view.image_name, NormalsToMat(refined->normals));
+  if (undistorter) {
+    const std::string image_path = dataset.LeftImagePath(view.station);
+    const cv::Mat distorted = cv::imread(image_path, cv::IMREAD_COLOR);
+    if (distorted.empty()) {
+      throw std::runtime_error("station " + station + ": cannot read " + image_path);
+    }
+    workspace.WriteImage(view.image_name, undistorter->UndistortImage(distorted));
+  } else {
+    workspace.CopyImage(view.image_name, dataset.LeftImagePath(view.station));
+  }
+  const fs::path preview_dir = fs::path(workspace.Root()) / "stereo" / "previews";
+  fs::create_directories(preview_dir);
+  cv::imwrite((preview_dir / (station + ".png")).string(),
+              SourcePreview(refined->source, width, height));
+}
+
 // Fold 1 and 2 for one station; writes its maps, image and preview into the workspace and returns
 // its LiDAR cloud in the world frame (for the LiDAR map) in `points_in_world`.
-StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
+// What every station's refinement reads: the pinhole model, the calibration, the dataset with its
+// stereo depth (`depth_path`, empty: none) and the dense workspace written into.
+struct DensifyContext {
+  const colmap::Reconstruction& reconstruction;
+  const colmap::Rigid3d& cam_from_lidar;
+  const StationDataset& dataset;
+  const std::string& depth_path;
+  const DenseWorkspace& workspace;
+  const DensifierOptions& options;
+};
+
+StationDensification RefineStation(const DensifyContext& context,
                                    const StationView& view,
-                                   const colmap::Rigid3d& cam_from_lidar,
-                                   const StationDataset& dataset,
-                                   const std::string& depth_path,
-                                   const DenseWorkspace& workspace,
-                                   const DensifierOptions& options,
                                    const colmap::Camera& original_camera,
                                    const CameraUndistorter* undistorter,
                                    std::vector<Eigen::Vector3d>* points_in_world) {
+  const colmap::Reconstruction& reconstruction = context.reconstruction;
+  const colmap::Rigid3d& cam_from_lidar = context.cam_from_lidar;
+  const StationDataset& dataset = context.dataset;
+  const std::string& depth_path = context.depth_path;
+  const DensifierOptions& options = context.options;
   const std::string& station = dataset.stations[view.station];
   StationDensification result;
   result.station = station;
@@ -195,79 +292,77 @@ StationDensification RefineStation(const colmap::Reconstruction& reconstruction,
   // The station's cloud: into the LiDAR map (world frame), and cropped to the camera's view.
   const PointCloud cloud = ReadStationCloud(dataset.cloud_paths[view.station]);
   const colmap::Rigid3d world_from_lidar = colmap::Inverse(image.CamFromWorld()) * cam_from_lidar;
-  std::vector<Eigen::Vector3d> in_view;
   points_in_world->clear();
   points_in_world->reserve(cloud.Size());
   for (const Eigen::Vector3d& point_in_lidar : cloud.points) {
     points_in_world->push_back(world_from_lidar * point_in_lidar);
-    const Eigen::Vector3d point_in_cam = cam_from_lidar * point_in_lidar;
-    Eigen::Vector2d xy;
-    if (point_in_cam.z() < options.min_depth_m || point_in_cam.z() > options.max_depth_m ||
-        !intrinsics.Project(point_in_cam, &xy)) {
-      continue;
-    }
-    const double margin = 0.05 * intrinsics.width;
-    if (xy.x() < -margin || xy.y() < -margin || xy.x() > intrinsics.width + margin ||
-        xy.y() > intrinsics.height + margin) {
-      continue;
-    }
-    in_view.push_back(point_in_cam);
   }
+  const std::vector<Eigen::Vector3d> in_view =
+      LidarPointsInView(cloud, cam_from_lidar, intrinsics, options);
   result.lidar_points_in_view = in_view.size();
 
-  RefinedDepth refined;
-  if (options.refine_with_lidar) {
-    LidarSurfaceOptions surface_options = options.surface;
-    // The samples of a sparse sweep grow their neighbourhoods instead of being dropped where the
-    // LiDAR is the only depth (a monocular rig) and on a moving platform (rig.json's clouds are
-    // sweeps), whose stereo is decimetres off at 10-30 m. Tripod stations, whose dense clouds cover
-    // the stereo, keep the strict neighbourhoods.
-    surface_options.grow_sparse_neighbourhoods |=
-        depth_path.empty() || dataset.rig.IsMovingPlatform();
-    const LidarSurface surface = BuildLidarSurface(in_view, surface_options);
-    refined = RefineDepthWithLidar(stereo_depth, surface, intrinsics, options.refinement);
-  } else {
-    refined.depth = stereo_depth;
-    refined.normals = NormalsFromDepth(refined.depth, intrinsics);
-    refined.source.assign(refined.depth.size(), DepthSource::kNone);
-    for (Eigen::Index k = 0; k < refined.depth.size(); ++k) {
-      if (refined.depth.data()[k] > 0) {
-        refined.source[k] = DepthSource::kStereo;
-        ++refined.stats.stereo_pixels;
-        ++refined.stats.stereo_without_lidar;
-      }
-    }
-  }
+  RefinedDepth refined =
+      RefineStationDepth(stereo_depth, in_view, intrinsics, dataset, !depth_path.empty(), options);
   result.refinement = refined.stats;
 
-  const cv::Mat depth_mat(intrinsics.height, intrinsics.width, CV_32F, refined.depth.data());
-  workspace.WriteDepthMap(view.image_name, depth_mat);
-  workspace.WriteNormalMap(view.image_name, NormalsToMat(refined.normals));
-  if (undistorter) {
-    const std::string image_path = dataset.LeftImagePath(view.station);
-    const cv::Mat distorted = cv::imread(image_path, cv::IMREAD_COLOR);
-    if (distorted.empty()) {
-      throw std::runtime_error("station " + station + ": cannot read " + image_path);
-    }
-    workspace.WriteImage(view.image_name, undistorter->UndistortImage(distorted));
-  } else {
-    workspace.CopyImage(view.image_name, dataset.LeftImagePath(view.station));
-  }
-  const fs::path preview_dir = fs::path(workspace.Root()) / "stereo" / "previews";
-  fs::create_directories(preview_dir);
-  cv::imwrite((preview_dir / (station + ".png")).string(),
-              SourcePreview(refined.source, intrinsics.width, intrinsics.height));
+  WriteStationMaps(view, dataset, context.workspace, undistorter, &refined);
   return result;
 }
 
+// A neighbouring view's depth map with its camera.
+struct OtherView {
+  cv::Mat depth;
+  PinholeIntrinsics intrinsics;
+  colmap::Rigid3d cam_from_world;
+};
+
+// The refined depth maps of the views that overlap view `view_index` most (at most
+// max_neighbor_views).
+std::vector<OtherView> OtherDepthMaps(const colmap::Reconstruction& reconstruction,
+                                      const std::vector<StationView>& views,
+                                      size_t view_index,
+                                      const cv::Mat& depth,
+                                      const DenseWorkspace& workspace,
+                                      const DensifierOptions& options) {
+  std::vector<OtherView> others;
+  for (size_t k :
+       OverlappingViews(reconstruction, views, view_index, depth, options.max_neighbor_views)) {
+    const colmap::Image& other = reconstruction.Image(views[k].image_id);
+    others.push_back({workspace.ReadDepthMap(views[k].image_name),
+                      IntrinsicsOf(reconstruction.Camera(other.CameraId())),
+                      other.CamFromWorld()});
+  }
+  return others;
+}
+
+// How many of `others` see `point_in_world` at their own depth (within the consistency tolerance).
+int AgreeingViews(const std::vector<OtherView>& others,
+                  const Eigen::Vector3d& point_in_world,
+                  const DensifierOptions& options) {
+  int agreeing = 0;
+  for (const OtherView& other : others) {
+    const Eigen::Vector3d point_in_other = other.cam_from_world * point_in_world;
+    Eigen::Vector2d xy;
+    if (!other.intrinsics.Project(point_in_other, &xy) || !other.intrinsics.Contains(xy)) {
+      continue;
+    }
+    const float other_z = other.depth.at<float>(static_cast<int>(xy.y()), static_cast<int>(xy.x()));
+    agreeing +=
+        other_z > 0 && std::abs(other_z - point_in_other.z()) <=
+                           options.consistency_abs_m + options.consistency_rel * point_in_other.z();
+  }
+  return agreeing;
+}
+
 // Back-projects one station's refined map (with colour and normals) into the fused grid.
-void FuseStation(const colmap::Reconstruction& reconstruction,
+void FuseStation(const DensifyContext& context,
                  const std::vector<StationView>& views,
                  size_t view_index,
-                 const DenseWorkspace& workspace,
-                 const DensifierOptions& options,
                  StationDensification* result,
                  VoxelAccumulator* fused) {
+  const colmap::Reconstruction& reconstruction = context.reconstruction;
+  const DenseWorkspace& workspace = context.workspace;
+  const DensifierOptions& options = context.options;
   const StationView& view = views[view_index];
   const colmap::Image& image = reconstruction.Image(view.image_id);
   const PinholeIntrinsics intrinsics = IntrinsicsOf(reconstruction.Camera(image.CameraId()));
@@ -278,21 +373,10 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
   if (bgr.empty() || bgr.cols != depth.cols || bgr.rows != depth.rows) {
     throw std::runtime_error("densifier: cannot read " + image_path + " at the depth map's size");
   }
-  struct Other {
-    cv::Mat depth;
-    PinholeIntrinsics intrinsics;
-    colmap::Rigid3d cam_from_world;
-  };
-  std::vector<Other> others;
-  if (options.min_consistent_views > 0) {
-    for (size_t k :
-         OverlappingViews(reconstruction, views, view_index, depth, options.max_neighbor_views)) {
-      const colmap::Image& other = reconstruction.Image(views[k].image_id);
-      others.push_back({workspace.ReadDepthMap(views[k].image_name),
-                        IntrinsicsOf(reconstruction.Camera(other.CameraId())),
-                        other.CamFromWorld()});
-    }
-  }
+  const std::vector<OtherView> others =
+      options.min_consistent_views > 0
+          ? OtherDepthMaps(reconstruction, views, view_index, depth, workspace, options)
+          : std::vector<OtherView>();
   const colmap::Rigid3d world_from_cam = colmap::Inverse(image.CamFromWorld());
   const Eigen::Matrix3d world_from_cam_rotation = world_from_cam.rotation.toRotationMatrix();
 
@@ -310,24 +394,10 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
       if (!(z > 0)) continue;
       const Eigen::Vector3d ray = intrinsics.PixelRay(col, row);
       const Eigen::Vector3d point_in_world = world_from_cam * (ray * double(z));
-      if (options.min_consistent_views > 0) {
-        int agreeing = 0;
-        for (const Other& other : others) {
-          const Eigen::Vector3d point_in_other = other.cam_from_world * point_in_world;
-          Eigen::Vector2d xy;
-          if (!other.intrinsics.Project(point_in_other, &xy) || !other.intrinsics.Contains(xy)) {
-            continue;
-          }
-          const float other_z =
-              other.depth.at<float>(static_cast<int>(xy.y()), static_cast<int>(xy.x()));
-          agreeing += other_z > 0 &&
-                      std::abs(other_z - point_in_other.z()) <=
-                          options.consistency_abs_m + options.consistency_rel * point_in_other.z();
-        }
-        if (agreeing < options.min_consistent_views) {
-          ++inconsistent;
-          continue;
-        }
+      if (options.min_consistent_views > 0 &&
+          AgreeingViews(others, point_in_world, options) < options.min_consistent_views) {
+        ++inconsistent;
+        continue;
       }
       const cv::Vec3f& n = normals.at<cv::Vec3f>(row, col);
       Eigen::Vector3d normal_in_cam(n[0], n[1], n[2]);
@@ -345,6 +415,32 @@ void FuseStation(const colmap::Reconstruction& reconstruction,
     }
   }
   result->inconsistent = inconsistent;
+}
+
+// Every station's refined map back-projected into one voxel grid: the fused cloud.
+PointCloud FuseStations(const DensifyContext& context,
+                        const std::vector<StationView>& views,
+                        DensifierSummary* summary) {
+  VoxelAccumulator fused(context.options.fused_voxel_size_m);
+  for (size_t k = 0; k < views.size(); ++k) {
+    const auto station_start = std::chrono::steady_clock::now();
+    FuseStation(context, views, k, &summary->stations[k], &fused);
+    summary->stations[k].seconds += SecondsSince(station_start);
+  }
+  const size_t num_fused_points = fused.NumPointsAdded();
+  PointCloud fused_cloud = fused.ExtractAndClear();
+  summary->fused_points = fused_cloud.Size();
+  std::cout << "densifier: fused " << num_fused_points << " points into " << fused_cloud.Size()
+            << " voxels of " << context.options.fused_voxel_size_m * 1000 << " mm" << std::endl;
+  return fused_cloud;
+}
+
+// The workspace's sparse model and the configuration files of COLMAP's dense steps.
+void WriteWorkspaceModel(const DensifyContext& context, const std::vector<StationView>& views) {
+  context.workspace.WriteSparse(context.reconstruction);
+  std::vector<std::string> names;
+  for (const StationView& view : views) names.push_back(view.image_name);
+  context.workspace.WriteConfigs(names);
 }
 
 nlohmann::json StationReport(const StationDensification& station) {
@@ -503,19 +599,16 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
   std::mutex mutex;
   size_t num_done = 0;
   StationOrderedMap ordered_lidar_map(&lidar_map);
+  const DensifyContext context{
+      reconstruction, cam_from_lidar, dataset, depth_path, workspace, options};
   ParallelForEach(static_cast<int>(views.size()), [&](int k) {
     const auto station_start = std::chrono::steady_clock::now();
     const colmap::camera_t camera_id = input_model.Image(views[k].image_id).CameraId();
     const auto undistorter = undistorters.find(camera_id);
     std::vector<Eigen::Vector3d> points_in_world;
     StationDensification station =
-        RefineStation(reconstruction,
+        RefineStation(context,
                       views[k],
-                      cam_from_lidar,
-                      dataset,
-                      depth_path,
-                      workspace,
-                      options,
                       input_model.Camera(camera_id),
                       undistorter == undistorters.end() ? nullptr : undistorter->second.get(),
                       &points_in_world);
@@ -532,23 +625,9 @@ DensifierSummary Densify(const colmap::Reconstruction& input_model,
   WritePointCloud(partial.File("lidar_map.ply"), lidar_cloud);
   lidar_cloud = PointCloud();
 
-  VoxelAccumulator fused(options.fused_voxel_size_m);
-  for (size_t k = 0; k < views.size(); ++k) {
-    const auto station_start = std::chrono::steady_clock::now();
-    FuseStation(reconstruction, views, k, workspace, options, &summary.stations[k], &fused);
-    summary.stations[k].seconds += SecondsSince(station_start);
-  }
-  const size_t num_fused_points = fused.NumPointsAdded();
-  const PointCloud fused_cloud = fused.ExtractAndClear();
-  summary.fused_points = fused_cloud.Size();
-  std::cout << "densifier: fused " << num_fused_points << " points into " << fused_cloud.Size()
-            << " voxels of " << options.fused_voxel_size_m * 1000 << " mm" << std::endl;
-  WritePointCloud(partial.File("fused.ply"), fused_cloud);
+  WritePointCloud(partial.File("fused.ply"), FuseStations(context, views, &summary));
 
-  workspace.WriteSparse(reconstruction);
-  std::vector<std::string> names;
-  for (const StationView& view : views) names.push_back(view.image_name);
-  workspace.WriteConfigs(names);
+  WriteWorkspaceModel(context, views);
   summary.seconds = SecondsSince(start);
   WriteFileAtomically(partial.File("densifier.json"),
                       DensifierReport(options, summary, !depth_path.empty()).dump(2) + "\n");

@@ -151,13 +151,14 @@ colmap::Rigid3d GridStep(const std::vector<EdgeStation>& stations,
 
 }  // namespace
 
-void RunCalibrateEdgesStep(const std::string& dataset_path,
-                           const std::string& input_path,
-                           const std::string& cam_from_lidar_path,
-                           const std::string& output_path,
+void RunCalibrateEdgesStep(const EdgeCalibrationPaths& paths,
                            const EdgeCalibrationOptions& options,
-                           const std::string& registration_path,
                            const std::optional<EdgeAxisProfileRequest>& profile) {
+  const std::string& dataset_path = paths.dataset_path;
+  const std::string& input_path = paths.input_path;
+  const std::string& cam_from_lidar_path = paths.cam_from_lidar_path;
+  const std::string& output_path = paths.output_path;
+  const std::string& registration_path = paths.registration_path;
   THROW_CHECK(options.Check());
   if (profile) THROW_CHECK(profile->options.Check());
   const StationDataset dataset =
@@ -234,13 +235,10 @@ int RunCalibrateEdges(int argc, char** argv) {
   options.translation_steps_m = colmap::CSVToVector<double>(translation_steps);
   THROW_CHECK_GE(max_points, 0);
   lidar.max_points = static_cast<size_t>(max_points);
-  RunCalibrateEdgesStep(dataset_path,
-                        input_path,
-                        cam_from_lidar_path,
-                        output_path,
-                        options,
-                        registration_path,
-                        profile);
+  RunCalibrateEdgesStep(
+      {dataset_path, input_path, cam_from_lidar_path, output_path, registration_path},
+      options,
+      profile);
   return EXIT_SUCCESS;
 }
 

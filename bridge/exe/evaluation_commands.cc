@@ -89,29 +89,10 @@ void PrintModelEvaluation(const ModelEvaluation& result) {
   }
 }
 
-}  // namespace
-
-void RunEvaluateModelStep(const std::string& model_path,
-                          const std::string& ground_truth_path,
-                          const std::string& truth_from_model_path,
-                          const std::string& output_path,
-                          const ModelEvaluationOptions& options) {
-  // Inputs first: a missing or bad cloud must not leave an output folder behind.
-  PointCloud model = ReadPointCloud(model_path);
-  if (!truth_from_model_path.empty()) {
-    const colmap::Rigid3d truth_from_model = ReadPoseFile(truth_from_model_path);
-    for (Eigen::Vector3d& point : model.points) point = truth_from_model * point;
-    for (Eigen::Vector3d& normal : model.normals) {
-      normal = truth_from_model.rotation * normal;
-    }
-  }
-  const PointCloud truth = ReadPointCloud(ground_truth_path);
-  THROW_CHECK(truth.HasNormals()) << ground_truth_path << " has no normals";
-  std::cout << "evaluate_model: " << model.Size() << " model points against " << truth.Size()
-            << " surface samples" << std::endl;
-  const ModelEvaluation result = EvaluateModel(model, truth, options);
-
-  fs::create_directories(output_path);
+// evaluate_model's metrics.json.
+nlohmann::json ModelMetricsJson(const std::string& model_path,
+                                const ModelEvaluation& result,
+                                const ModelEvaluationOptions& options) {
   nlohmann::json metrics;
   metrics["model_path"] = model_path;
   metrics["num_model_points"] = result.num_model_points;
@@ -139,7 +120,90 @@ void RunEvaluateModelStep(const std::string& model_path,
     metrics["f_score_" + label] = at.f_score;
   }
   metrics["density_points_per_cm2"] = result.density_points_per_cm2;
-  WriteFileAtomically((fs::path(output_path) / "metrics.json").string(), metrics.dump(2) + "\n");
+  return metrics;
+}
+
+// The evaluated points, aligned, coloured by error (blue 0 -> red at the 95th percentile).
+PointCloud ErrorColoredCloud(const PointCloud& model, const ModelEvaluation& result) {
+  PointCloud coloured;
+  coloured.Reserve(result.num_evaluated, false, true, false);
+  for (size_t k = 0; k < result.num_evaluated; ++k) {
+    coloured.points.push_back(result.truth_from_model * model.points[result.evaluated_indices[k]]);
+    coloured.colors.push_back(ErrorColor(result.distances[k], result.p95));
+  }
+  return coloured;
+}
+
+// evaluate_calibration's metrics.json.
+nlohmann::json CalibrationMetricsJson(const CalibrationEvaluation& result) {
+  nlohmann::json metrics;
+  metrics["cam_from_lidar_rotation_error_deg"] = result.cam_from_lidar_rotation_error_deg;
+  metrics["cam_from_lidar_translation_error_mm"] = result.cam_from_lidar_translation_error_mm;
+  for (int k = 0; k < 3; ++k) {
+    metrics[std::string("cam_from_lidar_translation_error_") + "xyz"[k] + "_mm"] =
+        result.cam_from_lidar_translation_error_in_cam_mm[k];
+  }
+  if (result.alignment == "none") return metrics;
+  metrics["pose_alignment"] = result.alignment;
+  metrics["pose_alignment_scale"] = result.alignment_scale;
+  metrics["num_stations_evaluated"] = result.num_stations_evaluated;
+  metrics["missing_stations"] = result.missing_stations;
+  metrics["pose_rotation_error_mean_deg"] = result.mean_rotation_error_deg;
+  metrics["pose_rotation_error_max_deg"] = result.max_rotation_error_deg;
+  metrics["pose_position_error_mean_mm"] = result.mean_position_error_mm;
+  metrics["pose_position_error_max_mm"] = result.max_position_error_mm;
+  for (const auto& [name, error] : result.position_error_mm) {
+    metrics["station_" + name + "_position_error_mm"] = error;
+    metrics["station_" + name + "_rotation_error_deg"] = result.rotation_error_deg.at(name);
+  }
+  return metrics;
+}
+
+// evaluate_calibration's console summary.
+void PrintCalibrationEvaluation(const CalibrationEvaluation& result) {
+  std::cout << std::fixed << std::setprecision(4) << "evaluate_calibration: cam_from_lidar error "
+            << result.cam_from_lidar_rotation_error_deg << " deg, " << std::setprecision(2)
+            << result.cam_from_lidar_translation_error_mm << " mm";
+  if (result.alignment == "none") {
+    std::cout << " (against the dataset's reference; no true station poses)" << std::endl;
+  } else {
+    std::cout << "; station poses (" << result.alignment << " alignment, "
+              << result.num_stations_evaluated << " stations): mean "
+              << result.mean_position_error_mm << " mm / " << std::setprecision(4)
+              << result.mean_rotation_error_deg << " deg, max " << std::setprecision(2)
+              << result.max_position_error_mm << " mm" << std::endl;
+  }
+  if (!result.missing_stations.empty()) {
+    std::cout << "evaluate_calibration: " << result.missing_stations.size()
+              << " stations of the truth are not in the model" << std::endl;
+  }
+}
+
+}  // namespace
+
+void RunEvaluateModelStep(const std::string& model_path,
+                          const std::string& ground_truth_path,
+                          const std::string& truth_from_model_path,
+                          const std::string& output_path,
+                          const ModelEvaluationOptions& options) {
+  // Inputs first: a missing or bad cloud must not leave an output folder behind.
+  PointCloud model = ReadPointCloud(model_path);
+  if (!truth_from_model_path.empty()) {
+    const colmap::Rigid3d truth_from_model = ReadPoseFile(truth_from_model_path);
+    for (Eigen::Vector3d& point : model.points) point = truth_from_model * point;
+    for (Eigen::Vector3d& normal : model.normals) {
+      normal = truth_from_model.rotation * normal;
+    }
+  }
+  const PointCloud truth = ReadPointCloud(ground_truth_path);
+  THROW_CHECK(truth.HasNormals()) << ground_truth_path << " has no normals";
+  std::cout << "evaluate_model: " << model.Size() << " model points against " << truth.Size()
+            << " surface samples" << std::endl;
+  const ModelEvaluation result = EvaluateModel(model, truth, options);
+
+  fs::create_directories(output_path);
+  WriteFileAtomically((fs::path(output_path) / "metrics.json").string(),
+                      ModelMetricsJson(model_path, result, options).dump(2) + "\n");
 
   HistogramPlotOptions plot;
   plot.title = "Distance to the true surface";
@@ -148,16 +212,10 @@ void RunEvaluateModelStep(const std::string& model_path,
   WriteHistogramPng(
       (fs::path(output_path) / "error_histogram.png").string(), result.distances, plot);
 
-  // The evaluated points, aligned, coloured by error (blue 0 -> red at the 95th percentile).
-  PointCloud coloured;
-  coloured.Reserve(result.num_evaluated, false, true, false);
-  for (size_t k = 0; k < result.num_evaluated; ++k) {
-    coloured.points.push_back(result.truth_from_model * model.points[result.evaluated_indices[k]]);
-    coloured.colors.push_back(ErrorColor(result.distances[k], result.p95));
-  }
-  WritePointCloud((fs::path(output_path) / "error_colored.ply").string(), coloured);
+  WritePointCloud((fs::path(output_path) / "error_colored.ply").string(),
+                  ErrorColoredCloud(model, result));
 
-  if (measured) {
+  if (result.num_evaluated > 0) {
     PrintModelEvaluation(result);
   } else {
     std::cout << "evaluate_model: no model point lies within " << options.crop_distance_m
@@ -214,43 +272,8 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
                                                            reconstruction,
                                                            alignment == "similarity");
 
-  nlohmann::json metrics;
-  metrics["cam_from_lidar_rotation_error_deg"] = result.cam_from_lidar_rotation_error_deg;
-  metrics["cam_from_lidar_translation_error_mm"] = result.cam_from_lidar_translation_error_mm;
-  for (int k = 0; k < 3; ++k) {
-    metrics[std::string("cam_from_lidar_translation_error_") + "xyz"[k] + "_mm"] =
-        result.cam_from_lidar_translation_error_in_cam_mm[k];
-  }
-  if (result.alignment != "none") {
-    metrics["pose_alignment"] = result.alignment;
-    metrics["pose_alignment_scale"] = result.alignment_scale;
-    metrics["num_stations_evaluated"] = result.num_stations_evaluated;
-    metrics["missing_stations"] = result.missing_stations;
-    metrics["pose_rotation_error_mean_deg"] = result.mean_rotation_error_deg;
-    metrics["pose_rotation_error_max_deg"] = result.max_rotation_error_deg;
-    metrics["pose_position_error_mean_mm"] = result.mean_position_error_mm;
-    metrics["pose_position_error_max_mm"] = result.max_position_error_mm;
-    for (const auto& [name, error] : result.position_error_mm) {
-      metrics["station_" + name + "_position_error_mm"] = error;
-      metrics["station_" + name + "_rotation_error_deg"] = result.rotation_error_deg.at(name);
-    }
-  }
-  std::cout << std::fixed << std::setprecision(4) << "evaluate_calibration: cam_from_lidar error "
-            << result.cam_from_lidar_rotation_error_deg << " deg, " << std::setprecision(2)
-            << result.cam_from_lidar_translation_error_mm << " mm";
-  if (result.alignment == "none") {
-    std::cout << " (against the dataset's reference; no true station poses)" << std::endl;
-  } else {
-    std::cout << "; station poses (" << result.alignment << " alignment, "
-              << result.num_stations_evaluated << " stations): mean "
-              << result.mean_position_error_mm << " mm / " << std::setprecision(4)
-              << result.mean_rotation_error_deg << " deg, max " << std::setprecision(2)
-              << result.max_position_error_mm << " mm" << std::endl;
-  }
-  if (!result.missing_stations.empty()) {
-    std::cout << "evaluate_calibration: " << result.missing_stations.size()
-              << " stations of the truth are not in the model" << std::endl;
-  }
+  const nlohmann::json metrics = CalibrationMetricsJson(result);
+  PrintCalibrationEvaluation(result);
   if (!output_path.empty()) {
     fs::create_directories(output_path);
     WriteFileAtomically((fs::path(output_path) / "metrics.json").string(), metrics.dump(2) + "\n");

@@ -266,14 +266,24 @@ std::string ObservabilityVerdict(const JointAdjusterOptions& options,
          ", though the motion alone is degenerate: " + summary.motion.verdict;
 }
 
+// What one joint adjustment ended with, for its report.
+struct JointOutcome {
+  const colmap::Rigid3d& initial;  // cam_from_lidar at the start
+  const colmap::Rigid3d& refined;
+  const JointAdjustmentSummary& summary;
+  const std::string& caveat;  // UncertaintyCaveat
+  const std::optional<VerticalAlignment>& vertical;
+};
+
 void WriteReport(const std::string& directory,
                  const JointAdjusterOptions& options,
                  const LoadedJointData& loaded,
-                 const colmap::Rigid3d& initial,
-                 const colmap::Rigid3d& refined,
-                 const JointAdjustmentSummary& summary,
-                 const std::string& caveat,
-                 const std::optional<VerticalAlignment>& vertical) {
+                 const JointOutcome& outcome) {
+  const colmap::Rigid3d& initial = outcome.initial;
+  const colmap::Rigid3d& refined = outcome.refined;
+  const JointAdjustmentSummary& summary = outcome.summary;
+  const std::string& caveat = outcome.caveat;
+  const std::optional<VerticalAlignment>& vertical = outcome.vertical;
   nlohmann::json report;
   if (vertical) report["vertical_alignment"] = VerticalAlignmentJson(*vertical);
   report["mode"] = JointModeName(options.mode);
@@ -326,7 +336,13 @@ void WriteReport(const std::string& directory,
   WriteFileAtomically(directory + "/report.json", report.dump(2) + "\n");
 }
 
-void WritePlots(const std::string& directory, const JointAdjustmentSummary& summary) {
+void WritePlots(const std::string& directory,
+                const JointAdjustmentSummary& summary,
+                const std::optional<VerticalAlignment>& vertical) {
+  if (vertical && vertical->valid) {
+    WriteVerticalAlignmentPlot((fs::path(directory) / "vertical_alignment.png").string(),
+                               *vertical);
+  }
   PlotSeries total{"total cost", {}, {}};
   for (size_t k = 0; k < summary.solves.size(); ++k) {
     const SolveStats& s = summary.solves[k];
@@ -698,6 +714,29 @@ void PrintWarnings(const StartDeparture& departure, const AssociationSettling& s
   }
 }
 
+// The input sparse model; at least two registered images.
+colmap::Reconstruction ReadInputModel(const std::string& input_path) {
+  THROW_CHECK(fs::is_directory(input_path)) << "no sparse model folder " << input_path;
+  colmap::Reconstruction reconstruction;
+  reconstruction.Read(input_path);
+  THROW_CHECK_GE(reconstruction.NumRegImages(), 2)
+      << input_path << " has fewer than 2 registered images";
+  return reconstruction;
+}
+
+// The clock offset between images and sweeps is estimated on a moving platform only (and when
+// asked); it needs each image's time.
+void DecideTimeOffset(const StationDataset& dataset,
+                      const InitialisationFacts& facts,
+                      LoadedJointData* loaded,
+                      JointAdjusterStepOptions* options) {
+  options->adjuster.estimate_time_offset =
+      options->estimate_time_offset && IsMovingPlatform(dataset, facts);
+  if (options->adjuster.estimate_time_offset) {
+    loaded->data.image_times = ImageTimes(dataset, *loaded);
+  }
+}
+
 }  // namespace
 
 void RunJointAdjusterStep(const StationDataset& dataset,
@@ -709,11 +748,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                                 "/rig.json has one camera");
   }
   const auto start = std::chrono::steady_clock::now();
-  THROW_CHECK(fs::is_directory(paths.input_path)) << "no sparse model folder " << paths.input_path;
-  colmap::Reconstruction reconstruction;
-  reconstruction.Read(paths.input_path);
-  THROW_CHECK_GE(reconstruction.NumRegImages(), 2)
-      << paths.input_path << " has fewer than 2 registered images";
+  colmap::Reconstruction reconstruction = ReadInputModel(paths.input_path);
   const InitialisationFacts facts = ReadInitialisationFacts(paths.input_path);
   const bool vertical_alignment =
       DecideFromMotion(dataset, facts, reconstruction, &options.adjuster);
@@ -731,11 +766,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                            options.data);
   std::cout << "Loaded depth priors, clouds and the pose graph (" << SecondsSince(start) << " s)"
             << std::endl;
-  options.adjuster.estimate_time_offset =
-      options.estimate_time_offset && IsMovingPlatform(dataset, facts);
-  if (options.adjuster.estimate_time_offset) {
-    loaded->data.image_times = ImageTimes(dataset, *loaded);
-  }
+  DecideTimeOffset(dataset, facts, loaded.get(), &options);
   const std::optional<VerticalAlignment> vertical = AddExtrinsicMeasurements(
       dataset, vertical_alignment, reconstruction, options, loaded.get(), &cam_from_lidar);
   const JointAdjustmentSummary summary =
@@ -755,15 +786,8 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   WriteReport(partial.Path(),
               options.adjuster,
               *loaded,
-              initial,
-              cam_from_lidar,
-              summary,
-              caveat,
-              vertical);
-  WritePlots(partial.Path(), summary);
-  if (vertical && vertical->valid) {
-    WriteVerticalAlignmentPlot(partial.File("vertical_alignment.png"), *vertical);
-  }
+              {initial, cam_from_lidar, summary, caveat, vertical});
+  WritePlots(partial.Path(), summary, vertical);
   partial.Commit();
   PrintUncertainty(summary, caveat);
   PrintWarnings(CheckStartDeparture(initial, cam_from_lidar, loaded->data, summary),

@@ -118,49 +118,8 @@ void WriteInitializationReport(const std::string& path,
   WriteFileAtomically(path, report.dump(2) + "\n");
 }
 
-}  // namespace
-
-void RunPoseInitializerStep(const StationDataset& dataset,
-                            const PoseInitializerPaths& paths,
-                            const PoseInitializerOptions& options) {
-  THROW_CHECK(options.Check());
-  const auto start = std::chrono::steady_clock::now();
-  PartialOutputFolder partial(paths.output_path);
-  PoseInitialization init;
-  std::vector<double> scales{1.0};
-  if (paths.input_path.empty() && !dataset.rig.IsStereo()) {
-    std::cout << "Monocular dataset: stations placed through their LiDAR poses" << std::endl;
-    init = InitializeMonocular(paths.database_path, dataset, paths.registration_path, options);
-    scales = {init.hand_eye.scale};
-    TriangulateInitialModel(
-        paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
-  } else if (paths.input_path.empty()) {
-    init = InitializePoses(
-        paths.database_path, dataset, paths.registration_path, options, paths.depth_path);
-    std::cout << "Pose graph: " << init.num_image_edges << " image edges (A_c), "
-              << init.num_lidar_edges << " LiDAR edges (A_l); " << init.cam_from_world.size()
-              << " stations reachable" << std::endl;
-    TriangulateInitialModel(
-        paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
-  } else {
-    std::vector<colmap::Reconstruction> models = ReadModels(paths.input_path);
-    init = InitializeFromModels(paths.database_path,
-                                dataset,
-                                paths.registration_path,
-                                options,
-                                &models,
-                                &scales,
-                                paths.depth_path);
-    for (size_t k = 0; k < models.size(); ++k) {
-      std::cout << "Model " << k << " (" << models[k].NumRegImages()
-                << " registered images) rescaled to metres by " << scales[k] << std::endl;
-    }
-    std::cout << "Completed through the LiDAR: " << init.cam_from_world.size() << " stations from "
-              << init.num_image_edges << " model edges and " << init.num_lidar_edges
-              << " LiDAR edges (A_l)" << std::endl;
-    TriangulateInitialModel(
-        paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
-  }
+// The start's source, and a WARNING per loop that does not close and per station left out.
+void PrintInitialization(const PoseInitialization& init) {
   std::cout << "cam_from_lidar: " << init.extrinsic_source
             << "; hand-eye: " << init.hand_eye.message << std::endl;
   for (const std::string& edge : init.disagreeing_edges) {
@@ -175,6 +134,49 @@ void RunPoseInitializerStep(const StationDataset& dataset,
                                                           : reason->second)
               << ")" << std::endl;
   }
+}
+
+}  // namespace
+
+void RunPoseInitializerStep(const StationDataset& dataset,
+                            const PoseInitializerPaths& paths,
+                            const PoseInitializerOptions& options) {
+  THROW_CHECK(options.Check());
+  const auto start = std::chrono::steady_clock::now();
+  PartialOutputFolder partial(paths.output_path);
+  PoseInitialization init;
+  std::vector<double> scales{1.0};
+  if (paths.input_path.empty() && !dataset.rig.IsStereo()) {
+    std::cout << "Monocular dataset: stations placed through their LiDAR poses" << std::endl;
+    init = InitializeMonocular(paths.database_path, dataset, paths.registration_path, options);
+    scales = {init.hand_eye.scale};
+  } else if (paths.input_path.empty()) {
+    init = InitializePoses(
+        paths.database_path, dataset, paths.registration_path, options, paths.depth_path);
+    std::cout << "Pose graph: " << init.num_image_edges << " image edges (A_c), "
+              << init.num_lidar_edges << " LiDAR edges (A_l); " << init.cam_from_world.size()
+              << " stations reachable" << std::endl;
+  } else {
+    ExistingModels existing{ReadModels(paths.input_path), {}};
+    init = InitializeFromModels(paths.database_path,
+                                dataset,
+                                paths.registration_path,
+                                options,
+                                &existing,
+                                paths.depth_path);
+    const std::vector<colmap::Reconstruction>& models = existing.models;
+    scales = existing.scales;
+    for (size_t k = 0; k < models.size(); ++k) {
+      std::cout << "Model " << k << " (" << models[k].NumRegImages()
+                << " registered images) rescaled to metres by " << scales[k] << std::endl;
+    }
+    std::cout << "Completed through the LiDAR: " << init.cam_from_world.size() << " stations from "
+              << init.num_image_edges << " model edges and " << init.num_lidar_edges
+              << " LiDAR edges (A_l)" << std::endl;
+  }
+  TriangulateInitialModel(
+      paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
+  PrintInitialization(init);
   WritePoseFile(partial.File("cam_from_lidar.txt"),
                 "initial cam_from_lidar (" + init.extrinsic_source + "); qw qx qy qz tx ty tz",
                 init.cam_from_lidar);

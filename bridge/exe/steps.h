@@ -229,16 +229,22 @@ struct EdgeAxisProfileRequest {
   EdgeAxisProfileOptions options;
 };
 
-// calibrate_edges: cam_from_lidar by Levinson & Thrun's edge alignment from a start (the file, or
-// rig.json's guess), over all stations or those registered in `input_path`.
-// `registration_path`: lidar_registrator's output, whose static (de-skewed) clouds replace the
-// dataset's; empty: the dataset's clouds. `profile`: the start turned about one axis only.
-void RunCalibrateEdgesStep(const std::string& dataset_path,
-                           const std::string& input_path,
-                           const std::string& cam_from_lidar_path,
-                           const std::string& output_path,
+struct EdgeCalibrationPaths {
+  std::string dataset_path;
+  // A sparse model: only its registered stations; empty: all stations.
+  std::string input_path;
+  // The start (qw qx qy qz tx ty tz); empty: rig.json's guess.
+  std::string cam_from_lidar_path;
+  std::string output_path;
+  // lidar_registrator's output, whose static (de-skewed) clouds replace the dataset's; empty: the
+  // dataset's clouds.
+  std::string registration_path;
+};
+
+// calibrate_edges: cam_from_lidar by Levinson & Thrun's edge alignment from a start, over the
+// stations. `profile`: the start turned about one axis only.
+void RunCalibrateEdgesStep(const EdgeCalibrationPaths& paths,
                            const EdgeCalibrationOptions& options,
-                           const std::string& registration_path = "",
                            const std::optional<EdgeAxisProfileRequest>& profile = std::nullopt);
 
 // evaluate_calibration: cam_from_lidar and station poses against ground_truth/. `output_path` empty:

@@ -22,24 +22,28 @@ struct MatchedPoints {
   std::vector<Eigen::Vector3d> in_i, in_j;
 };
 
+// One image's keypoints, depth priors and camera.
+struct ImageWithDepth {
+  const colmap::FeatureKeypoints& keypoints;
+  const std::unordered_map<colmap::point2D_t, DepthPrior>& priors;
+  const colmap::Camera& camera;
+};
+
+// The inlier matches of the pair with a depth prior in both images, as 3D points in each camera.
 MatchedPoints PointsWithDepth(const colmap::TwoViewGeometry& geometry,
-                              const colmap::FeatureKeypoints& keypoints_i,
-                              const colmap::FeatureKeypoints& keypoints_j,
-                              const std::unordered_map<colmap::point2D_t, DepthPrior>& priors_i,
-                              const std::unordered_map<colmap::point2D_t, DepthPrior>& priors_j,
-                              const colmap::Camera& camera_i,
-                              const colmap::Camera& camera_j) {
+                              const ImageWithDepth& image_i,
+                              const ImageWithDepth& image_j) {
   MatchedPoints points;
   for (const colmap::FeatureMatch& match : geometry.inlier_matches) {
-    const auto prior_i = priors_i.find(match.point2D_idx1);
-    const auto prior_j = priors_j.find(match.point2D_idx2);
-    if (prior_i == priors_i.end() || prior_j == priors_j.end()) continue;
-    const colmap::FeatureKeypoint& ki = keypoints_i.at(match.point2D_idx1);
-    const colmap::FeatureKeypoint& kj = keypoints_j.at(match.point2D_idx2);
+    const auto prior_i = image_i.priors.find(match.point2D_idx1);
+    const auto prior_j = image_j.priors.find(match.point2D_idx2);
+    if (prior_i == image_i.priors.end() || prior_j == image_j.priors.end()) continue;
+    const colmap::FeatureKeypoint& ki = image_i.keypoints.at(match.point2D_idx1);
+    const colmap::FeatureKeypoint& kj = image_j.keypoints.at(match.point2D_idx2);
     points.in_i.push_back(prior_i->second.depth *
-                          camera_i.CamFromImg(Eigen::Vector2d(ki.x, ki.y)).homogeneous());
+                          image_i.camera.CamFromImg(Eigen::Vector2d(ki.x, ki.y)).homogeneous());
     points.in_j.push_back(prior_j->second.depth *
-                          camera_j.CamFromImg(Eigen::Vector2d(kj.x, kj.y)).homogeneous());
+                          image_j.camera.CamFromImg(Eigen::Vector2d(kj.x, kj.y)).homogeneous());
   }
   return points;
 }
@@ -132,13 +136,10 @@ std::vector<ImagePairPose> EstimateImagePairPoses(const colmap::Database& databa
     const auto priors_i = depth_priors.find(image_i);
     const auto priors_j = depth_priors.find(image_j);
     if (priors_i == depth_priors.end() || priors_j == depth_priors.end()) continue;
-    const MatchedPoints points = PointsWithDepth(geometries[p],
-                                                 keypoints_of(image_i),
-                                                 keypoints_of(image_j),
-                                                 priors_i->second,
-                                                 priors_j->second,
-                                                 cameras.at(images.at(image_i).CameraId()),
-                                                 cameras.at(images.at(image_j).CameraId()));
+    const MatchedPoints points = PointsWithDepth(
+        geometries[p],
+        {keypoints_of(image_i), priors_i->second, cameras.at(images.at(image_i).CameraId())},
+        {keypoints_of(image_j), priors_j->second, cameras.at(images.at(image_j).CameraId())});
     ImagePairPose pose;
     pose.image_i = image_i;
     pose.image_j = image_j;

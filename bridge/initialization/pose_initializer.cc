@@ -273,6 +273,34 @@ std::vector<HandEyeMotion> PairedMotions(const ImageEdges& image_edge,
   return motions;
 }
 
+// A_c: the image pairs' relative poses (with the depth priors' scale), added to init->edges.
+ImageEdges AddImageEdges(const std::string& database_path,
+                         const StationImages& images,
+                         const PoseInitializerOptions& options,
+                         PoseInitialization* init) {
+  const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
+  const colmap::Database database(database_path);
+  DepthPriorsByImage priors;
+  for (const auto& [image_id, name] : images.names) {
+    for (const DepthPrior& prior : extension.ReadDepthPriors(image_id)) {
+      priors[image_id][prior.point2D_idx] = prior;
+    }
+  }
+  const std::vector<ImagePairPose> image_pairs =
+      EstimateImagePairPoses(database, priors, options.image_pairs);
+  ImageEdges image_edge;
+  for (const ImagePairPose& pair : image_pairs) {
+    init->edges.push_back({pair.image_i,
+                           pair.image_j,
+                           pair.cam_i_from_cam_j,
+                           static_cast<double>(pair.num_inliers),
+                           false});
+    image_edge[{pair.image_i, pair.image_j}] = pair.cam_i_from_cam_j;
+  }
+  init->num_image_edges = static_cast<int>(image_pairs.size());
+  return image_edge;
+}
+
 }  // namespace
 
 PoseInitialization InitializePoses(const std::string& database_path,
@@ -286,28 +314,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
   PoseInitialization init;
   const StationImages images = ReadStationImages(database_path, dataset);
   const std::map<std::string, colmap::image_t>& image_of_station = images.image_of_station;
-  const ExtensionDatabase extension(database_path, ExtensionDatabase::Mode::kReadOnly);
-  const colmap::Database database(database_path);
-  DepthPriorsByImage priors;
-  for (const auto& [image_id, name] : images.names) {
-    for (const DepthPrior& prior : extension.ReadDepthPriors(image_id)) {
-      priors[image_id][prior.point2D_idx] = prior;
-    }
-  }
-
-  // A_c.
-  const std::vector<ImagePairPose> image_pairs =
-      EstimateImagePairPoses(database, priors, options.image_pairs);
-  ImageEdges image_edge;
-  for (const ImagePairPose& pair : image_pairs) {
-    init.edges.push_back({pair.image_i,
-                          pair.image_j,
-                          pair.cam_i_from_cam_j,
-                          static_cast<double>(pair.num_inliers),
-                          false});
-    image_edge[{pair.image_i, pair.image_j}] = pair.cam_i_from_cam_j;
-  }
-  init.num_image_edges = static_cast<int>(image_pairs.size());
+  const ImageEdges image_edge = AddImageEdges(database_path, images, options, &init);
 
   // A_l, without the edges the images contradict.
   const std::vector<LidarStationEdge> lidar_edges =
@@ -466,9 +473,10 @@ void ChooseModelScalesAndExtrinsic(const std::string& database_path,
                                    const StationDataset& dataset,
                                    const std::vector<LidarPairRecord>& lidar_pairs,
                                    const PoseInitializerOptions& options,
-                                   std::vector<colmap::Reconstruction>* models,
-                                   std::vector<double>* scales,
+                                   ExistingModels* existing,
                                    PoseInitialization* init) {
+  std::vector<colmap::Reconstruction>* models = &existing->models;
+  std::vector<double>* scales = &existing->scales;
   scales->clear();
   // An existing model of a drive that does not turn needs a guess.
   const auto travel = [&] {
@@ -504,11 +512,11 @@ PoseInitialization InitializeFromModels(const std::string& database_path,
                                         const StationDataset& dataset,
                                         const std::string& registration_path,
                                         const PoseInitializerOptions& options,
-                                        std::vector<colmap::Reconstruction>* models,
-                                        std::vector<double>* scales,
+                                        ExistingModels* existing,
                                         const std::string& depth_path) {
   THROW_CHECK(options.Check());
-  THROW_CHECK(models != nullptr && scales != nullptr);
+  THROW_CHECK(existing != nullptr);
+  const std::vector<colmap::Reconstruction>* models = &existing->models;
   THROW_CHECK(!models->empty()) << "no COLMAP model given";
   const StationImages images = ReadStationImages(database_path, dataset);
   for (const colmap::Reconstruction& model : *models) CheckModelImages(model, images);
@@ -517,8 +525,7 @@ PoseInitialization InitializeFromModels(const std::string& database_path,
           ? std::vector<LidarPairRecord>()
           : ReadLidarPairs((fs::path(registration_path) / "pairs.txt").string());
   PoseInitialization init;
-  ChooseModelScalesAndExtrinsic(
-      database_path, dataset, lidar_pairs, options, models, scales, &init);
+  ChooseModelScalesAndExtrinsic(database_path, dataset, lidar_pairs, options, existing, &init);
   if (!depth_path.empty() && options.align_stereo_with_lidar) {
     RefineWithStereo(dataset, depth_path, options, &init);
   }

@@ -135,7 +135,7 @@ PoseInitialization InitializePoses(const std::string& database_path,
 
 // The existing-COLMAP-workflow variant: `models` (colmap mapper's, of the same database; ReadModels in
 // bridge/initialization/model_completion.h, the largest first) are rescaled to metres in place
-// (`scales` returns the factors) and cam_from_lidar chosen:
+// (`existing->scales` returns the factors) and cam_from_lidar chosen:
 // - stereo rig: each model's scale is the median ratio of depth prior to model depth over its landmark
 //   observations; cam_from_lidar the guess or hand-eye with the models' relative poses as image motions;
 // - monocular rig: the first model's similarity hand-eye gives both (or the guess, with the scale fitted
@@ -145,12 +145,15 @@ PoseInitialization InitializePoses(const std::string& database_path,
 // pose graph (CompleteThroughLidar) in the first model's frame; stations no edge reaches are listed
 // with the kind of edge missing. `cameras` holds the models' cameras. With `depth_path` (stereo_depth's
 // output) cam_from_lidar is then refined by the stereo-LiDAR alignment, as in InitializePoses.
+struct ExistingModels {
+  std::vector<colmap::Reconstruction> models;  // rescaled to metres in place
+  std::vector<double> scales;                  // the factors, one per model
+};
 PoseInitialization InitializeFromModels(const std::string& database_path,
                                         const StationDataset& dataset,
                                         const std::string& registration_path,
                                         const PoseInitializerOptions& options,
-                                        std::vector<colmap::Reconstruction>* models,
-                                        std::vector<double>* scales,
+                                        ExistingModels* existing,
                                         const std::string& depth_path = "");
 
 // The monocular initialisation: cam_from_lidar from rig.json's guess (if allowed and present), else

@@ -14,6 +14,7 @@
 #include <functional>
 #include <iomanip>
 #include <map>
+#include <optional>
 #include <sstream>
 
 namespace colmap_lidar {
@@ -370,19 +371,26 @@ Eigen::MatrixXd GroupedSandwich(const std::vector<Eigen::VectorXd>& scores,
 // With station groups (two-way clustering, Cameron, Gelbach & Miller 2011): V = V_A + V_B - V_AB, with A
 // the clusters merged by their first group key, B by their second, AB the clusters themselves, then
 // negative eigenvalues clipped; errors shared by every pair of one station are then covered.
-bool ClusterRobust(const JacobianRows& rows,
-                   const Eigen::SparseMatrix<double>& information,
-                   int num_other,
-                   const std::vector<std::array<int, 2>>& cluster_groups,
-                   size_t num_clusters,
-                   Eigen::MatrixXd* sandwich,
-                   Eigen::VectorXd* scale_sensitivity) {
+struct ClusterRobustCovariance {
+  Eigen::MatrixXd sandwich;           // in the parameters' own units
+  Eigen::VectorXd scale_sensitivity;  // dT_e / d(stereo scale)
+};
+
+std::optional<ClusterRobustCovariance> ClusterRobust(
+    const JacobianRows& rows,
+    const Eigen::SparseMatrix<double>& information,
+    int num_other,
+    const std::vector<std::array<int, 2>>& cluster_groups,
+    size_t num_clusters) {
+  ClusterRobustCovariance robust;
+  Eigen::MatrixXd* sandwich = &robust.sandwich;
+  Eigen::VectorXd* scale_sensitivity = &robust.scale_sensitivity;
   const int num_cols = static_cast<int>(information.cols());
   const int num_extrinsic = num_cols - num_other;
   Eigen::SparseMatrix<double> regularised = information;
   for (int i = 0; i < num_cols; ++i) regularised.coeffRef(i, i) += 1e-12;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> full(regularised);
-  if (full.info() != Eigen::Success || num_clusters < 2) return false;
+  if (full.info() != Eigen::Success || num_clusters < 2) return std::nullopt;
   Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(num_cols, num_extrinsic);
   for (int a = 0; a < num_extrinsic; ++a) selector(num_other + a, a) = 1;
   const Eigen::MatrixXd y = rows.jacobian * full.solve(selector);
@@ -411,7 +419,8 @@ bool ClusterRobust(const JacobianRows& rows,
                 eigen.eigenvectors().transpose();
   }
   *sandwich += known;
-  return sandwich->allFinite();
+  if (!sandwich->allFinite()) return std::nullopt;
+  return robust;
 }
 
 // One sentence per direction whose standard deviation exceeds the thresholds.
@@ -447,6 +456,39 @@ std::vector<std::string> NameUnobservable(const ExtrinsicUncertainty& result,
   return sentences;
 }
 
+// The cluster-robust (sandwich) covariance of T_e with the stereo scale's consider term, into
+// result->covariance where the sandwich can be formed; the formal one stays otherwise.
+void AddClusterRobustCovariance(const JacobianRows& rows,
+                                const Eigen::SparseMatrix<double>& information,
+                                const ColumnLayout& layout,
+                                const ExtrinsicUncertaintyInputs& inputs,
+                                const ObservabilityOptions& options,
+                                ExtrinsicUncertainty* result) {
+  const std::optional<ClusterRobustCovariance> cluster_robust = ClusterRobust(
+      rows, information, layout.num_other, inputs.cluster_groups, inputs.clusters.size());
+  if (!cluster_robust) return;
+  const Eigen::MatrixXd& sandwich = cluster_robust->sandwich;
+  const Eigen::VectorXd& scale_sensitivity = cluster_robust->scale_sensitivity;
+  for (size_t a = 0; a < layout.extrinsic_index.size(); ++a) {
+    result->stereo_scale_sensitivity[layout.extrinsic_index[a]] =
+        scale_sensitivity[a] * ReportedUnit(layout.extrinsic_index[a]);
+  }
+  Matrix6 robust = ToReportedUnits(sandwich, layout.extrinsic_index, 1, 0.0);
+  // Directions the data leaves undetermined keep the formal (capped) variance.
+  Eigen::SelfAdjointEigenSolver<Matrix6> formal(result->formal_covariance);
+  for (int k = 0; k < 6; ++k) {
+    if (formal.eigenvalues()[k] > kUnobservableVariance) {
+      robust += formal.eigenvalues()[k] * formal.eigenvectors().col(k) *
+                formal.eigenvectors().col(k).transpose();
+    }
+  }
+  result->covariance = robust + options.stereo_scale_sigma * options.stereo_scale_sigma *
+                                    result->stereo_scale_sensitivity *
+                                    result->stereo_scale_sensitivity.transpose();
+  result->cluster_robust = true;
+  result->num_clusters = static_cast<int>(inputs.clusters.size());
+}
+
 }  // namespace
 
 std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform) {
@@ -478,19 +520,13 @@ void RestrictToFreeDirections(const Eigen::Matrix3d& held_rotation,
   }
 }
 
-ExtrinsicUncertainty ComputeExtrinsicUncertainty(
-    ceres::Problem* problem,
-    double* cam_from_lidar_rotation,
-    double* cam_from_lidar_translation,
-    const std::array<bool, 3>& held_translation,
-    const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
-    const std::vector<std::array<int, 2>>& cluster_groups,
-    const std::vector<ceres::ResidualBlockId>& regularizers,
-    const std::vector<ceres::ResidualBlockId>& measurements,
-    size_t hidden_residuals,
-    const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
-    const MotionAnalysis& motion,
-    const ObservabilityOptions& options) {
+ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInputs& inputs,
+                                                 const MotionAnalysis& motion,
+                                                 const ObservabilityOptions& options) {
+  ceres::Problem* problem = inputs.problem;
+  double* cam_from_lidar_rotation = inputs.cam_from_lidar_rotation;
+  double* cam_from_lidar_translation = inputs.cam_from_lidar_translation;
+  const auto& clusters = inputs.clusters;
   ExtrinsicUncertainty result;
   const bool rotation_free = problem->HasParameterBlock(cam_from_lidar_rotation) &&
                              !problem->IsParameterBlockConstant(cam_from_lidar_rotation);
@@ -505,9 +541,13 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
                                                cam_from_lidar_translation,
                                                rotation_free,
                                                translation_free,
-                                               held_translation);
-  const JacobianRows rows =
-      EvaluateRows(problem, layout, clusters, regularizers, measurements, depth_scale_derivative);
+                                               inputs.held_translation);
+  const JacobianRows rows = EvaluateRows(problem,
+                                         layout,
+                                         clusters,
+                                         inputs.regularizers,
+                                         inputs.measurements,
+                                         inputs.depth_scale_derivative);
   const Eigen::SparseMatrix<double> data_jacobian = rows.jacobian.topRows(rows.num_data_rows);
   const Eigen::SparseMatrix<double> data_information =
       (data_jacobian.transpose() * data_jacobian).pruned();
@@ -524,41 +564,14 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(
   double squared_norm = 0;
   for (int row = 0; row < rows.num_data_rows; ++row)
     squared_norm += rows.residuals[row] * rows.residuals[row];
-  const int redundancy = rows.num_data_rows + static_cast<int>(hidden_residuals) -
+  const int redundancy = rows.num_data_rows + static_cast<int>(inputs.hidden_residuals) -
                          static_cast<int>(information.cols());
   result.variance_factor = redundancy > 0 ? squared_norm / redundancy : 1.0;
   result.formal_covariance = CovarianceFromInformation(
       ToReportedUnits(marginal, layout.extrinsic_index, -1, 1e30), result.variance_factor);
   result.covariance = result.formal_covariance;
 
-  Eigen::MatrixXd sandwich;
-  Eigen::VectorXd scale_sensitivity;
-  if (ClusterRobust(rows,
-                    information,
-                    layout.num_other,
-                    cluster_groups,
-                    clusters.size(),
-                    &sandwich,
-                    &scale_sensitivity)) {
-    for (size_t a = 0; a < layout.extrinsic_index.size(); ++a) {
-      result.stereo_scale_sensitivity[layout.extrinsic_index[a]] =
-          scale_sensitivity[a] * ReportedUnit(layout.extrinsic_index[a]);
-    }
-    Matrix6 robust = ToReportedUnits(sandwich, layout.extrinsic_index, 1, 0.0);
-    // Directions the data leaves undetermined keep the formal (capped) variance.
-    Eigen::SelfAdjointEigenSolver<Matrix6> formal(result.formal_covariance);
-    for (int k = 0; k < 6; ++k) {
-      if (formal.eigenvalues()[k] > kUnobservableVariance) {
-        robust += formal.eigenvalues()[k] * formal.eigenvectors().col(k) *
-                  formal.eigenvectors().col(k).transpose();
-      }
-    }
-    result.covariance = robust + options.stereo_scale_sigma * options.stereo_scale_sigma *
-                                     result.stereo_scale_sensitivity *
-                                     result.stereo_scale_sensitivity.transpose();
-    result.cluster_robust = true;
-    result.num_clusters = static_cast<int>(clusters.size());
-  }
+  AddClusterRobustCovariance(rows, information, layout, inputs, options, &result);
 
   Eigen::SelfAdjointEigenSolver<Matrix6> eigen(result.covariance);
   for (int k = 0; k < 6; ++k) {  // ascending: standard deviations ascending

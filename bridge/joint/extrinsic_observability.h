@@ -109,33 +109,38 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
 // holds across runs of one drive (docs/benchmarks/drive_uncertainty.md).
 std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform);
 
-// Marginal covariance of T_e's blocks in `problem` (both must be variable parameter blocks; the rotation
-// with a quaternion manifold of tangent size 3, the translation possibly with a subset manifold).
-// `motion` turns unobservable directions into advice.
-// `depth_scale_derivative`: d(residual)/d(stereo scale) of each depth-prior block (-d / sigma_d).
-// `clusters`: every data residual block of the problem, grouped (see above).
-// `cluster_groups`: empty, or per cluster two group keys (a LiDAR pair's target and source station; -1:
-// the cluster is a group of its own) for two-way clustering.
-// `hidden_residuals`: data residuals that compressed blocks stand for beyond their own rows (for the
-// variance factor's redundancy).
-// `regularizers`: residual blocks that are not data (the weak extrinsic prior): they keep the
-// information invertible for the sandwich but never decide what is observable.
-// `measurements`: whitened residual blocks of measurements with a known covariance (the stereo-LiDAR
-// alignment's E_x): data, whose share of the sandwich is their information J^T J, not a score (one
-// draw of a measurement says nothing about its spread).
-// `held_translation`: translation components held constant by a subset manifold (known exactly).
-ExtrinsicUncertainty ComputeExtrinsicUncertainty(
-    ceres::Problem* problem,
-    double* cam_from_lidar_rotation,
-    double* cam_from_lidar_translation,
-    const std::array<bool, 3>& held_translation,
-    const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
-    const std::vector<std::array<int, 2>>& cluster_groups,
-    const std::vector<ceres::ResidualBlockId>& regularizers,
-    const std::vector<ceres::ResidualBlockId>& measurements,
-    size_t hidden_residuals,
-    const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative,
-    const MotionAnalysis& motion,
-    const ObservabilityOptions& options);
+// What the covariance of T_e is computed from: the joint problem and T_e's blocks in it (both
+// variable parameter blocks; the rotation with a quaternion manifold of tangent size 3, the
+// translation possibly with a subset manifold), and its residual blocks by role.
+struct ExtrinsicUncertaintyInputs {
+  ceres::Problem* problem = nullptr;
+  double* cam_from_lidar_rotation = nullptr;
+  double* cam_from_lidar_translation = nullptr;
+  // Translation components held constant by a subset manifold (known exactly).
+  std::array<bool, 3> held_translation = {false, false, false};
+  // Every data residual block of the problem, grouped (see above).
+  std::vector<std::vector<ceres::ResidualBlockId>> clusters;
+  // Empty, or per cluster two group keys (a LiDAR pair's target and source station; -1: the
+  // cluster is a group of its own) for two-way clustering.
+  std::vector<std::array<int, 2>> cluster_groups;
+  // Residual blocks that are not data (the weak extrinsic prior): they keep the information
+  // invertible for the sandwich but never decide what is observable.
+  std::vector<ceres::ResidualBlockId> regularizers;
+  // Whitened residual blocks of measurements with a known covariance (the stereo-LiDAR alignment's
+  // E_x): data, whose share of the sandwich is their information J^T J, not a score (one draw of a
+  // measurement says nothing about its spread).
+  std::vector<ceres::ResidualBlockId> measurements;
+  // Data residuals that compressed blocks stand for beyond their own rows (for the variance
+  // factor's redundancy).
+  size_t hidden_residuals = 0;
+  // d(residual)/d(stereo scale) of each depth-prior block (-d / sigma_d).
+  std::unordered_map<ceres::ResidualBlockId, double> depth_scale_derivative;
+};
+
+// Marginal covariance of T_e in `inputs.problem`; `motion` turns unobservable directions into
+// advice.
+ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInputs& inputs,
+                                                 const MotionAnalysis& motion,
+                                                 const ObservabilityOptions& options);
 
 }  // namespace colmap_lidar

@@ -639,14 +639,13 @@ std::vector<LidarObservation> Associate(const RunState& state, double max_distan
         LidarIFromLidarJ(reconstruction.Image(target).CamFromWorld(),
                          reconstruction.Image(source).CamFromWorld(),
                          cam_from_lidar);
-    for (const PointToPlaneObservation& observation :
-         AssociatePointToPlane(state.data.clouds.at(source)->cloud,
-                               target_cloud.cloud,
-                               *target_cloud.tree,
-                               ToIsometry(target_from_source),
-                               association,
-                               &target_cloud.curvature,
-                               &state.data.clouds.at(source)->curvature)) {
+    for (const PointToPlaneObservation& observation : AssociatePointToPlane(
+             state.data.clouds.at(source)->cloud,
+             target_cloud.cloud,
+             *target_cloud.tree,
+             ToIsometry(target_from_source),
+             association,
+             {&target_cloud.curvature, &state.data.clouds.at(source)->curvature})) {
       per_pair[k].push_back({target, source, observation, false});
     }
   }
@@ -825,25 +824,24 @@ Clusters ResidualClusters(const colmap::Reconstruction& reconstruction, const Jo
 ExtrinsicUncertainty Uncertainty(const RunState& state,
                                  const JointProblem& joint,
                                  const MotionAnalysis& motion) {
-  std::unordered_map<ceres::ResidualBlockId, double> depth_scale_derivative;
+  ExtrinsicUncertaintyInputs inputs;
+  inputs.problem = joint.problem.get();
+  inputs.cam_from_lidar_rotation = state.ExtrinsicRotation();
+  inputs.cam_from_lidar_translation = state.ExtrinsicTranslation();
+  inputs.held_translation = state.options.hold_translation;
   for (size_t k = 0; k < joint.depth_ids.size(); ++k) {
-    depth_scale_derivative[joint.depth_ids[k]] = joint.depth_scale_derivatives[k];
+    inputs.depth_scale_derivative[joint.depth_ids[k]] = joint.depth_scale_derivatives[k];
   }
-  const Clusters clusters = ResidualClusters(*state.reconstruction, joint);
-  ExtrinsicUncertainty uncertainty = ComputeExtrinsicUncertainty(
-      joint.problem.get(),
-      state.ExtrinsicRotation(),
-      state.ExtrinsicTranslation(),
-      state.options.hold_translation,
-      clusters.blocks,
-      state.options.observability.two_way_lidar_clusters ? clusters.groups
-                                                         : std::vector<std::array<int, 2>>(),
-      joint.prior_ids,
-      joint.measurement_ids,
-      joint.num_hidden_residuals,
-      depth_scale_derivative,
-      motion,
-      state.options.observability);
+  Clusters clusters = ResidualClusters(*state.reconstruction, joint);
+  inputs.clusters = std::move(clusters.blocks);
+  if (state.options.observability.two_way_lidar_clusters) {
+    inputs.cluster_groups = std::move(clusters.groups);
+  }
+  inputs.regularizers = joint.prior_ids;
+  inputs.measurements = joint.measurement_ids;
+  inputs.hidden_residuals = joint.num_hidden_residuals;
+  ExtrinsicUncertainty uncertainty =
+      ComputeExtrinsicUncertainty(inputs, motion, state.options.observability);
   RestrictToFreeDirections(state.held_rotation, state.held_translation, &uncertainty);
   if (joint.reprojection_ids.empty() && joint.depth_ids.empty()) {
     uncertainty.unobservable.insert(

@@ -47,6 +47,24 @@ cv::Mat RenderImage(const Scene& scene,
   return image;
 }
 
+namespace {
+
+// The parts' points and intensities, in order.
+PointCloud Concatenated(const std::vector<PointCloud>& parts) {
+  PointCloud cloud;
+  size_t total = 0;
+  for (const PointCloud& part : parts) total += part.Size();
+  cloud.Reserve(total, false, false, true);
+  for (const PointCloud& part : parts) {
+    cloud.points.insert(cloud.points.end(), part.points.begin(), part.points.end());
+    cloud.intensities.insert(
+        cloud.intensities.end(), part.intensities.begin(), part.intensities.end());
+  }
+  return cloud;
+}
+
+}  // namespace
+
 PointCloud ScanLidar(const Scene& scene,
                      const colmap::Rigid3d& world_from_lidar,
                      const LidarOptions& options) {
@@ -104,16 +122,7 @@ PointCloud ScanLidar(const Scene& scene,
       }
     }
   }
-  PointCloud cloud;
-  size_t total = 0;
-  for (const PointCloud& part : per_step) total += part.Size();
-  cloud.Reserve(total, false, false, true);
-  for (PointCloud& part : per_step) {
-    cloud.points.insert(cloud.points.end(), part.points.begin(), part.points.end());
-    cloud.intensities.insert(
-        cloud.intensities.end(), part.intensities.begin(), part.intensities.end());
-  }
-  return cloud;
+  return Concatenated(per_step);
 }
 
 colmap::Rigid3d Interpolate(const colmap::Rigid3d& a, const colmap::Rigid3d& b, double tau) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 #include <stdexcept>
 
@@ -373,68 +374,80 @@ bool Scene::InsideObject(const Eigen::Vector3d& point, double tolerance) const {
   return false;
 }
 
+namespace {
+
+using SurfaceSampleSink =
+    std::function<void(const Eigen::Vector3d& point, const Eigen::Vector3d& normal)>;
+
+// Samples `spacing` apart on the six faces of box `p`, each with its outward normal.
+void SampleBoxSurface(const Primitive& p, double spacing, const SurfaceSampleSink& keep) {
+  const Eigen::Matrix3d R = RotZ(p.yaw);
+  for (int axis = 0; axis < 3; ++axis) {
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    const int nu = std::max(1, static_cast<int>(std::ceil(2 * p.half_size[u] / spacing)));
+    const int nv = std::max(1, static_cast<int>(std::ceil(2 * p.half_size[v] / spacing)));
+    for (const double side : {-1.0, 1.0}) {
+      Eigen::Vector3d n = Eigen::Vector3d::Zero();
+      n[axis] = side;
+      for (int a = 0; a < nu; ++a) {
+        for (int b = 0; b < nv; ++b) {
+          Eigen::Vector3d local;
+          local[axis] = side * p.half_size[axis];
+          local[u] = -p.half_size[u] + (a + 0.5) * 2 * p.half_size[u] / nu;
+          local[v] = -p.half_size[v] + (b + 0.5) * 2 * p.half_size[v] / nv;
+          keep(p.center + R * local, R * n);
+        }
+      }
+    }
+  }
+}
+
+// Samples `spacing` apart on the mantle and both caps of cylinder `p`.
+void SampleCylinderSurface(const Primitive& p, double spacing, const SurfaceSampleSink& keep) {
+  const double r = p.half_size.x(), h = p.half_size.z();
+  const int n_theta = static_cast<int>(std::ceil(2 * M_PI * r / spacing));
+  const int n_z = static_cast<int>(std::ceil(2 * h / spacing));
+  for (int a = 0; a < n_theta; ++a) {
+    const double theta = 2 * M_PI * (a + 0.5) / n_theta;
+    const Eigen::Vector3d n(std::cos(theta), std::sin(theta), 0);
+    for (int b = 0; b < n_z; ++b) {
+      keep(p.center + r * n + Eigen::Vector3d(0, 0, -h + (b + 0.5) * 2 * h / n_z), n);
+    }
+  }
+  const int n_cap = static_cast<int>(std::ceil(2 * r / spacing));
+  for (const double side : {-1.0, 1.0}) {
+    for (int a = 0; a < n_cap; ++a) {
+      for (int b = 0; b < n_cap; ++b) {
+        const Eigen::Vector2d xy(-r + (a + 0.5) * 2 * r / n_cap, -r + (b + 0.5) * 2 * r / n_cap);
+        if (xy.norm() > r) continue;
+        keep(p.center + Eigen::Vector3d(xy.x(), xy.y(), side * h), Eigen::Vector3d(0, 0, side));
+      }
+    }
+  }
+}
+
+}  // namespace
+
 PointCloud Scene::SampleObjectSurface(double spacing) const {
   PointCloud cloud;
-  auto keep = [&](const Eigen::Vector3d& point, const Eigen::Vector3d& normal, size_t self) {
-    if (point.z() < 1e-4) return;  // resting on the ground
-    // Drop samples on or inside another object primitive (hidden faces of a union).
-    for (size_t j = 0; j < primitives_.size(); ++j) {
-      if (j == self || !primitives_[j].is_object) continue;
-      Scene single;
-      single.primitives_ = {primitives_[j]};
-      if (single.InsideObject(point, 1e-7)) return;
-    }
-    cloud.points.push_back(point);
-    cloud.normals.push_back(normal);
-  };
   for (size_t i = 0; i < primitives_.size(); ++i) {
     const Primitive& p = primitives_[i];
     if (!p.is_object) continue;
-    if (p.type == Primitive::Type::kBox) {
-      const Eigen::Matrix3d R = RotZ(p.yaw);
-      for (int axis = 0; axis < 3; ++axis) {
-        const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-        const int nu = std::max(1, static_cast<int>(std::ceil(2 * p.half_size[u] / spacing)));
-        const int nv = std::max(1, static_cast<int>(std::ceil(2 * p.half_size[v] / spacing)));
-        for (const double side : {-1.0, 1.0}) {
-          Eigen::Vector3d n = Eigen::Vector3d::Zero();
-          n[axis] = side;
-          for (int a = 0; a < nu; ++a) {
-            for (int b = 0; b < nv; ++b) {
-              Eigen::Vector3d local;
-              local[axis] = side * p.half_size[axis];
-              local[u] = -p.half_size[u] + (a + 0.5) * 2 * p.half_size[u] / nu;
-              local[v] = -p.half_size[v] + (b + 0.5) * 2 * p.half_size[v] / nv;
-              keep(p.center + R * local, R * n, i);
-            }
-          }
-        }
+    // Samples resting on the ground, or on or inside another object primitive (hidden faces of a
+    // union), are dropped.
+    const auto keep = [&](const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
+      if (point.z() < 1e-4) return;
+      for (size_t j = 0; j < primitives_.size(); ++j) {
+        if (j == i || !primitives_[j].is_object) continue;
+        Scene single;
+        single.primitives_ = {primitives_[j]};
+        if (single.InsideObject(point, 1e-7)) return;
       }
-    } else if (p.type == Primitive::Type::kCylinder) {
-      const double r = p.half_size.x(), h = p.half_size.z();
-      const int n_theta = static_cast<int>(std::ceil(2 * M_PI * r / spacing));
-      const int n_z = static_cast<int>(std::ceil(2 * h / spacing));
-      for (int a = 0; a < n_theta; ++a) {
-        const double theta = 2 * M_PI * (a + 0.5) / n_theta;
-        const Eigen::Vector3d n(std::cos(theta), std::sin(theta), 0);
-        for (int b = 0; b < n_z; ++b) {
-          keep(p.center + r * n + Eigen::Vector3d(0, 0, -h + (b + 0.5) * 2 * h / n_z), n, i);
-        }
-      }
-      const int n_cap = static_cast<int>(std::ceil(2 * r / spacing));
-      for (const double side : {-1.0, 1.0}) {
-        for (int a = 0; a < n_cap; ++a) {
-          for (int b = 0; b < n_cap; ++b) {
-            const Eigen::Vector2d xy(-r + (a + 0.5) * 2 * r / n_cap,
-                                     -r + (b + 0.5) * 2 * r / n_cap);
-            if (xy.norm() > r) continue;
-            keep(p.center + Eigen::Vector3d(xy.x(), xy.y(), side * h),
-                 Eigen::Vector3d(0, 0, side),
-                 i);
-          }
-        }
-      }
-    }
+      cloud.points.push_back(point);
+      cloud.normals.push_back(normal);
+    };
+    if (p.type == Primitive::Type::kBox) SampleBoxSurface(p, spacing, keep);
+    if (p.type == Primitive::Type::kCylinder) SampleCylinderSurface(p, spacing, keep);
   }
   return cloud;
 }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
 
 namespace colmap_lidar {
 namespace sim {
@@ -49,44 +50,54 @@ bool IsDrive(Motion motion) { return motion == Motion::kDrive || motion == Motio
 
 namespace {
 
-// Two identical PINHOLE cameras with the given horizontal FOV, the right one `baseline_m` to the right
-// and turned by `misalignment_deg` about a generic axis (a real bar is never perfectly parallel).
-StationRig MakePinholePair(double width_px,
-                           double height_px,
-                           double horizontal_fov_deg,
-                           double baseline_m,
-                           double misalignment_deg,
-                           const Eigen::Vector3d& misalignment_axis,
-                           const std::string& lidar_model) {
-  const size_t width = static_cast<size_t>(std::lround(width_px));
-  const size_t height = static_cast<size_t>(std::lround(height_px));
-  const double focal = 0.5 * width / std::tan(0.5 * horizontal_fov_deg * kDegToRad);
+// A simulated stereo pod: two identical PINHOLE cameras with a horizontal field of view, the right
+// one `baseline_m` to the right and turned by `misalignment_deg` about a generic axis (a real bar is
+// never perfectly parallel), and its LiDAR's model name.
+struct PodModel {
+  double width_px;
+  double height_px;
+  double horizontal_fov_deg;
+  double baseline_m;
+  double misalignment_deg;
+  Eigen::Vector3d misalignment_axis;
+  std::string lidar_model;
+};
+
+StationRig MakePinholePair(const PodModel& pod) {
+  const size_t width = static_cast<size_t>(std::lround(pod.width_px));
+  const size_t height = static_cast<size_t>(std::lround(pod.height_px));
+  const double focal = 0.5 * width / std::tan(0.5 * pod.horizontal_fov_deg * kDegToRad);
   StationRig rig;
   rig.left = colmap::Camera::CreateFromModelName(
       colmap::kInvalidCameraId, "PINHOLE", focal, width, height);
   rig.right = rig.left;
   rig.right_from_left.rotation = Eigen::Quaterniond(
-      Eigen::AngleAxisd(misalignment_deg * kDegToRad, misalignment_axis.normalized()));
-  rig.right_from_left.translation = Eigen::Vector3d(-baseline_m, 0.0, 0.0);
-  rig.lidar_model = lidar_model;
+      Eigen::AngleAxisd(pod.misalignment_deg * kDegToRad, pod.misalignment_axis.normalized()));
+  rig.right_from_left.translation = Eigen::Vector3d(-pod.baseline_m, 0.0, 0.0);
+  rig.lidar_model = pod.lidar_model;
   return rig;
 }
 
 }  // namespace
 
 StationRig MakeStereoRig(double image_scale) {
-  return MakePinholePair(1028 * image_scale,
-                         752 * image_scale,
-                         48,
-                         0.38,
-                         0.15,
-                         Eigen::Vector3d(0.2, 1, 0.1),
-                         "VLP-16");
+  return MakePinholePair({1028 * image_scale,
+                          752 * image_scale,
+                          48,
+                          0.38,
+                          0.15,
+                          Eigen::Vector3d(0.2, 1, 0.1),
+                          "VLP-16"});
 }
 
 StationRig MakeDriveRig(double image_scale) {
-  return MakePinholePair(
-      1242 * image_scale, 375 * image_scale, 90, 0.54, 0.1, Eigen::Vector3d(0.1, 1, 0.2), "HDL-64");
+  return MakePinholePair({1242 * image_scale,
+                          375 * image_scale,
+                          90,
+                          0.54,
+                          0.1,
+                          Eigen::Vector3d(0.1, 1, 0.2),
+                          "HDL-64"});
 }
 
 colmap::Rigid3d TrueCamFromLidar() {
@@ -177,6 +188,43 @@ std::vector<colmap::Rigid3d> ReturnDriveStations(int num_stations, std::mt19937_
   return stations;
 }
 
+// 0.5-1 m per frame; a lane change (1.6 m over ~25 m) and a swerve, heading along the path.
+std::vector<colmap::Rigid3d> DriveStations(int num_stations, std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  auto lateral = [](double x) {
+    return 1.6 / (1 + std::exp(-(x - 20) / 4)) - 1.8 + 0.4 * std::sin(x / 9);
+  };
+  std::vector<colmap::Rigid3d> stations;
+  double x = 0;
+  for (int i = 0; i < num_stations; ++i) {
+    const double slope = (lateral(x + 0.5) - lateral(x - 0.5));
+    stations.push_back(CamFromWorld(WorldFromCamRotation(std::atan(slope), 0, 0),
+                                    Eigen::Vector3d(x, lateral(x), 1.65)));
+    x += 0.5 + 0.5 * unit(*rng);
+  }
+  return stations;
+}
+
+// A line of stations in front of the structure, all with the same orientation.
+std::vector<colmap::Rigid3d> FixedRotationStations(const Scene& scene,
+                                                   int num_stations,
+                                                   double pitch,
+                                                   std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  const Eigen::Vector3d& c = scene.ObjectCenter();
+  const double yaw = M_PI / 2;  // looking along +y from the -y side
+  const Eigen::Matrix3d world_from_cam = WorldFromCamRotation(yaw, pitch, 0);
+  const double distance = scene.ObjectRadius() + 2.3;
+  std::vector<colmap::Rigid3d> stations;
+  for (int i = 0; i < num_stations; ++i) {
+    const double s = -1.2 + 2.4 * i / (num_stations - 1);
+    const Eigen::Vector3d center(
+        c.x() + s, c.y() - distance + 0.3 * unit(*rng), 1.1 + 0.2 * unit(*rng));
+    stations.push_back(CamFromWorld(world_from_cam, center));
+  }
+  return stations;
+}
+
 }  // namespace
 
 std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
@@ -192,32 +240,9 @@ std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
   std::vector<colmap::Rigid3d> stations;
 
   if (motion == Motion::kDriveReturn) return ReturnDriveStations(num_stations, &rng);
-  if (motion == Motion::kDrive) {
-    // 0.5-1 m per frame; a lane change (1.6 m over ~25 m) and a swerve, heading along the path.
-    auto lateral = [](double x) {
-      return 1.6 / (1 + std::exp(-(x - 20) / 4)) - 1.8 + 0.4 * std::sin(x / 9);
-    };
-    double x = 0;
-    for (int i = 0; i < num_stations; ++i) {
-      const double slope = (lateral(x + 0.5) - lateral(x - 0.5));
-      stations.push_back(CamFromWorld(WorldFromCamRotation(std::atan(slope), 0, 0),
-                                      Eigen::Vector3d(x, lateral(x), 1.65)));
-      x += 0.5 + 0.5 * unit(rng);
-    }
-    return stations;
-  }
+  if (motion == Motion::kDrive) return DriveStations(num_stations, &rng);
   if (motion == Motion::kFixedRotation) {
-    // A line of stations in front of the structure, all with the same orientation.
-    const double yaw = M_PI / 2;  // looking along +y from the -y side
-    const Eigen::Matrix3d world_from_cam = WorldFromCamRotation(yaw, ring_pitch, 0);
-    const double distance = scene.ObjectRadius() + 2.3;
-    for (int i = 0; i < num_stations; ++i) {
-      const double s = -1.2 + 2.4 * i / (num_stations - 1);
-      const Eigen::Vector3d center(
-          c.x() + s, c.y() - distance + 0.3 * unit(rng), 1.1 + 0.2 * unit(rng));
-      stations.push_back(CamFromWorld(world_from_cam, center));
-    }
-    return stations;
+    return FixedRotationStations(scene, num_stations, ring_pitch, &rng);
   }
 
   // About a fifth of the stations tilted (at least one), never more than half.

@@ -1,12 +1,12 @@
 #include "bridge/simulation/simulate_dataset.h"
 
-#include "colmap_ext/logging.h"
-#include "colmap_ext/station_dataset.h"
-#include "lidar/cloud_io.h"
 #include "bridge/simulation/kitti_layout.h"
 #include "bridge/simulation/renderer.h"
 #include "bridge/simulation/scene.h"
 #include "bridge/simulation/sensor_pod.h"
+#include "colmap_ext/logging.h"
+#include "colmap_ext/station_dataset.h"
+#include "lidar/cloud_io.h"
 
 #include "colmap/mvs/depth_map.h"
 
@@ -83,11 +83,10 @@ bool SimulationOptions::Check() const {
   return true;
 }
 
-SimulationResult SimulateDataset(const SimulationOptions& options) {
-  THROW_CHECK(options.Check()) << "Invalid simulation options";
-  const auto start = std::chrono::steady_clock::now();
-  const Scene scene = Scene::Create(options.scene);
-  const Motion motion = MotionFromName(options.motion);
+namespace {
+
+// OUTPUT.partial with the dataset's folders; refuses an existing OUTPUT without `overwrite`.
+fs::path MakePartialFolder(const SimulationOptions& options) {
   const fs::path output(options.output_path);
   if (fs::exists(output) && !options.overwrite) {
     throw std::runtime_error(output.string() + " exists; pass --overwrite 1 to replace it");
@@ -98,10 +97,14 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
     fs::create_directories(partial / dir);
   }
   if (!options.mono) fs::create_directories(partial / "images/right");
+  return partial;
+}
 
-  const bool drive = IsDrive(motion);
+// The stereo rig of the capture (the right camera kept for rendering even when the dataset is mono).
+StationRig MakeStereoRigOf(const SimulationOptions& options,
+                           bool drive,
+                           const colmap::Rigid3d& cam_from_lidar) {
   StationRig rig = drive ? MakeDriveRig(options.image_scale) : MakeStereoRig(options.image_scale);
-  const colmap::Rigid3d cam_from_lidar = TrueCamFromLidar();
   if (options.write_guess) {
     rig.cam_from_lidar_guess = PerturbPose(
         cam_from_lidar, options.guess_rotation_deg, options.guess_translation_m, options.seed + 1);
@@ -112,9 +115,103 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
   if (drive && options.sweep_motion) rig.lidar_sweep = StationRig::LidarSweep();
   // KITTI's images are rectified: the right camera is not turned against the left one.
   if (options.layout == "kitti") rig.right_from_left.rotation = Eigen::Quaterniond::Identity();
+  return rig;
+}
+
+// Station i's images (left, and right unless mono) and depth map under `partial`.
+void RenderStationImages(const SimulationOptions& options,
+                         const Scene& frame_scene,
+                         const StationRig& stereo_rig,
+                         const colmap::Rigid3d& cam_from_world,
+                         size_t i,
+                         const fs::path& partial) {
+  const std::string name = StationName(static_cast<int>(i));
+  ImageOptions image_options;
+  image_options.pixel_noise = options.pixel_noise;
+  image_options.vignetting = options.vignetting;
+  image_options.seed = options.seed * 1000 + 2 * i;
+  cv::Mat depth;
+  WriteImage((partial / "images/left" / (name + ".png")).string(),
+             RenderImage(frame_scene, stereo_rig.left, cam_from_world, image_options, &depth));
+  WriteDepthMap((partial / "ground_truth/depth" / (name + ".bin")).string(), depth);
+  image_options.seed += 1;
+  if (options.mono) return;
+  WriteImage((partial / "images/right" / (name + ".png")).string(),
+             RenderImage(frame_scene,
+                         *stereo_rig.right,
+                         stereo_rig.right_from_left * cam_from_world,
+                         image_options,
+                         nullptr));
+}
+
+// Station i's LiDAR cloud (a sweep along the path when driving) under `partial`; its size.
+size_t ScanStation(const SimulationOptions& options,
+                   const Scene& scene,
+                   const Scene& frame_scene,
+                   const std::vector<colmap::Rigid3d>& world_from_lidar,
+                   size_t i,
+                   const fs::path& partial) {
+  LidarOptions lidar_options;
+  lidar_options.num_points = options.lidar_points;
+  lidar_options.range_noise_m = options.range_noise_m;
+  lidar_options.mixed_edge_points = options.mixed_edge_points;
+  lidar_options.seed = options.seed * 1000 + i;
+  const PointCloud cloud =
+      IsDrive(MotionFromName(options.motion))
+          ? ScanSweep(
+                frame_scene, SweepPath(world_from_lidar, i, options.sweep_motion), lidar_options)
+          : ScanLidar(scene, world_from_lidar[i], lidar_options);
+  WritePointCloud((partial / "lidar" / (StationName(static_cast<int>(i)) + ".pcd")).string(),
+                  cloud);
+  return cloud.Size();
+}
+
+// The ground truth (station poses, cam_from_lidar, the object's surface) under `partial`; the
+// surface's size.
+size_t WriteGroundTruth(const SimulationOptions& options,
+                        const Scene& scene,
+                        const std::map<std::string, colmap::Rigid3d>& cam_from_world,
+                        const colmap::Rigid3d& cam_from_lidar,
+                        const fs::path& partial) {
+  WriteNamedPoses((partial / "ground_truth/cam_from_world.txt").string(),
+                  "True pose of each station's left camera: cam_from_world",
+                  cam_from_world);
+  WritePoseFile((partial / "ground_truth/cam_from_lidar.txt").string(),
+                "True extrinsic: cam_from_lidar (x_cam = R x_lidar + t)",
+                cam_from_lidar);
+  const PointCloud surface = scene.SampleObjectSurface(options.surface_spacing_m);
+  WritePointCloud((partial / "ground_truth/surface.ply").string(), surface);
+  return surface.Size();
+}
+
+// OUTPUT.partial (in KITTI's layout if asked) renamed to OUTPUT.
+void FinishOutput(const SimulationOptions& options, const fs::path& partial) {
+  const fs::path output(options.output_path);
+  if (options.layout == "kitti") {
+    const fs::path kitti_partial = output.string() + ".kitti.partial";
+    fs::remove_all(kitti_partial);
+    WriteKittiLayout(partial.string(), kitti_partial.string());
+    fs::remove_all(partial);
+    fs::rename(kitti_partial, partial);
+  }
+  if (fs::exists(output)) fs::remove_all(output);
+  fs::rename(partial, output);
+}
+
+}  // namespace
+
+SimulationResult SimulateDataset(const SimulationOptions& options) {
+  THROW_CHECK(options.Check()) << "Invalid simulation options";
+  const auto start = std::chrono::steady_clock::now();
+  const Scene scene = Scene::Create(options.scene);
+  const Motion motion = MotionFromName(options.motion);
+  const fs::path partial = MakePartialFolder(options);
+  const bool drive = IsDrive(motion);
+  const colmap::Rigid3d cam_from_lidar = TrueCamFromLidar();
   // Mono: the same left images and clouds as the stereo dataset of the same seed; the right camera is
   // neither rendered nor described.
-  const StationRig stereo_rig = rig;
+  const StationRig stereo_rig = MakeStereoRigOf(options, drive, cam_from_lidar);
+  StationRig rig = stereo_rig;
   if (options.mono) rig.right.reset();
   WriteRigJson((partial / "rig.json").string(), rig);
 
@@ -133,57 +230,16 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
     const Scene frame_scene =
         drive && options.moving_cars ? scene.MovedTo(i * kDriveFramePeriod) : scene;
     cam_from_world[name] = stations[i];
-    ImageOptions image_options;
-    image_options.pixel_noise = options.pixel_noise;
-    image_options.vignetting = options.vignetting;
-    image_options.seed = options.seed * 1000 + 2 * i;
-    cv::Mat depth;
-    WriteImage((partial / "images/left" / (name + ".png")).string(),
-               RenderImage(frame_scene, rig.left, stations[i], image_options, &depth));
-    WriteDepthMap((partial / "ground_truth/depth" / (name + ".bin")).string(), depth);
-    image_options.seed += 1;
-    if (!options.mono) {
-      WriteImage((partial / "images/right" / (name + ".png")).string(),
-                 RenderImage(frame_scene,
-                             *stereo_rig.right,
-                             stereo_rig.right_from_left * stations[i],
-                             image_options,
-                             nullptr));
-    }
-
-    LidarOptions lidar_options;
-    lidar_options.num_points = options.lidar_points;
-    lidar_options.range_noise_m = options.range_noise_m;
-    lidar_options.mixed_edge_points = options.mixed_edge_points;
-    lidar_options.seed = options.seed * 1000 + i;
-    const PointCloud cloud = drive ? ScanSweep(frame_scene,
-                                               SweepPath(world_from_lidar, i, options.sweep_motion),
-                                               lidar_options)
-                                   : ScanLidar(scene, world_from_lidar[i], lidar_options);
-    WritePointCloud((partial / "lidar" / (name + ".pcd")).string(), cloud);
-    result.num_lidar_points += cloud.Size();
+    RenderStationImages(options, frame_scene, stereo_rig, stations[i], i, partial);
+    const size_t num_points =
+        ScanStation(options, scene, frame_scene, world_from_lidar, i, partial);
+    result.num_lidar_points += num_points;
     std::cout << "simulate_dataset: station " << name << " (" << i + 1 << "/" << stations.size()
-              << "): " << cloud.Size() << " LiDAR points" << std::endl;
+              << "): " << num_points << " LiDAR points" << std::endl;
   }
-  WriteNamedPoses((partial / "ground_truth/cam_from_world.txt").string(),
-                  "True pose of each station's left camera: cam_from_world",
-                  cam_from_world);
-  WritePoseFile((partial / "ground_truth/cam_from_lidar.txt").string(),
-                "True extrinsic: cam_from_lidar (x_cam = R x_lidar + t)",
-                cam_from_lidar);
-  const PointCloud surface = scene.SampleObjectSurface(options.surface_spacing_m);
-  WritePointCloud((partial / "ground_truth/surface.ply").string(), surface);
-  result.num_surface_points = surface.Size();
-
-  if (options.layout == "kitti") {
-    const fs::path kitti_partial = output.string() + ".kitti.partial";
-    fs::remove_all(kitti_partial);
-    WriteKittiLayout(partial.string(), kitti_partial.string());
-    fs::remove_all(partial);
-    fs::rename(kitti_partial, partial);
-  }
-  if (fs::exists(output)) fs::remove_all(output);
-  fs::rename(partial, output);
+  result.num_surface_points =
+      WriteGroundTruth(options, scene, cam_from_world, cam_from_lidar, partial);
+  FinishOutput(options, partial);
   result.num_stations = static_cast<int>(stations.size());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
