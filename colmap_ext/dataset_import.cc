@@ -17,6 +17,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 namespace colmap_lidar {
 namespace {
@@ -253,14 +254,14 @@ void WritePosePriors(const StationDataset& dataset,
 
 // COLMAP's exhaustive, sequential or spatial matcher on the database.
 void MatchFeatures(const DatasetImportOptions& options, const std::string& database_path) {
-  std::cout << "COLMAP " << options.matcher << " matching" << std::endl;
+  std::cout << "COLMAP " << ImageMatcherName(options.matcher) << " matching" << std::endl;
   std::unique_ptr<colmap::Thread> matcher;
-  if (options.matcher == "sequential") {
+  if (options.matcher == ImageMatcher::kSequential) {
     matcher = colmap::CreateSequentialFeatureMatcher(options.sequential_matching,
                                                      options.sift_matching,
                                                      options.two_view_geometry,
                                                      database_path);
-  } else if (options.matcher == "spatial") {
+  } else if (options.matcher == ImageMatcher::kSpatial) {
     matcher = colmap::CreateSpatialFeatureMatcher(
         options.spatial_matching, options.sift_matching, options.two_view_geometry, database_path);
   } else {
@@ -359,6 +360,26 @@ std::string DatasetImportOptions::ImageName(const StationDataset& dataset, size_
   return name;
 }
 
+ImageMatcher ImageMatcherFromName(const std::string& name) {
+  if (name == "exhaustive") return ImageMatcher::kExhaustive;
+  if (name == "sequential") return ImageMatcher::kSequential;
+  if (name == "spatial") return ImageMatcher::kSpatial;
+  throw std::invalid_argument("unknown matcher '" + name +
+                              "' (expected exhaustive, sequential or spatial)");
+}
+
+const char* ImageMatcherName(ImageMatcher matcher) {
+  switch (matcher) {
+    case ImageMatcher::kExhaustive:
+      return "exhaustive";
+    case ImageMatcher::kSequential:
+      return "sequential";
+    case ImageMatcher::kSpatial:
+      return "spatial";
+  }
+  return "exhaustive";
+}
+
 colmap::SpatialMatchingOptions LidarSpatialMatchingOptions() {
   colmap::SpatialMatchingOptions options;
   options.ignore_z = false;
@@ -366,7 +387,6 @@ colmap::SpatialMatchingOptions LidarSpatialMatchingOptions() {
 }
 
 bool DatasetImportOptions::Check() const {
-  CHECK_OPTION(matcher == "exhaustive" || matcher == "sequential" || matcher == "spatial");
   CHECK_OPTION(image_name_format.empty() ||
                fs::path(image_name_format).stem().string() == kStationPlaceholder);
   CHECK_OPTION(exhaustive_matching.Check());
@@ -407,9 +427,10 @@ DatasetImportSummary ImportIntoPartial(const StationDataset& dataset,
   }
   const std::vector<colmap::image_t> image_ids =
       ImportedImageIds(dataset, names, summary.camera_id, partial);
-  if (options.matcher == "spatial") WritePosePriors(dataset, image_ids, options, partial);
+  if (options.matcher == ImageMatcher::kSpatial)
+    WritePosePriors(dataset, image_ids, options, partial);
   MatchFeatures(options, partial);
-  if (options.matcher == "spatial") {
+  if (options.matcher == ImageMatcher::kSpatial) {
     MatchStationsWithoutPosition(dataset, names, options, partial);
   }
   WriteRigAndLidarFrames(dataset, summary.camera_id, image_ids, partial);
@@ -428,7 +449,7 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
   THROW_CHECK(options.sift_matching.Check());
   THROW_CHECK(options.two_view_geometry.Check());
   THROW_CHECK(options.Check());
-  THROW_CHECK(options.matcher != "spatial" || !options.station_positions.empty())
+  THROW_CHECK(options.matcher != ImageMatcher::kSpatial || !options.station_positions.empty())
       << "the spatial matcher needs station positions (none came from the LiDAR registration)";
   THROW_CHECK(!dataset.stations.empty()) << "no stations in " << dataset.root;
   std::cout << "Checking " << dataset.stations.size()

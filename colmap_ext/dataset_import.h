@@ -27,20 +27,25 @@ namespace colmap_lidar {
 
 colmap::SpatialMatchingOptions LidarSpatialMatchingOptions();
 
+// How the imported images are paired for matching: every pair; each image with its successors by
+// name (frames of a moving platform); each image with the images whose stations are near.
+enum class ImageMatcher { kExhaustive, kSequential, kSpatial };
+// "exhaustive" | "sequential" | "spatial"; throws std::invalid_argument naming any other.
+ImageMatcher ImageMatcherFromName(const std::string& name);
+const char* ImageMatcherName(ImageMatcher matcher);
+
 struct DatasetImportOptions {
   colmap::SiftExtractionOptions sift_extraction;
   colmap::SiftMatchingOptions sift_matching;
   colmap::TwoViewGeometryOptions two_view_geometry;
-  // "exhaustive" (every image pair), "sequential" (each image with its successors by name, for
-  // frames of a moving platform: SequentialMatchingOptions::overlap of them) or "spatial" (each image
-  // with the images whose stations are near: COLMAP's spatial matcher on pose priors written from
-  // `station_positions`).
-  std::string matcher = "exhaustive";
+  // Sequential: SequentialMatchingOptions::overlap successors; spatial: COLMAP's spatial matcher on
+  // pose priors written from `station_positions`.
+  ImageMatcher matcher = ImageMatcher::kExhaustive;
   colmap::ExhaustiveMatchingOptions exhaustive_matching;
   colmap::SequentialMatchingOptions sequential_matching;
   // COLMAP's defaults except ignore_z = false (LiDAR positions, unlike GPS, have a good z).
   colmap::SpatialMatchingOptions spatial_matching = LidarSpatialMatchingOptions();
-  // "spatial": the position of each station's camera in one world frame, by station name (e.g. from
+  // kSpatial: the position of each station's camera in one world frame, by station name (e.g. from
   // lidar_registrator's lidar_poses.txt). Stations without one get no pose prior; they are matched
   // with every other image instead.
   std::map<std::string, Eigen::Vector3d> station_positions;

@@ -24,7 +24,7 @@ void AddImportStepOptions(const std::string& prefix,
   manager->AddSpatialMatchingOptions();
   PrefixedOptions add(manager, prefix);
   add.Add("matcher",
-          &options->import.matcher,
+          &options->matcher,
           "exhaustive | sequential (frames of a moving platform, by name) | spatial "
           "(stations near in --lidar_registration_path); pipeline: auto (exhaustive up to "
           "Import.max_exhaustive_stations, spatial beyond)");
@@ -42,7 +42,8 @@ void AddImportStepOptions(const std::string& prefix,
 
 bool ImportStepOptions::Check() const {
   CHECK_OPTION(import.Check());
-  CHECK_OPTION(import.matcher != "spatial" || !lidar_registration_path.empty());
+  CHECK_OPTION(matcher == "exhaustive" || matcher == "sequential" || matcher == "spatial");
+  CHECK_OPTION(matcher != "spatial" || !lidar_registration_path.empty());
   return true;
 }
 
@@ -60,7 +61,8 @@ void RunImportStep(const StationDataset& dataset,
                    ImportStepOptions options) {
   const auto start = std::chrono::steady_clock::now();
   THROW_CHECK(options.Check());
-  if (options.import.matcher == "spatial") {
+  options.import.matcher = ImageMatcherFromName(options.matcher);
+  if (options.import.matcher == ImageMatcher::kSpatial) {
     options.import.station_positions =
         StationCameraPositions(options.lidar_registration_path,
                                dataset.rig.cam_from_lidar_guess.value_or(colmap::Rigid3d()));

@@ -422,10 +422,13 @@ void PrintUncertainty(const JointAdjustmentSummary& summary, const std::string& 
 
 }  // namespace
 
-bool JointAdjusterStepOptions::Check() {
-  adjuster.mode = JointModeFromName(mode);
-  adjuster.hold_translation = ParseHeldAxes(hold_translation);
-  return adjuster.Check() && data.Check();
+bool JointAdjusterStepOptions::Check() const { return AdjusterOptions().Check() && data.Check(); }
+
+JointAdjusterOptions JointAdjusterStepOptions::AdjusterOptions() const {
+  JointAdjusterOptions resolved = adjuster;
+  resolved.mode = JointModeFromName(mode);
+  resolved.hold_translation = ParseHeldAxes(hold_translation);
+  return resolved;
 }
 
 void AddJointAdjusterOptions(const std::string& prefix,
@@ -743,6 +746,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                           const JointAdjusterPaths& paths,
                           JointAdjusterStepOptions options) {
   THROW_CHECK(options.Check());
+  options.adjuster = options.AdjusterOptions();
   if (!dataset.rig.IsStereo() && options.adjuster.mode == JointMode::kStereoOnly) {
     throw std::invalid_argument("--mode stereo_only needs a stereo rig; " + dataset.root +
                                 "/rig.json has one camera");

@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -119,20 +120,33 @@ std::vector<fs::path> StationCloudFiles(const std::string& lidar_path) {
   return files;
 }
 
+// --remove_moving_points: on, off, or none (auto: decided by deskew_sweeps).
+const std::map<std::string, std::optional<bool>> kMovingPointRemoval = {
+    {"auto", std::nullopt}, {"on", true}, {"1", true}, {"off", false}, {"0", false}};
+
 }  // namespace
 
-bool LidarRegistratorStepOptions::Check() {
+bool LidarRegistratorStepOptions::Check() const {
   CHECK_OPTION_GE(max_neighbors, 0);
   CHECK_OPTION_GE(sequential, 0);
   CHECK_OPTION_GE(bridge_neighbors, 0);
-  graph.bridge_neighbors = static_cast<size_t>(bridge_neighbors);
-  graph.max_neighbors = static_cast<size_t>(max_neighbors);
-  graph.sequential = static_cast<size_t>(sequential);
   CHECK_OPTION_GE(refine_neighbors, 0);
-  CHECK_OPTION_GE(remove_moving_points, -1);
-  CHECK_OPTION_LE(remove_moving_points, 1);
+  CHECK_OPTION(kMovingPointRemoval.count(remove_moving_points) > 0);
   CHECK_OPTION(method == "auto" || method == "pairwise" || method == "odometry");
   return sweep_timing.Check() && moving.Check() && odometry.Check() && revisit.Check();
+}
+
+bool LidarRegistratorStepOptions::RemovesMovingPoints() const {
+  const std::optional<bool> on = kMovingPointRemoval.at(remove_moving_points);
+  return on.value_or(deskew_sweeps);
+}
+
+LidarGraphOptions LidarRegistratorStepOptions::GraphOptions() const {
+  LidarGraphOptions counted = graph;
+  counted.bridge_neighbors = static_cast<size_t>(bridge_neighbors);
+  counted.max_neighbors = static_cast<size_t>(max_neighbors);
+  counted.sequential = static_cast<size_t>(sequential);
+  return counted;
 }
 
 namespace {
@@ -213,8 +227,8 @@ void AddLidarRegistratorOptions(const std::string& prefix,
   add.Add("sweep_counter_clockwise", &options->sweep_timing.counter_clockwise);
   add.Add("remove_moving_points",
           &options->remove_moving_points,
-          "1: flag moving objects by free space, write static/<station>.pcd without them; -1: "
-          "with deskew_sweeps");
+          "on (1): flag moving objects by free space, write static/<station>.pcd without them; "
+          "off (0); auto: with deskew_sweeps");
   add.Add("moving_neighbour_clouds",
           &options->moving.num_neighbour_clouds,
           "clouds compared on each side (name order)");
@@ -273,7 +287,7 @@ LidarGraph RegisterClouds(const std::vector<fs::path>& files,
                 << std::defaultfloat << std::setprecision(6) << std::endl;
     }
   };
-  return RegisterAllStations(pointers, options.graph, progress, frame_indices);
+  return RegisterAllStations(pointers, options.GraphOptions(), progress, frame_indices);
 }
 
 // The frame index of each station: its name when every name is a number (KITTI's %010d, possibly
@@ -531,7 +545,7 @@ LidarGraph RegisterStations(const std::vector<fs::path>& files,
                             std::string* method_line) {
   // Sweeps of a moving platform: their frames in time order turn on the speed check.
   const std::vector<double> frames =
-      options.deskew_sweeps || options.graph.sequential > 0 ? clock : std::vector<double>();
+      options.deskew_sweeps || options.sequential > 0 ? clock : std::vector<double>();
   const bool odometry = UseOdometry(options);
   LidarGraph graph;
   if (odometry) {
@@ -580,8 +594,7 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
   std::string method_line;
   LidarGraph graph = RegisterStations(files, clock, options, output_path, start, &method_line);
   fs::create_directories(output_path);
-  if (options.remove_moving_points == 1 ||
-      (options.remove_moving_points == -1 && options.deskew_sweeps)) {
+  if (options.RemovesMovingPoints()) {
     std::vector<std::string> cloud_paths;
     for (const fs::path& file : files) {
       cloud_paths.push_back(options.deskew_sweeps

@@ -255,7 +255,7 @@ void AddPipelineOptions(colmap::OptionManager* manager, PipelineOptions* options
   // import's cost; with 4096 the LiDAR, not the feature count, still sets the accuracy of
   // cam_from_lidar (docs/benchmarks/pipeline.md). Images of up to 1 MP rarely have more.
   manager->sift_extraction->max_num_features = 4096;
-  options->import.import.matcher = "auto";
+  options->import.matcher = "auto";
   options->import.import.spatial_matching.max_num_neighbors = 12;
   AddImportStepOptions("Import.", manager, &options->import);
   manager->AddDefaultOption(
@@ -389,7 +389,7 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
       }};
   // The spatial matcher matches only images of stations near in the LiDAR registration: the LiDAR
   // registration runs first (no N^2 image pairs on large surveys).
-  const bool lidar_first = options.import.import.matcher == "spatial" || select;
+  const bool lidar_first = options.import.matcher == "spatial" || select;
   std::vector<PipelineStep> steps;
   if (lidar_first) steps.push_back(registrator);
   if (select) {
@@ -494,8 +494,7 @@ void RunSteps(const std::vector<PipelineStep>& steps, const fs::path& ws, bool o
 // Import.matcher spatial without a registration path: the pipeline's own LiDAR registration (of
 // the selected frames), which then runs before the import (PipelineSteps).
 void SetSpatialMatchingRegistration(const StationDataset& dataset, PipelineOptions* pipeline) {
-  if (pipeline->import.import.matcher != "spatial" ||
-      !pipeline->import.lidar_registration_path.empty()) {
+  if (pipeline->import.matcher != "spatial" || !pipeline->import.lidar_registration_path.empty()) {
     return;
   }
   const WorkspacePaths paths(pipeline->workspace_path);
@@ -507,7 +506,7 @@ void SetSpatialMatchingRegistration(const StationDataset& dataset, PipelineOptio
 
 // Import.matcher auto (see PipelineOptions::max_exhaustive_stations).
 void ResolveAutoMatcher(size_t num_stations, PipelineOptions* pipeline) {
-  std::string& matcher = pipeline->import.import.matcher;
+  std::string& matcher = pipeline->import.matcher;
   if (matcher != "auto") return;
   const bool exhaustive = num_stations <= static_cast<size_t>(pipeline->max_exhaustive_stations);
   matcher = exhaustive ? "exhaustive" : "spatial";

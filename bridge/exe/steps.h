@@ -58,7 +58,10 @@ class PrefixedOptions {
 // import_dataset: COLMAP SIFT extraction and matching, our rig and lidar_frames rows.
 struct ImportStepOptions {
   DatasetImportOptions import;
-  // lidar_registrator's output folder, for import.matcher == "spatial".
+  // The command line's matcher: exhaustive | sequential | spatial (the pipeline resolves its auto
+  // first); RunImportStep parses it into import.matcher.
+  std::string matcher = "exhaustive";
+  // lidar_registrator's output folder, for the spatial matcher.
   std::string lidar_registration_path;
 
   bool Check() const;
@@ -94,7 +97,7 @@ void RunDepthPriorStep(const std::string& database_path,
 struct LidarRegistratorStepOptions {
   StationCloudOptions cloud;
   LidarGraphOptions graph;
-  // Parsed as int (the OptionManager has no size_t); copied into `graph` by Check().
+  // Parsed as int (the OptionManager has no size_t); GraphOptions() gives `graph` with them.
   int max_neighbors = 0;
   int sequential = 0;
   int bridge_neighbors = 4;
@@ -126,12 +129,15 @@ struct LidarRegistratorStepOptions {
   // After registration, flag the points of moving objects by free space (lidar/moving_points.h) and
   // write each cloud without them to OUTPUT/static/<station>.pcd (and all flagged points, in the
   // first station's frame, to OUTPUT/moving_points.ply); the later steps of `pipeline` use them.
-  // 1: on, 0: off, -1: on for sweeps of a moving platform (with deskew_sweeps).
-  int remove_moving_points = -1;
+  // auto: for sweeps of a moving platform (with deskew_sweeps); on (1); off (0).
+  std::string remove_moving_points = "auto";
   MovingPointOptions moving;
 
-  // Validates and copies max_neighbors, sequential and bridge_neighbors into `graph`.
-  bool Check();
+  bool Check() const;
+  // `graph` with max_neighbors, sequential and bridge_neighbors.
+  LidarGraphOptions GraphOptions() const;
+  // Whether moving points are removed (remove_moving_points, auto decided by deskew_sweeps).
+  bool RemovesMovingPoints() const;
 };
 void AddLidarRegistratorOptions(const std::string& prefix,
                                 colmap::OptionManager* manager,
@@ -177,10 +183,11 @@ inline constexpr char kRegistrationPathHelp[] =
 struct JointAdjusterStepOptions {
   JointAdjusterOptions adjuster;
   JointDataOptions data;
-  // joint | precalibrated | stereo_only; copied into `adjuster.mode` by Check(). Registered by the
+  // joint | precalibrated | stereo_only; into `adjuster.mode` by AdjusterOptions(). Registered by the
   // joint_adjuster command, not by AddJointAdjusterOptions (the pipeline's --mode sets it).
   std::string mode = "joint";
-  // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by Check().
+  // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by
+  // AdjusterOptions().
   std::string hold_translation;
   // On a moving platform (rig.json), estimate the LiDAR clock's offset from the cameras in E_m
   // (JointAdjusterOptions::estimate_time_offset).
@@ -188,8 +195,10 @@ struct JointAdjusterStepOptions {
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
   bool write_text = false;
 
-  // Copies mode and hold_translation in; throws on a malformed one.
-  bool Check();
+  // Throws on a malformed mode or hold_translation.
+  bool Check() const;
+  // `adjuster` with `mode` and `hold_translation` parsed into it.
+  JointAdjusterOptions AdjusterOptions() const;
 };
 void AddJointAdjusterOptions(const std::string& prefix,
                              colmap::OptionManager* manager,

@@ -72,7 +72,7 @@ std::map<std::string, Eigen::Vector3d> StationCameraPositions(
     const std::string& registration_path, const colmap::Rigid3d& cam_from_lidar);
 
 // `dataset` with each station's cloud replaced by the one lidar_registrator wrote for it:
-// `registration_path`/static/<station>.pcd (--remove_moving_points 1: moving objects left out), else
+// `registration_path`/static/<station>.pcd (--remove_moving_points on: moving objects left out), else
 // `registration_path`/deskewed/<station>.pcd (--deskew_sweeps 1). An empty path changes nothing.
 StationDataset WithRegistratorClouds(StationDataset dataset, const std::string& registration_path);
 
