@@ -14,10 +14,10 @@
 // IJCV 1996; Yang et al., RA-L 2020): its ICP runs with the kernel's scale at 3 sigma, then sigma,
 // then the sigma / 3 of every frame, each from the last. With only the narrow kernel, the points
 // that show a platform already moving at driving speed (poles, the ends of parked cars) sit in the
-// kernel's tail, and along a street whose facades hold the travel weakly the ICP stops near rest. Every frame gets a pose. Its information is measured point-to-plane
-// against the map; a frame whose weakest constrained direction is below `degenerate_ratio` of its
-// strongest (a tunnel, a street of bare facades) is flagged with that direction, never silently
-// accepted.
+// kernel's tail, and along a street whose facades hold the travel weakly the ICP stops near rest.
+// Every frame gets a pose. Its information is measured point-to-plane against the map; a frame
+// whose weakest constrained direction is below `degenerate_ratio` of its strongest (a tunnel, a
+// street of bare facades) is flagged with that direction, never silently accepted.
 #pragma once
 
 #include "lidar/adaptive_threshold.h"

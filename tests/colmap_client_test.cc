@@ -1,8 +1,8 @@
 // The real `colmap` executable as a client: databases that carry our tables stay usable by COLMAP, and
 // COLMAP's own SIFT pipeline finds and verifies matches between neighbouring simulated stations.
+#include "bridge/simulation/simulate_dataset.h"
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/station_dataset.h"
-#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

@@ -1,8 +1,8 @@
 // calibrate_edges (Levinson & Thrun's baseline) through the CLI: what it writes, and what it refuses.
 // Its accuracy is checked on real data (tests/kitti_sample_test.cc): on the simulator's textured
 // surfaces the edge objective is flat (docs/edge_calibration.md).
-#include "colmap_ext/station_dataset.h"
 #include "bridge/simulation/simulate_dataset.h"
+#include "colmap_ext/station_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

@@ -1,9 +1,9 @@
 // evaluate_trajectory through the CLI on the simulator's drive (sim::MakeStations, the street, 40
 // frames): the true camera trajectory with an injected 1 % scale error and a yaw drift of
 // 0.01 deg/m must read back as such; bad inputs give one clear error and no output.
-#include "colmap_ext/station_dataset.h"
 #include "bridge/simulation/scene.h"
 #include "bridge/simulation/sensor_pod.h"
+#include "colmap_ext/station_dataset.h"
 #include "tests/testing/distorted_trajectory.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"

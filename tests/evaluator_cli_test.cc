@@ -1,7 +1,7 @@
 // The evaluators through the CLI, on simulated data: ~0 for the truth, the known value for known errors.
+#include "bridge/simulation/simulate_dataset.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
-#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

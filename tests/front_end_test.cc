@@ -2,11 +2,11 @@
 // stereo_depth, depth_prior_extractor; accuracy against the simulator's ground truth; COLMAP's own
 // mapper on the imported database; bad input.
 #include "bridge/initialization/lidar_registration_files.h"
+#include "bridge/simulation/scene.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/statistics.h"
-#include "bridge/simulation/scene.h"
-#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/file_bytes.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"

@@ -2,8 +2,8 @@
 // import_dataset -> depth_prior_extractor -> an initial model (true poses perturbed, landmarks
 // triangulated by the real `colmap point_triangulator`) -> joint_adjuster; accuracy against ground truth.
 #include "bridge/evaluation/calibration_evaluation.h"
-#include "colmap_ext/station_dataset.h"
 #include "bridge/simulation/simulate_dataset.h"
+#include "colmap_ext/station_dataset.h"
 #include "tests/testing/file_bytes.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"

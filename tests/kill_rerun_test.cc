@@ -5,8 +5,8 @@
 // where a result belongs, and a rerun on the same workspace finishes and gives the uninterrupted run's
 // cam_from_lidar within the run-to-run spread of COLMAP's feature matching (our own steps are
 // deterministic; docs/reliability.md).
-#include "colmap_ext/station_dataset.h"
 #include "bridge/simulation/simulate_dataset.h"
+#include "colmap_ext/station_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

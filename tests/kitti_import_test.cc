@@ -3,10 +3,10 @@
 // published format with a generic R_rect_00 and KITTI-like P_rect offsets): the import must give back
 // the simulator's truth (extrinsic to 1e-9, intrinsics, baseline, frames), select frames, and refuse bad
 // drives naming the file, leaving nothing behind. The real sample is in kitti_sample_test.cc.
-#include "colmap_ext/station_dataset.h"
-#include "lidar/cloud_io.h"
 #include "bridge/simulation/sensor_pod.h"
 #include "bridge/simulation/simulate_dataset.h"
+#include "colmap_ext/station_dataset.h"
+#include "lidar/cloud_io.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

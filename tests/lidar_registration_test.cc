@@ -1,5 +1,6 @@
 // Pairwise LiDAR registration (BSC + RANSAC + point-to-plane ICP) on simulated station clouds with
 // range noise, against the simulator's ground truth.
+#include "bridge/simulation/simulate_dataset.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
@@ -7,7 +8,6 @@
 #include "lidar/pair_registration.h"
 #include "lidar/revisit_closure.h"
 #include "lidar/station_cloud.h"
-#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 

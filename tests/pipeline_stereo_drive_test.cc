@@ -3,8 +3,8 @@
 // direction coarse (2.5 deg off) and the translation at 0; the pose initialiser's stereo-LiDAR
 // alignment (each station's stereo depth against its own LiDAR cloud, no motion needed) gives the
 // start, and the joint adjustment refines it. Evaluated against the simulator's truth.
-#include "colmap_ext/station_dataset.h"
 #include "bridge/simulation/simulate_dataset.h"
+#include "colmap_ext/station_dataset.h"
 #include "tests/testing/pipeline_fixture.h"
 #include "tests/testing/scoped_temp_dir.h"
 

@@ -1,10 +1,10 @@
 // plan_survey through the CLI: a plan whose stations all rotate about the vertical is told that the
 // translation along that axis (camera y) is missing, and that a tilted extra station fixes it; bad
 // plans are refused with the file named and nothing written.
-#include "colmap_ext/station_dataset.h"
-#include "lidar/cloud_io.h"
 #include "bridge/simulation/scene.h"
 #include "bridge/simulation/sensor_pod.h"
+#include "colmap_ext/station_dataset.h"
+#include "lidar/cloud_io.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"
 
