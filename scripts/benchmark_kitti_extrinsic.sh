@@ -80,6 +80,8 @@ for rig in stereo mono; do
   tail -1 "$results"
 done
 mkdir -p docs/benchmarks
+python3 scripts/kitti_reference_uncertainty.py "$PWD/../shared/data/kitti_raw_2011_09_28_sample/calibration" \
+  "$kSample/calib.txt" > "$work/reference.tsv"
 python3 scripts/kitti_extrinsic_table.py "$results" "${GUESS_DEG:-2}" "${GUESS_M:-0.05}" \
-  > docs/benchmarks/kitti_extrinsic.md
+  "$work/reference.tsv" > docs/benchmarks/kitti_extrinsic.md
 echo "Wrote docs/benchmarks/kitti_extrinsic.md"
