@@ -19,13 +19,4 @@ Matrix6d WhiteningOfCovariance(const Matrix6d& covariance) {
   return factor.matrixL().solve(Matrix6d::Identity());
 }
 
-Matrix6d WhiteningOfHeldDirections(const Eigen::Matrix3d& rotation_projection,
-                                   const Eigen::Matrix3d& translation_projection,
-                                   double sigma) {
-  Matrix6d whitening = Matrix6d::Zero();
-  whitening.topLeftCorner<3, 3>() = rotation_projection / sigma;
-  whitening.bottomRightCorner<3, 3>() = translation_projection / sigma;
-  return whitening;
-}
-
 }  // namespace colmap_lidar

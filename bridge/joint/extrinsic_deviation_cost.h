@@ -2,11 +2,9 @@
 //
 //   E_x = W [rotvec(R R_0^-1); t - t_0]    (6 residuals; rotation [rad] about the camera axes)
 //
-// Two uses in the joint problem (neither in the cost of Zhen et al. 2019):
-// - a measurement of T_e made outside the problem (the stereo-LiDAR alignment of the pose
-//   initialiser), W = the square root of its information (the inverse of its covariance);
-// - directions held at their initial value, W = [P_r 0; 0 P_t] / sigma with P_r, P_t projections onto
-//   the held directions and a tiny sigma (rows of zero where nothing is held).
+// In the joint problem (not in the cost of Zhen et al. 2019) it is outside knowledge of T_e: rig.json's
+// guess with its sigmas, or a fit to data no other term sees (the vertical alignment of image line
+// segments), W = the square root of its information (the inverse of its covariance).
 // Parameter blocks (COLMAP's layout): cam_from_lidar rotation [4] (Eigen quaternion, xyzw in memory)
 // and translation [3].
 #pragma once
@@ -63,11 +61,5 @@ class ExtrinsicDeviationCostFunctor {
 // W of a covariance (rotation [rad] about the camera axes, then translation [m]): W^T W = covariance^-1.
 // Throws std::invalid_argument unless the covariance is symmetric positive definite.
 Matrix6d WhiteningOfCovariance(const Matrix6d& covariance);
-
-// W that holds the directions of the projections P_r, P_t (sums of d d^T over unit directions in the
-// camera frame) with standard deviation `sigma` and leaves the others free.
-Matrix6d WhiteningOfHeldDirections(const Eigen::Matrix3d& rotation_projection,
-                                   const Eigen::Matrix3d& translation_projection,
-                                   double sigma);
 
 }  // namespace colmap_lidar

@@ -56,22 +56,6 @@ TEST(ExtrinsicDeviationCost, ZeroAtTheReferenceAndTheMahalanobisDistanceOffIt) {
   EXPECT_LT(mahalanobis, 4.5);
 }
 
-TEST(ExtrinsicDeviationCost, HeldDirectionsOnlySeeTheirOwnDeviation) {
-  const Extrinsic reference;
-  Eigen::Matrix3d held_translation = Eigen::Matrix3d::Zero();
-  held_translation(1, 1) = 1;  // camera y only
-  std::unique_ptr<ceres::CostFunction> cost(ExtrinsicDeviationCostFunctor::Create(
-      reference.rotation,
-      reference.translation,
-      WhiteningOfHeldDirections(Eigen::Matrix3d::Zero(), held_translation, 0.001)));
-  Extrinsic moved = reference;
-  moved.rotation = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()) * reference.rotation;
-  moved.translation += Eigen::Vector3d(0.5, 0.002, -0.3);
-  const Eigen::Matrix<double, 6, 1> residuals = Residuals(cost.get(), moved);
-  EXPECT_NEAR(residuals(4), 2.0, 1e-9);
-  EXPECT_NEAR(residuals.norm(), 2.0, 1e-9);
-}
-
 TEST(ExtrinsicDeviationCost, AutodiffJacobianMatchesNumericDifferences) {
   Extrinsic reference;
   std::unique_ptr<ceres::CostFunction> cost(ExtrinsicDeviationCostFunctor::Create(

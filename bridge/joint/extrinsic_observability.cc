@@ -1,5 +1,6 @@
 #include "bridge/joint/extrinsic_observability.h"
 
+#include "bridge/joint/subspace_manifold.h"
 #include "colmap_ext/logging.h"
 
 #include <Eigen/Eigenvalues>
@@ -194,39 +195,57 @@ constexpr double kMaxVariance = 1e8;
 // this (sigma 1 m or 1000 deg) is unobservable, whatever any prior says.
 constexpr double kUnobservableVariance = 1e6;
 
-// The variable parameter blocks in Jacobian column order, T_e last, and where T_e's tangent columns go
-// in the 6-vector (rotation 0..2, translation 3..5).
+// The variable parameter blocks in Jacobian column order, T_e last, and what T_e's tangent columns
+// are in the reported 6-vector (rotation [deg] 0..2, translation [mm] 3..5): column j of the tangent
+// is scale[j] reported units along the unit 6-vector directions.col(j). Held directions of T_e are no
+// columns (a subspace manifold), so they get no variance.
 struct ColumnLayout {
   std::vector<double*> blocks;
   int num_other = 0;
-  std::vector<int> extrinsic_index;
+  Eigen::MatrixXd directions = Eigen::MatrixXd(6, 0);
+  Eigen::VectorXd scale;
 };
 
-ColumnLayout MakeColumnLayout(ceres::Problem* problem,
-                              double* rotation,
-                              double* translation,
+// Appends T_e block's free tangent columns: `basis` (3 x m) placed at rows `offset`..offset+2.
+void AppendExtrinsicColumns(const Eigen::MatrixXd& basis,
+                            int offset,
+                            double unit,
+                            ColumnLayout* layout) {
+  const Eigen::Index m = layout->directions.cols();
+  layout->directions.conservativeResize(6, m + basis.cols());
+  layout->directions.rightCols(basis.cols()).setZero();
+  layout->directions.block(offset, m, 3, basis.cols()) = basis;
+  layout->scale.conservativeResize(m + basis.cols());
+  layout->scale.tail(basis.cols()).setConstant(unit);
+}
+
+ColumnLayout MakeColumnLayout(const ExtrinsicUncertaintyInputs& inputs,
                               bool rotation_free,
-                              bool translation_free,
-                              const std::array<bool, 3>& held_translation) {
+                              bool translation_free) {
   ColumnLayout layout;
+  ceres::Problem* problem = inputs.problem;
   std::vector<double*> blocks;
   problem->GetParameterBlocks(&blocks);
   for (double* block : blocks) {
-    if (block == rotation || block == translation || problem->IsParameterBlockConstant(block)) {
+    if (block == inputs.cam_from_lidar_rotation || block == inputs.cam_from_lidar_translation ||
+        problem->IsParameterBlockConstant(block)) {
       continue;
     }
     layout.blocks.push_back(block);
     layout.num_other += problem->ParameterBlockTangentSize(block);
   }
   if (rotation_free) {
-    layout.blocks.push_back(rotation);
-    layout.extrinsic_index.insert(layout.extrinsic_index.end(), {0, 1, 2});
+    layout.blocks.push_back(inputs.cam_from_lidar_rotation);
+    THROW_CHECK_EQ(problem->ParameterBlockTangentSize(inputs.cam_from_lidar_rotation),
+                   FreeDirectionsBasis(inputs.held_rotation).cols());
+    AppendExtrinsicColumns(
+        FreeDirectionsBasis(inputs.held_rotation), 0, kTangentToRotationDeg, &layout);
   }
   if (translation_free) {
-    layout.blocks.push_back(translation);
-    for (int i = 0; i < 3; ++i) {
-      if (!held_translation[i]) layout.extrinsic_index.push_back(3 + i);
-    }
+    layout.blocks.push_back(inputs.cam_from_lidar_translation);
+    THROW_CHECK_EQ(problem->ParameterBlockTangentSize(inputs.cam_from_lidar_translation),
+                   FreeDirectionsBasis(inputs.held_translation).cols());
+    AppendExtrinsicColumns(FreeDirectionsBasis(inputs.held_translation), 3, 1000.0, &layout);
   }
   return layout;
 }
@@ -277,7 +296,7 @@ JacobianRows EvaluateRows(
   ceres::CRSMatrix crs;
   problem->Evaluate(evaluate_options, &cost, &rows.residuals, nullptr, &crs);
   THROW_CHECK_EQ(static_cast<size_t>(crs.num_rows), rows.cluster.size());
-  THROW_CHECK_EQ(crs.num_cols, layout.num_other + static_cast<int>(layout.extrinsic_index.size()));
+  THROW_CHECK_EQ(crs.num_cols, layout.num_other + static_cast<int>(layout.directions.cols()));
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(crs.values.size());
   for (int row = 0; row < crs.num_rows; ++row) {
@@ -307,34 +326,25 @@ bool MarginalInformation(const Eigen::SparseMatrix<double>& information,
   return true;
 }
 
-// Tangent -> reported units. Ceres' EigenQuaternionManifold tangent delta rotates by 2|delta|
-// (q_delta = (cos|delta|, sin|delta| delta/|delta|)): the rotation vector is 2 delta.
-double ReportedUnit(int index) { return index < 3 ? kTangentToRotationDeg : 1000.0; }
+// A covariance of the scaled free directions (m x m, reported units) as the reported 6x6.
+Matrix6 ToReported(const Eigen::MatrixXd& covariance, const ColumnLayout& layout) {
+  return layout.directions * covariance * layout.directions.transpose();
+}
 
-// A tangent-space matrix (free components) scattered into the 6x6 reported units; `power` -1 for an
-// information matrix, +1 for a covariance. Held components get `fill` on the diagonal.
-Matrix6 ToReportedUnits(const Eigen::MatrixXd& matrix,
-                        const std::vector<int>& extrinsic_index,
-                        int power,
-                        double fill) {
-  Matrix6 result = Matrix6::Zero();
-  for (int i = 0; i < 6; ++i) result(i, i) = fill;
-  for (size_t a = 0; a < extrinsic_index.size(); ++a) {
-    for (size_t b = 0; b < extrinsic_index.size(); ++b) {
-      const int i = extrinsic_index[a], j = extrinsic_index[b];
-      result(i, j) = matrix(a, b) * std::pow(ReportedUnit(i) * ReportedUnit(j), power);
-    }
-  }
-  return result;
+// A tangent-space matrix in reported units along the free directions: covariances are multiplied by
+// the scales on both sides, information matrices divided.
+Eigen::MatrixXd ScaleTangent(const Eigen::MatrixXd& matrix, const ColumnLayout& layout, int power) {
+  const Eigen::VectorXd scale = power > 0 ? layout.scale : layout.scale.cwiseInverse();
+  return scale.asDiagonal() * matrix * scale.asDiagonal();
 }
 
 // The pseudo-inverse of an information matrix (whitened residuals) times the variance factor. A
 // direction whose nominal variance 1/lambda exceeds kUnobservableVariance has no information from the
 // data and gets the cap, whatever the factor (exact data has a factor near 0).
-Matrix6 CovarianceFromInformation(const Matrix6& information, double factor) {
-  Eigen::SelfAdjointEigenSolver<Matrix6> eigen(information);
-  Matrix6 covariance = Matrix6::Zero();
-  for (int k = 0; k < 6; ++k) {
+Eigen::MatrixXd CovarianceFromInformation(const Eigen::MatrixXd& information, double factor) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(information);
+  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(information.rows(), information.cols());
+  for (int k = 0; k < information.rows(); ++k) {
     const double lambda = eigen.eigenvalues()[k];
     const double variance =
         lambda * kUnobservableVariance > 1 ? std::min(factor / lambda, kMaxVariance) : kMaxVariance;
@@ -428,7 +438,6 @@ std::vector<std::string> NameUnobservable(const ExtrinsicUncertainty& result,
                                           const MotionAnalysis& motion,
                                           const ObservabilityOptions& options) {
   std::vector<std::string> sentences;
-  int num_unobservable_translation = 0;
   for (int k = 5; k >= 0; --k) {
     const Eigen::Matrix<double, 6, 1> v = result.eigenvectors.col(k);
     const double sigma = result.eigenvalues[k];
@@ -439,7 +448,6 @@ std::vector<std::string> NameUnobservable(const ExtrinsicUncertainty& result,
     std::ostringstream sentence;
     sentence << std::setprecision(3);
     if (translation) {
-      ++num_unobservable_translation;
       sentence << "translation along " << DescribeAxis(v.tail<3>()) << " is unobservable (sigma "
                << sigma << " mm): ";
     } else {
@@ -448,10 +456,6 @@ std::vector<std::string> NameUnobservable(const ExtrinsicUncertainty& result,
     }
     sentence << Advice(motion);
     sentences.push_back(sentence.str());
-  }
-  if (num_unobservable_translation == 3) {
-    sentences.insert(sentences.begin(),
-                     "all translation of cam_from_lidar is unobservable: " + Advice(motion));
   }
   return sentences;
 }
@@ -469,11 +473,9 @@ void AddClusterRobustCovariance(const JacobianRows& rows,
   if (!cluster_robust) return;
   const Eigen::MatrixXd& sandwich = cluster_robust->sandwich;
   const Eigen::VectorXd& scale_sensitivity = cluster_robust->scale_sensitivity;
-  for (size_t a = 0; a < layout.extrinsic_index.size(); ++a) {
-    result->stereo_scale_sensitivity[layout.extrinsic_index[a]] =
-        scale_sensitivity[a] * ReportedUnit(layout.extrinsic_index[a]);
-  }
-  Matrix6 robust = ToReportedUnits(sandwich, layout.extrinsic_index, 1, 0.0);
+  result->stereo_scale_sensitivity =
+      layout.directions * layout.scale.cwiseProduct(scale_sensitivity);
+  Matrix6 robust = ToReported(ScaleTangent(sandwich, layout, 1), layout);
   // Directions the data leaves undetermined keep the formal (capped) variance.
   Eigen::SelfAdjointEigenSolver<Matrix6> formal(result->formal_covariance);
   for (int k = 0; k < 6; ++k) {
@@ -489,6 +491,37 @@ void AddClusterRobustCovariance(const JacobianRows& rows,
   result->num_clusters = static_cast<int>(inputs.clusters.size());
 }
 
+// The directions held because the data do not determine them: one sentence each (before the others:
+// their standard deviation is unbounded), the camera axes lying mostly in them marked undetermined.
+void NameUndetermined(const ExtrinsicUncertaintyInputs& inputs,
+                      const MotionAnalysis& motion,
+                      ExtrinsicUncertainty* result) {
+  std::vector<std::string> sentences;
+  for (int block = 0; block < 2; ++block) {
+    const Eigen::Matrix3d& held =
+        block == 0 ? inputs.undetermined_rotation : inputs.undetermined_translation;
+    const Eigen::MatrixXd directions = HeldDirectionsOf(held);
+    for (int k = 0; k < directions.cols(); ++k) {
+      sentences.push_back((block == 0 ? "rotation about " : "translation along ") +
+                          DescribeAxis(directions.col(k)) +
+                          " is unobservable (held at its start, no sigma): " + Advice(motion));
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      result->undetermined[3 * block + axis] = held(axis, axis) > 0.5;
+    }
+  }
+  result->unobservable.insert(result->unobservable.begin(), sentences.begin(), sentences.end());
+  const auto is_translation = [](const std::string& sentence) {
+    return sentence.rfind("translation along ", 0) == 0;
+  };
+  if (std::count_if(result->unobservable.begin(), result->unobservable.end(), is_translation) ==
+      3) {
+    result->unobservable.insert(
+        result->unobservable.begin(),
+        "all translation of cam_from_lidar is unobservable: " + Advice(motion));
+  }
+}
+
 }  // namespace
 
 std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform) {
@@ -500,24 +533,6 @@ std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform
          "): on simulated 40-frame street drives the errors reached 3 of these sigmas with the "
          "vertical alignment (the rotation about the driving direction), 5-8 without it; read "
          "them as lower bounds";
-}
-
-void RestrictToFreeDirections(const Eigen::Matrix3d& held_rotation,
-                              const Eigen::Matrix3d& held_translation,
-                              ExtrinsicUncertainty* uncertainty) {
-  Matrix6 held = Matrix6::Zero();
-  held.topLeftCorner<3, 3>() = held_rotation;
-  held.bottomRightCorner<3, 3>() = held_translation;
-  if (held.isZero()) return;
-  const Matrix6 free = Matrix6::Identity() - held;
-  uncertainty->covariance = free * uncertainty->covariance * free.transpose();
-  uncertainty->formal_covariance = free * uncertainty->formal_covariance * free.transpose();
-  Eigen::SelfAdjointEigenSolver<Matrix6> eigen(uncertainty->covariance);
-  for (int k = 0; k < 6; ++k) {
-    uncertainty->eigenvalues[k] = std::sqrt(std::max(eigen.eigenvalues()[k], 0.0));
-    uncertainty->eigenvectors.col(k) = eigen.eigenvectors().col(k);
-    uncertainty->undetermined[k] = held(k, k) > 0.5;
-  }
 }
 
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInputs& inputs,
@@ -536,12 +551,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInput
     result.message = "cam_from_lidar is held constant in this mode";
     return result;
   }
-  const ColumnLayout layout = MakeColumnLayout(problem,
-                                               cam_from_lidar_rotation,
-                                               cam_from_lidar_translation,
-                                               rotation_free,
-                                               translation_free,
-                                               inputs.held_translation);
+  const ColumnLayout layout = MakeColumnLayout(inputs, rotation_free, translation_free);
   const JacobianRows rows = EvaluateRows(problem,
                                          layout,
                                          clusters,
@@ -560,15 +570,16 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInput
         "T_e)";
     return result;
   }
-  // Formal covariance from the data alone (no prior): held components are known exactly.
+  // Formal covariance from the data alone (no prior); held directions are no parameters.
   double squared_norm = 0;
   for (int row = 0; row < rows.num_data_rows; ++row)
     squared_norm += rows.residuals[row] * rows.residuals[row];
   const int redundancy = rows.num_data_rows + static_cast<int>(inputs.hidden_residuals) -
                          static_cast<int>(information.cols());
   result.variance_factor = redundancy > 0 ? squared_norm / redundancy : 1.0;
-  result.formal_covariance = CovarianceFromInformation(
-      ToReportedUnits(marginal, layout.extrinsic_index, -1, 1e30), result.variance_factor);
+  result.formal_covariance = ToReported(
+      CovarianceFromInformation(ScaleTangent(marginal, layout, -1), result.variance_factor),
+      layout);
   result.covariance = result.formal_covariance;
 
   AddClusterRobustCovariance(rows, information, layout, inputs, options, &result);
@@ -580,6 +591,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInput
   }
   result.computed = true;
   result.unobservable = NameUnobservable(result, motion, options);
+  NameUndetermined(inputs, motion, &result);
   return result;
 }
 

@@ -68,13 +68,6 @@ struct ExtrinsicUncertainty {
   std::array<bool, 6> undetermined = {false, false, false, false, false, false};
 };
 
-// Restricts the covariances of `uncertainty` to the complement of the held directions (projections
-// in the camera frame, rotation then translation): held directions get no variance, and the axes
-// lying mostly in them are marked undetermined.
-void RestrictToFreeDirections(const Eigen::Matrix3d& held_rotation,
-                              const Eigen::Matrix3d& held_translation,
-                              ExtrinsicUncertainty* uncertainty);
-
 struct MotionAnalysis {
   int num_stations = 0;
   int num_rotating_pairs = 0;     // relative rotation above 2 deg
@@ -116,8 +109,15 @@ struct ExtrinsicUncertaintyInputs {
   ceres::Problem* problem = nullptr;
   double* cam_from_lidar_rotation = nullptr;
   double* cam_from_lidar_translation = nullptr;
-  // Translation components held constant by a subset manifold (known exactly).
-  std::array<bool, 3> held_translation = {false, false, false};
+  // Projections (sums of d d^T over orthonormal camera-frame directions d) onto the directions of
+  // T_e's rotation and translation held at their start: the blocks' manifolds are subspace
+  // manifolds without them (bridge/joint/subspace_manifold.h), so they get no variance.
+  Eigen::Matrix3d held_rotation = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d held_translation = Eigen::Matrix3d::Zero();
+  // Of those, the ones held because the data do not determine them (the rest are held by the
+  // user): named in `unobservable`, and the axes lying mostly in them marked undetermined.
+  Eigen::Matrix3d undetermined_rotation = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d undetermined_translation = Eigen::Matrix3d::Zero();
   // Every data residual block of the problem, grouped (see above).
   std::vector<std::vector<ceres::ResidualBlockId>> clusters;
   // Empty, or per cluster two group keys (a LiDAR pair's target and source station; -1: the

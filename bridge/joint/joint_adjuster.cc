@@ -8,6 +8,7 @@
 #include "bridge/joint/lidar_pair_cost.h"
 #include "bridge/joint/lidar_point_to_plane_cost.h"
 #include "bridge/joint/start_departure.h"
+#include "bridge/joint/subspace_manifold.h"
 #include "colmap_ext/depth_prior_cost.h"
 #include "colmap_ext/elapsed.h"
 #include "colmap_ext/logging.h"
@@ -256,38 +257,53 @@ void AddDepthPriorBlocks(const RunState& state, JointProblem* joint) {
   }
 }
 
-// The shared T_e blocks, the degrees of freedom held, and the weak translation prior.
+// Projection onto the translation directions held at the start: the user's axes and the
+// directions the data do not determine.
+Eigen::Matrix3d HeldTranslation(const RunState& state) {
+  Eigen::Matrix3d held = state.held_translation;
+  for (int i = 0; i < 3; ++i) {
+    if (state.options.hold_translation[i]) held(i, i) = 1;
+  }
+  const Eigen::MatrixXd directions = HeldDirectionsOf(held);
+  return directions * directions.transpose();
+}
+
+// Projection onto the rotation directions held at the start (all of them with hold_rotation).
+Eigen::Matrix3d HeldRotation(const RunState& state) {
+  return state.options.hold_rotation ? Eigen::Matrix3d::Identity() : state.held_rotation;
+}
+
+// A T_e block: constant when nothing of it is free, else its manifold without the held directions.
+void SetExtrinsicManifold(const Eigen::Matrix3d& held,
+                          std::unique_ptr<ceres::Manifold> manifold,
+                          double* block,
+                          ceres::Problem* problem) {
+  const Eigen::MatrixXd free = FreeDirectionsBasis(held);
+  if (free.cols() == 0) {
+    problem->SetParameterBlockConstant(block);
+  } else if (free.cols() == 3) {
+    problem->SetManifold(block, manifold.release());
+  } else {
+    problem->SetManifold(block, new SubspaceManifold(std::move(manifold), free));
+  }
+}
+
+// The shared T_e blocks, the degrees of freedom held (exactly: they are not in the blocks'
+// tangent spaces), and the weak translation prior.
 void AddExtrinsicBlocks(const RunState& state, JointProblem* joint) {
   ceres::Problem* problem = joint->problem.get();
   double* rotation = state.ExtrinsicRotation();
   double* translation = state.ExtrinsicTranslation();
   problem->AddParameterBlock(rotation, 4);
-  colmap::SetQuaternionManifold(problem, rotation);
   problem->AddParameterBlock(translation, 3);
-  if (!state.refine_extrinsic || state.options.hold_rotation) {
-    problem->SetParameterBlockConstant(rotation);
-  }
-  std::vector<int> held;
-  for (int i = 0; i < 3; ++i) {
-    if (state.options.hold_translation[i]) held.push_back(i);
-  }
-  if (!state.refine_extrinsic || held.size() == 3) {
-    problem->SetParameterBlockConstant(translation);
-  } else if (!held.empty()) {
-    colmap::SetSubsetManifold(3, held, problem, translation);
-  }
-  if (state.refine_extrinsic &&
-      (state.held_rotation.squaredNorm() > 0 || state.held_translation.squaredNorm() > 0)) {
-    constexpr double kHoldSigma = 1e-7;  // [rad], [m]: effectively constant
-    joint->prior_ids.push_back(problem->AddResidualBlock(
-        ExtrinsicDeviationCostFunctor::Create(
-            state.initial_rotation,
-            state.initial_translation,
-            WhiteningOfHeldDirections(state.held_rotation, state.held_translation, kHoldSigma)),
-        nullptr,
-        rotation,
-        translation));
-  }
+  const Eigen::Matrix3d all = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d held_translation = state.refine_extrinsic ? HeldTranslation(state) : all;
+  SetExtrinsicManifold(state.refine_extrinsic ? HeldRotation(state) : all,
+                       std::make_unique<ceres::EigenQuaternionManifold>(),
+                       rotation,
+                       problem);
+  SetExtrinsicManifold(
+      held_translation, std::make_unique<ceres::EuclideanManifold<3>>(), translation, problem);
   for (const ExtrinsicMeasurement& measurement : state.data.extrinsic_measurements) {
     if (!state.refine_extrinsic) break;
     joint->measurement_ids.push_back(problem->AddResidualBlock(
@@ -298,7 +314,8 @@ void AddExtrinsicBlocks(const RunState& state, JointProblem* joint) {
         rotation,
         translation));
   }
-  if (state.refine_extrinsic && held.size() < 3 && state.options.extrinsic_prior_sigma_m > 0) {
+  if (!problem->IsParameterBlockConstant(translation) &&
+      state.options.extrinsic_prior_sigma_m > 0) {
     joint->prior_ids.push_back(problem->AddResidualBlock(
         ExtrinsicTranslationPriorCostFunctor::Create(state.initial_translation,
                                                      state.options.extrinsic_prior_sigma_m),
@@ -828,7 +845,10 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
   inputs.problem = joint.problem.get();
   inputs.cam_from_lidar_rotation = state.ExtrinsicRotation();
   inputs.cam_from_lidar_translation = state.ExtrinsicTranslation();
-  inputs.held_translation = state.options.hold_translation;
+  inputs.held_rotation = HeldRotation(state);
+  inputs.held_translation = HeldTranslation(state);
+  inputs.undetermined_rotation = state.held_rotation;
+  inputs.undetermined_translation = state.held_translation;
   for (size_t k = 0; k < joint.depth_ids.size(); ++k) {
     inputs.depth_scale_derivative[joint.depth_ids[k]] = joint.depth_scale_derivatives[k];
   }
@@ -842,7 +862,6 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
   inputs.hidden_residuals = joint.num_hidden_residuals;
   ExtrinsicUncertainty uncertainty =
       ComputeExtrinsicUncertainty(inputs, motion, state.options.observability);
-  RestrictToFreeDirections(state.held_rotation, state.held_translation, &uncertainty);
   if (joint.reprojection_ids.empty() && joint.depth_ids.empty()) {
     uncertainty.unobservable.insert(
         uncertainty.unobservable.begin(),
