@@ -39,8 +39,15 @@ struct StationRig {
     double translation_m = 0;
   };
   std::optional<GuessSigma> cam_from_lidar_guess_sigma;
-  std::string lidar_model;         // e.g. "VLP-16"; empty if not given
-  double lidar_range_noise_m = 0;  // 0 if not given
+  std::string lidar_model;  // e.g. "VLP-16"; empty if not given
+  // The LiDAR's range noise (1 sigma) [m]; 0 if not given. The one home of this quantity: the joint
+  // adjuster's nominal E_l sigma and the stereo-LiDAR alignments take LidarRangeNoiseM().
+  double lidar_range_noise_m = 0;
+  // A spinning LiDAR's typical range noise, used when rig.json gives none.
+  static constexpr double kDefaultLidarRangeNoiseM = 0.02;
+  double LidarRangeNoiseM() const {
+    return lidar_range_noise_m > 0 ? lidar_range_noise_m : kDefaultLidarRangeNoiseM;
+  }
   // "lidar": {"sweep": {"start_azimuth_deg": a, "counter_clockwise": b}}: each cloud is one revolution
   // of a rotating LiDAR on a moving platform (import_kitti writes it), which the pipeline de-skews.
   struct LidarSweep {

@@ -27,7 +27,8 @@ struct ExtrinsicAlignmentOptions {
   int max_iterations = 50;
   // only LiDAR samples with a planar neighbourhood (StationCloud::curvature at most this)
   double max_curvature = 0.05;
-  // LiDAR range noise [m], added in quadrature to each point's depth sigma along the normal
+  // LiDAR range noise [m], added in quadrature to each point's depth sigma along the normal (the pose
+  // initialiser passes the rig's, rig.json lidar.range_noise_m)
   double sigma_lidar_m = 0.02;
   // Huber threshold in sigma units: residuals beyond it count linearly (edges, moving objects)
   double huber_sigmas = 2.0;

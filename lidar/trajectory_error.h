@@ -15,11 +15,16 @@
 
 #include <Eigen/Geometry>
 
+#include <string>
 #include <vector>
 
 namespace colmap_lidar {
 
 enum class TrajectoryAlignment { kRigid, kSimilarity };
+
+// "rigid" | "similarity" and back; an unknown name throws std::invalid_argument naming the choices.
+std::string TrajectoryAlignmentName(TrajectoryAlignment alignment);
+TrajectoryAlignment TrajectoryAlignmentFromName(const std::string& name);
 
 struct TrajectoryErrorOptions {
   // Segment lengths [m]; empty: 10, 20, ... up to the reference's path length (at most 800).

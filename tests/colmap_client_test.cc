@@ -147,14 +147,14 @@ TEST(CliTest, HelpVersionAndErrors) {
   EXPECT_NE(missing_db.output.find(dir.File("x.db")), std::string::npos) << missing_db.output;
   EXPECT_FALSE(fs::exists(dir.File("x.db"))) << "database_info must not create a database";
 
-  // A nested option check (the LiDAR noise inside the joint adjuster's options) is acted on: the
+  // A nested option check (the hold threshold inside the joint adjuster's options) is acted on: the
   // value is refused before any file is read.
   const auto bad_threshold =
       RunCommand(cli + " joint_adjuster --database_path " + dir.File("x.db") + " --input_path " +
                  dir.File("m") + " --dataset_path " + dir.File("d") + " --output_path " +
-                 dir.File("o") + " --sigma_lidar_m -1");
+                 dir.File("o") + " --hold_translation_mm -1");
   EXPECT_NE(bad_threshold.exit_code, 0);
-  EXPECT_NE(bad_threshold.output.find("sigma_lidar_m > 0"), std::string::npos)
+  EXPECT_NE(bad_threshold.output.find("hold_translation_mm > 0"), std::string::npos)
       << bad_threshold.output;
   EXPECT_FALSE(fs::exists(dir.File("o")));
 
@@ -169,6 +169,12 @@ TEST(CliTest, HelpVersionAndErrors) {
             std::string::npos)
       << removed.output;
   EXPECT_FALSE(fs::exists(dir.File("o")));
+  const auto removed_noise =
+      RunCommand(cli + " joint_adjuster --database_path " + dir.File("x.db") + " --input_path " +
+                 dir.File("m") + " --dataset_path " + dir.File("d") + " --output_path " +
+                 dir.File("o") + " --sigma_lidar_m 0.01");
+  EXPECT_NE(removed_noise.output.find("rig.json's lidar.range_noise_m"), std::string::npos)
+      << removed_noise.output;
   const auto removed_in_pipeline =
       RunCommand(cli + " pipeline --dataset_path " + dir.File("d") + " --workspace_path " +
                  dir.File("ws") + " --JointAdjuster.loss=cauchy");
@@ -178,7 +184,7 @@ TEST(CliTest, HelpVersionAndErrors) {
       << removed_in_pipeline.output;
   EXPECT_FALSE(fs::exists(dir.File("ws")));
   // The same in a project file (--project_path), in a section or at the top level.
-  std::ofstream(dir.File("project.ini")) << "[JointAdjuster]\nsigma_lidar_m=0.01\n"
+  std::ofstream(dir.File("project.ini")) << "[JointAdjuster]\nhold_translation_mm=30\n"
                                             "max_landmark_plane_sigmas = 2\n";
   const auto removed_in_project =
       RunCommand(cli + " pipeline --project_path " + dir.File("project.ini"));
@@ -192,7 +198,7 @@ TEST(CliTest, HelpVersionAndErrors) {
   // The pipeline registers every step's options under the step's section; a bad one is refused
   // before the workspace is created.
   const auto pipeline_help = RunCommand(cli + " pipeline --help");
-  for (const char* option : {"--JointAdjuster.sigma_lidar_m",
+  for (const char* option : {"--JointAdjuster.hold_translation_mm",
                              "--StereoDepth.block_size",
                              "--LidarRegistrator.max_neighbors arg (=4)",
                              "--Densifier.fill_holes",
@@ -201,9 +207,9 @@ TEST(CliTest, HelpVersionAndErrors) {
   }
   const auto bad_step_option =
       RunCommand(cli + " pipeline --dataset_path " + dir.File("d") + " --workspace_path " +
-                 dir.File("ws") + " --JointAdjuster.sigma_lidar_m -1");
+                 dir.File("ws") + " --JointAdjuster.hold_translation_mm -1");
   EXPECT_NE(bad_step_option.exit_code, 0);
-  EXPECT_NE(bad_step_option.output.find("sigma_lidar_m > 0"), std::string::npos)
+  EXPECT_NE(bad_step_option.output.find("hold_translation_mm > 0"), std::string::npos)
       << bad_step_option.output;
   EXPECT_FALSE(fs::exists(dir.File("ws")));
 }

@@ -135,7 +135,7 @@ JointResult RunJoint(const Workspace& ws, const std::string& output, const std::
                           ReadPoseFile(output + "/cam_from_lidar.txt"),
                           ReadNamedPoses(dataset.GroundTruthPath("cam_from_world.txt")),
                           reconstruction,
-                          /*similarity_alignment=*/false);
+                          TrajectoryAlignment::kRigid);
   std::cout << output << ": cam_from_lidar error "
             << result.evaluation.cam_from_lidar_rotation_error_deg << " deg, "
             << result.evaluation.cam_from_lidar_translation_error_mm << " mm (in camera: "

@@ -128,7 +128,7 @@ CalibrationEvaluation EvaluateCalibration(
     const colmap::Rigid3d& estimated_cam_from_lidar,
     const std::map<std::string, colmap::Rigid3d>& true_cam_from_world,
     const colmap::Reconstruction& reconstruction,
-    bool similarity_alignment) {
+    TrajectoryAlignment pose_alignment) {
   CalibrationEvaluation result;
   result.cam_from_lidar_rotation_error_deg =
       RotationErrorDeg(true_cam_from_lidar, estimated_cam_from_lidar);
@@ -138,16 +138,16 @@ CalibrationEvaluation EvaluateCalibration(
       result.cam_from_lidar_translation_error_in_cam_mm.norm();
 
   if (true_cam_from_world.empty()) {
-    result.alignment = "none";  // no true poses (a KITTI drive): the extrinsic only
-    return result;
+    return result;  // no true poses (a KITTI drive): the extrinsic only
   }
   const MatchedCameras cameras =
       MatchCameras(true_cam_from_world, reconstruction, &result.missing_stations);
   result.num_stations_evaluated = cameras.names.size();
   THROW_CHECK_GE(cameras.names.size(), 3) << "Fewer than 3 stations of the ground "
                                              "truth are registered in the model";
-  const Eigen::Matrix4d alignment = AlignCameraFrames(cameras, similarity_alignment);
-  result.alignment = similarity_alignment ? "similarity" : "rigid";
+  const Eigen::Matrix4d alignment =
+      AlignCameraFrames(cameras, pose_alignment == TrajectoryAlignment::kSimilarity);
+  result.alignment = pose_alignment;
   const Eigen::Matrix3d scaled_rotation = alignment.topLeftCorner<3, 3>();
   result.alignment_scale = std::cbrt(scaled_rotation.determinant());
   result.truth_from_model =

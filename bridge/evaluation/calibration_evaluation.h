@@ -6,10 +6,13 @@
 // centres alone leave the rotation about their line free on a straight drive). Station i is matched by name: the stem of the image name.
 #pragma once
 
+#include "lidar/trajectory_error.h"
+
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/reconstruction.h"
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,7 +22,8 @@ struct CalibrationEvaluation {
   double cam_from_lidar_rotation_error_deg = 0;
   double cam_from_lidar_translation_error_mm = 0;
   Eigen::Vector3d cam_from_lidar_translation_error_in_cam_mm = Eigen::Vector3d::Zero();
-  std::string alignment;  // "rigid" or "similarity"
+  // How the model's stations were aligned with the true ones; none without true poses.
+  std::optional<TrajectoryAlignment> alignment;
   double alignment_scale = 1;
   // The alignment's rotation and translation: true_world_from_model_world without the scale (the
   // transform evaluate_model applies to a dense model of this sparse model).
@@ -36,13 +40,13 @@ struct CalibrationEvaluation {
 double RotationErrorDeg(const colmap::Rigid3d& a, const colmap::Rigid3d& b);
 
 // With no true poses (`true_cam_from_world` empty, e.g. a KITTI drive), only the extrinsic is
-// evaluated: alignment "none", no station errors.
+// evaluated: no alignment, no station errors.
 CalibrationEvaluation EvaluateCalibration(
     const colmap::Rigid3d& true_cam_from_lidar,
     const colmap::Rigid3d& estimated_cam_from_lidar,
     const std::map<std::string, colmap::Rigid3d>& true_cam_from_world,
     const colmap::Reconstruction& reconstruction,
-    bool similarity_alignment);
+    TrajectoryAlignment alignment);
 
 // "left/000.png" -> "000"
 std::string StationOfImageName(const std::string& image_name);

@@ -50,14 +50,17 @@ class CalibrationEvaluationTest : public ::testing::Test {
 };
 
 TEST_F(CalibrationEvaluationTest, TruthGivesZeroWhateverTheModelGauge) {
-  const CalibrationEvaluation result = EvaluateCalibration(
-      cam_from_lidar_, cam_from_lidar_, truth_, ModelOfTruth(truth_, gauge_, 1.0), false);
+  const CalibrationEvaluation result = EvaluateCalibration(cam_from_lidar_,
+                                                           cam_from_lidar_,
+                                                           truth_,
+                                                           ModelOfTruth(truth_, gauge_, 1.0),
+                                                           TrajectoryAlignment::kRigid);
   EXPECT_EQ(result.num_stations_evaluated, 6u);
   EXPECT_NEAR(result.cam_from_lidar_rotation_error_deg, 0, 1e-9);
   EXPECT_NEAR(result.cam_from_lidar_translation_error_mm, 0, 1e-9);
   EXPECT_LT(result.max_position_error_mm, 1e-6);
   EXPECT_LT(result.max_rotation_error_deg, 1e-6);
-  EXPECT_EQ(result.alignment, "rigid");
+  EXPECT_EQ(result.alignment, TrajectoryAlignment::kRigid);
 }
 
 // Stations along a straight line whose estimated centres carry 1 mm of noise and whose
@@ -77,8 +80,8 @@ TEST_F(CalibrationEvaluationTest, AStraightDriveIsAlignedByTheCamerasAxesToo) {
     model.Image(id).CamFromWorld().translation +=
         Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
   }
-  const CalibrationEvaluation result =
-      EvaluateCalibration(cam_from_lidar_, cam_from_lidar_, straight, model, false);
+  const CalibrationEvaluation result = EvaluateCalibration(
+      cam_from_lidar_, cam_from_lidar_, straight, model, TrajectoryAlignment::kRigid);
   // Measured 0.0076 deg: the centres' noise over the axes' 4 m lever.
   EXPECT_LT(result.max_rotation_error_deg, 0.025);
   EXPECT_LT(result.max_position_error_mm, 5);
@@ -93,7 +96,7 @@ TEST_F(CalibrationEvaluationTest, KnownErrorsAreMeasured) {
   guess.translation += Eigen::Vector3d(0.03, 0, 0.04);
   colmap::Reconstruction model = ModelOfTruth(truth_, gauge_, 1.0);
   const CalibrationEvaluation result =
-      EvaluateCalibration(cam_from_lidar_, guess, truth_, model, false);
+      EvaluateCalibration(cam_from_lidar_, guess, truth_, model, TrajectoryAlignment::kRigid);
   EXPECT_NEAR(result.cam_from_lidar_rotation_error_deg, 3.0, 1e-9);
   EXPECT_NEAR(result.cam_from_lidar_translation_error_mm, 50.0, 1e-9);
   EXPECT_NEAR(result.cam_from_lidar_translation_error_in_cam_mm.z(), 40.0, 1e-9);
@@ -101,12 +104,12 @@ TEST_F(CalibrationEvaluationTest, KnownErrorsAreMeasured) {
 
 TEST_F(CalibrationEvaluationTest, ScaledModelNeedsSimilarityAlignment) {
   const colmap::Reconstruction model = ModelOfTruth(truth_, gauge_, 0.5);
-  const CalibrationEvaluation rigid =
-      EvaluateCalibration(cam_from_lidar_, cam_from_lidar_, truth_, model, false);
+  const CalibrationEvaluation rigid = EvaluateCalibration(
+      cam_from_lidar_, cam_from_lidar_, truth_, model, TrajectoryAlignment::kRigid);
   EXPECT_GT(rigid.mean_position_error_mm,
             100);  // the rigid alignment exposes the scale error
-  const CalibrationEvaluation similarity =
-      EvaluateCalibration(cam_from_lidar_, cam_from_lidar_, truth_, model, true);
+  const CalibrationEvaluation similarity = EvaluateCalibration(
+      cam_from_lidar_, cam_from_lidar_, truth_, model, TrajectoryAlignment::kSimilarity);
   EXPECT_NEAR(similarity.alignment_scale, 2.0, 1e-9);
   EXPECT_LT(similarity.max_position_error_mm, 1e-6);
 }
@@ -115,13 +118,16 @@ TEST_F(CalibrationEvaluationTest, MissingStationsAreReportedAndTooFewRejected) {
   auto partial = truth_;
   partial.erase("003");
   colmap::Reconstruction model = ModelOfTruth(partial, gauge_, 1.0);
-  const CalibrationEvaluation result =
-      EvaluateCalibration(cam_from_lidar_, cam_from_lidar_, truth_, model, false);
+  const CalibrationEvaluation result = EvaluateCalibration(
+      cam_from_lidar_, cam_from_lidar_, truth_, model, TrajectoryAlignment::kRigid);
   EXPECT_EQ(result.missing_stations, std::vector<std::string>{"003"});
   EXPECT_EQ(result.num_stations_evaluated, 5u);
   const std::map<std::string, colmap::Rigid3d> two = {*truth_.begin(), *truth_.rbegin()};
-  EXPECT_THROW(EvaluateCalibration(
-                   cam_from_lidar_, cam_from_lidar_, truth_, ModelOfTruth(two, gauge_, 1.0), false),
+  EXPECT_THROW(EvaluateCalibration(cam_from_lidar_,
+                                   cam_from_lidar_,
+                                   truth_,
+                                   ModelOfTruth(two, gauge_, 1.0),
+                                   TrajectoryAlignment::kRigid),
                std::invalid_argument);
 }
 

@@ -239,7 +239,7 @@ void WriteTrajectoryEvaluation(const std::string& output_path,
                                const TrajectoryErrorOptions& options) {
   PartialOutputFolder partial(output_path);
   nlohmann::json metrics = ErrorJson(error);
-  metrics["alignment"] = options.alignment == TrajectoryAlignment::kRigid ? "rigid" : "similarity";
+  metrics["alignment"] = TrajectoryAlignmentName(options.alignment);
   metrics["matched_by"] = matched.matched_by;
   metrics["num_estimate_unmatched"] = matched.num_estimate_unmatched;
   metrics["num_reference_unmatched"] = matched.num_reference_unmatched;

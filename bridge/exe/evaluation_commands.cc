@@ -143,8 +143,8 @@ nlohmann::json CalibrationMetricsJson(const CalibrationEvaluation& result) {
     metrics[std::string("cam_from_lidar_translation_error_") + "xyz"[k] + "_mm"] =
         result.cam_from_lidar_translation_error_in_cam_mm[k];
   }
-  if (result.alignment == "none") return metrics;
-  metrics["pose_alignment"] = result.alignment;
+  if (!result.alignment) return metrics;
+  metrics["pose_alignment"] = TrajectoryAlignmentName(*result.alignment);
   metrics["pose_alignment_scale"] = result.alignment_scale;
   metrics["num_stations_evaluated"] = result.num_stations_evaluated;
   metrics["missing_stations"] = result.missing_stations;
@@ -164,10 +164,10 @@ void PrintCalibrationEvaluation(const CalibrationEvaluation& result) {
   std::cout << std::fixed << std::setprecision(4) << "evaluate_calibration: cam_from_lidar error "
             << result.cam_from_lidar_rotation_error_deg << " deg, " << std::setprecision(2)
             << result.cam_from_lidar_translation_error_mm << " mm";
-  if (result.alignment == "none") {
+  if (!result.alignment) {
     std::cout << " (against the dataset's reference; no true station poses)" << std::endl;
   } else {
-    std::cout << "; station poses (" << result.alignment << " alignment, "
+    std::cout << "; station poses (" << TrajectoryAlignmentName(*result.alignment) << " alignment, "
               << result.num_stations_evaluated << " stations): mean "
               << result.mean_position_error_mm << " mm / " << std::setprecision(4)
               << result.mean_rotation_error_deg << " deg, max " << std::setprecision(2)
@@ -237,7 +237,11 @@ int RunEvaluateCalibration(int argc, char** argv) {
   manager.AddDefaultOption("output_path", &output_path, "directory for metrics.json (optional)");
   manager.AddDefaultOption("alignment", &alignment, "rigid | similarity");
   manager.Parse(argc, argv);
-  RunEvaluateCalibrationStep(dataset_path, input_path, cam_from_lidar_path, output_path, alignment);
+  RunEvaluateCalibrationStep(dataset_path,
+                             input_path,
+                             cam_from_lidar_path,
+                             output_path,
+                             TrajectoryAlignmentFromName(alignment));
   return EXIT_SUCCESS;
 }
 
@@ -245,9 +249,7 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
                                 const std::string& input_path,
                                 const std::string& cam_from_lidar_path,
                                 const std::string& output_path,
-                                const std::string& alignment) {
-  THROW_CHECK(alignment == "rigid" || alignment == "similarity")
-      << "--alignment must be rigid or similarity, not " << alignment;
+                                TrajectoryAlignment alignment) {
   const std::string estimate_path = cam_from_lidar_path.empty()
                                         ? (fs::path(input_path) / "cam_from_lidar.txt").string()
                                         : cam_from_lidar_path;
@@ -266,20 +268,17 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
   THROW_CHECK(fs::is_directory(input_path)) << "No sparse model at " << input_path;
   colmap::Reconstruction reconstruction;
   reconstruction.Read(input_path);
-  const CalibrationEvaluation result = EvaluateCalibration(true_cam_from_lidar,
-                                                           cam_from_lidar,
-                                                           true_cam_from_world,
-                                                           reconstruction,
-                                                           alignment == "similarity");
+  const CalibrationEvaluation result = EvaluateCalibration(
+      true_cam_from_lidar, cam_from_lidar, true_cam_from_world, reconstruction, alignment);
 
   const nlohmann::json metrics = CalibrationMetricsJson(result);
   PrintCalibrationEvaluation(result);
   if (!output_path.empty()) {
     fs::create_directories(output_path);
     WriteFileAtomically((fs::path(output_path) / "metrics.json").string(), metrics.dump(2) + "\n");
-    if (result.alignment == "none") return;
+    if (!result.alignment) return;
     WritePoseFile((fs::path(output_path) / "truth_from_model.txt").string(),
-                  "true_world_from_model_world by " + result.alignment +
+                  "true_world_from_model_world by " + TrajectoryAlignmentName(*result.alignment) +
                       " alignment of the camera centres (scale " +
                       std::to_string(result.alignment_scale) +
                       " not included); qw qx qy qz tx ty tz",

@@ -436,9 +436,6 @@ void AddJointAdjusterOptions(const std::string& prefix,
                              JointAdjusterStepOptions* options) {
   PrefixedOptions add(manager, prefix);
   JointAdjusterOptions& adjuster = options->adjuster;
-  add.Add("sigma_lidar_m",
-          &adjuster.sigma_lidar_m,
-          "nominal LiDAR range noise: the starting weight of the LiDAR terms");
   add.Add("estimate_variance_components",
           &adjuster.estimate_variance_components,
           "weight each data group by its variance factor estimated with the solve");
@@ -522,6 +519,9 @@ constexpr RemovedOption kRemovedOptions[] = {
     {"use_stereo_alignment",
      "the stereo-LiDAR alignment is the start, not a measurement in the cost"},
     {"vertical_alignment", kFromMotion},
+    {"sigma_lidar_m",
+     "the LiDAR's range noise is rig.json's lidar.range_noise_m (default 0.02 m), the starting "
+     "weight of E_l that the estimated variance factor scales"},
 };
 
 }  // namespace
@@ -747,6 +747,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                           JointAdjusterStepOptions options) {
   THROW_CHECK(options.Check());
   options.adjuster = options.AdjusterOptions();
+  options.adjuster.sigma_lidar_m = dataset.rig.LidarRangeNoiseM();
   if (!dataset.rig.IsStereo() && options.adjuster.mode == JointMode::kStereoOnly) {
     throw std::invalid_argument("--mode stereo_only needs a stereo rig; " + dataset.root +
                                 "/rig.json has one camera");

@@ -124,6 +124,11 @@ std::vector<fs::path> StationCloudFiles(const std::string& lidar_path) {
 const std::map<std::string, std::optional<bool>> kMovingPointRemoval = {
     {"auto", std::nullopt}, {"on", true}, {"1", true}, {"off", false}, {"0", false}};
 
+const std::map<std::string, RegistrationMethod> kRegistrationMethods = {
+    {"auto", RegistrationMethod::kAuto},
+    {"pairwise", RegistrationMethod::kPairwise},
+    {"odometry", RegistrationMethod::kOdometry}};
+
 }  // namespace
 
 bool LidarRegistratorStepOptions::Check() const {
@@ -132,8 +137,12 @@ bool LidarRegistratorStepOptions::Check() const {
   CHECK_OPTION_GE(bridge_neighbors, 0);
   CHECK_OPTION_GE(refine_neighbors, 0);
   CHECK_OPTION(kMovingPointRemoval.count(remove_moving_points) > 0);
-  CHECK_OPTION(method == "auto" || method == "pairwise" || method == "odometry");
+  CHECK_OPTION(kRegistrationMethods.count(method) > 0);
   return sweep_timing.Check() && moving.Check() && odometry.Check() && revisit.Check();
+}
+
+RegistrationMethod LidarRegistratorStepOptions::Method() const {
+  return kRegistrationMethods.at(method);
 }
 
 bool LidarRegistratorStepOptions::RemovesMovingPoints() const {
@@ -361,7 +370,8 @@ void RemoveMovingPoints(const std::vector<std::string>& names,
 // The method asked for; auto: the odometry for the sweeps of a moving platform (de-skewed, or
 // rig.json says the platform moves), the pairwise path for tripod stations. Says which and why.
 bool UseOdometry(const LidarRegistratorStepOptions& options) {
-  if (options.method != "auto") return options.method == "odometry";
+  const RegistrationMethod method = options.Method();
+  if (method != RegistrationMethod::kAuto) return method == RegistrationMethod::kOdometry;
   const bool sweeps = options.deskew_sweeps || options.moving_platform;
   std::cout << "lidar_registrator: "
             << (sweeps ? "odometry (frame-to-map ICP): the clouds are sweeps of a moving platform"

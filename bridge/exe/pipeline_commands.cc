@@ -330,7 +330,8 @@ std::vector<PipelineStep> EvaluationSteps(const StationDataset& dataset,
   // A KITTI drive: the reference extrinsic only.
   if (dataset.HasReferenceExtrinsic()) {
     steps.push_back({"evaluate_calibration", [=, &dataset] {
-                       RunEvaluateCalibrationStep(dataset.root, joint, "", evaluation, "rigid");
+                       RunEvaluateCalibrationStep(
+                           dataset.root, joint, "", evaluation, TrajectoryAlignment::kRigid);
                      }});
   }
   // The simulator's true depth maps: how far the stereo depth priors are from the truth.

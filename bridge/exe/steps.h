@@ -3,7 +3,7 @@
 // colmap::OptionManager under a prefix, and a Run*Step function that prints progress and writes the
 // step's outputs. A command (`colmap-lidar joint_adjuster ...`, commands.h) registers its step's options
 // without a prefix; `pipeline` registers every step's options in one manager under the step's section
-// ("JointAdjuster.sigma_lidar_m", "StereoDepth.block_size", ...; COLMAP's own SiftExtraction.* etc. keep
+// ("JointAdjuster.hold_translation_mm", "StereoDepth.block_size", ...; COLMAP's own SiftExtraction.* etc. keep
 // their names), so that an option on its command line or in its --project_path .ini reaches the step,
 // as COLMAP's automatic_reconstructor does. Errors are thrown.
 #pragma once
@@ -94,6 +94,9 @@ void RunDepthPriorStep(const std::string& database_path,
                        const DepthPriorOptions& options);
 
 // lidar_registrator: BSC + RANSAC + ICP over station pairs, the LiDAR pose graph A_l.
+// lidar_registrator's --method.
+enum class RegistrationMethod { kAuto, kPairwise, kOdometry };
+
 struct LidarRegistratorStepOptions {
   StationCloudOptions cloud;
   LidarGraphOptions graph;
@@ -136,6 +139,8 @@ struct LidarRegistratorStepOptions {
   bool Check() const;
   // `graph` with max_neighbors, sequential and bridge_neighbors.
   LidarGraphOptions GraphOptions() const;
+  // `method` parsed (Check() has validated it).
+  RegistrationMethod Method() const;
   // Whether moving points are removed (remove_moving_points, auto decided by deskew_sweeps).
   bool RemovesMovingPoints() const;
 };
@@ -262,7 +267,7 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
                                 const std::string& input_path,
                                 const std::string& cam_from_lidar_path,
                                 const std::string& output_path,
-                                const std::string& alignment);
+                                TrajectoryAlignment alignment);
 
 // evaluate_trajectory: a trajectory against a reference
 // (bridge/evaluation/trajectory_evaluation.h).

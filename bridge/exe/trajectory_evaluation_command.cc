@@ -77,10 +77,7 @@ int RunEvaluateTrajectory(int argc, char** argv) {
   options.lengths_m = ParsePositiveNumbers(lengths);
   THROW_CHECK(lengths.empty() || !options.lengths_m.empty())
       << "--lengths_m must be comma-separated positive lengths in metres, not '" << lengths << "'";
-  THROW_CHECK(alignment == "rigid" || alignment == "similarity")
-      << "--alignment is rigid or similarity, not '" << alignment << "'";
-  options.alignment =
-      alignment == "rigid" ? TrajectoryAlignment::kRigid : TrajectoryAlignment::kSimilarity;
+  options.alignment = TrajectoryAlignmentFromName(alignment);
   RunEvaluateTrajectoryStep(options);
   return EXIT_SUCCESS;
 }

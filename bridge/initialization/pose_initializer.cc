@@ -99,6 +99,13 @@ bool PlanarHandEye(const std::vector<HandEyeMotion>& motions,
   return true;
 }
 
+// `options` with the rig's LiDAR range noise in its alignment (rig.json is that quantity's one home).
+template <typename AlignmentStepOptions>
+AlignmentStepOptions WithRigLidarNoise(AlignmentStepOptions options, const StationRig& rig) {
+  options.alignment.sigma_lidar_m = rig.LidarRangeNoiseM();
+  return options;
+}
+
 // A drive that does not turn, without a guess: cam_from_lidar from the travel direction and the
 // structure (bridge/initialization/travel_structure_extrinsic.h). Throws with the hand-eye's and
 // its own reason when that fails too.
@@ -119,7 +126,7 @@ void InitializeFromTravel(const std::string& database_path,
       dataset,
       LargestComponentLidarPoses(registration_path),
       ReadStationImages(database_path, dataset).image_of_station,
-      options.travel_structure);
+      WithRigLidarNoise(options.travel_structure, dataset.rig));
   std::cout << "  " << init->travel_structure->message << std::endl;
   if (!init->travel_structure->valid) {
     throw std::runtime_error(
@@ -165,7 +172,10 @@ void RefineWithStereo(const StationDataset& dataset,
                       const PoseInitializerOptions& options,
                       PoseInitialization* init) {
   init->stereo_alignment =
-      AlignStereoWithLidar(dataset, depth_path, init->cam_from_lidar, options.stereo_alignment);
+      AlignStereoWithLidar(dataset,
+                           depth_path,
+                           init->cam_from_lidar,
+                           WithRigLidarNoise(options.stereo_alignment, dataset.rig));
   std::cout << "Stereo-LiDAR alignment: " << init->stereo_alignment->message << std::endl;
   if (!init->stereo_alignment->used) return;
   init->cam_from_lidar = init->stereo_alignment->cam_from_lidar;

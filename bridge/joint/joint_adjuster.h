@@ -63,7 +63,8 @@ std::string JointModeName(JointMode mode);
 struct JointAdjusterOptions {
   JointMode mode = JointMode::kJoint;
   // Standard deviation of a LiDAR point-to-plane distance (the paper uses 0.02 - 0.1 m). sigma_p = 1 px
-  // is COLMAP's reprojection weight; sigma_d comes with each depth prior.
+  // is COLMAP's reprojection weight; sigma_d comes with each depth prior. The joint_adjuster command
+  // sets it to the rig's LiDAR range noise (rig.json lidar.range_noise_m, StationRig::LidarRangeNoiseM).
   double sigma_lidar_m = 0.02;
   // Estimate each data group's variance factor (reprojection, depth priors, E_l, E_m) with the solve
   // (bridge/joint/variance_components.h) and weight the group by it: the nominal sigmas (1 px,
