@@ -1,6 +1,6 @@
 #include "colmap_ext/kitti_calibration.h"
 
-#include "colmap_ext/atomic_file.h"
+#include "lidar/util/atomic_file.h"
 
 #include <filesystem>
 #include <fstream>

@@ -1,6 +1,6 @@
 #include "colmap_ext/kitti_import.h"
 
-#include "colmap_ext/atomic_file.h"
+#include "lidar/util/atomic_file.h"
 #include "colmap_ext/kitti_source.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/pose_perturbation.h"

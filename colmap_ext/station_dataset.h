@@ -10,7 +10,7 @@
 // quaternions (xyzw storage) inside colmap::Rigid3d.
 #pragma once
 
-#include "colmap_ext/atomic_file.h"  // WriteFileAtomically, used with the pose files
+#include "lidar/util/atomic_file.h"  // WriteFileAtomically, used with the pose files
 
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/camera.h"

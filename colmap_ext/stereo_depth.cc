@@ -3,8 +3,8 @@
 #include "colmap_ext/elapsed.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/stereo_depth_files.h"
+#include "lidar/util/parallel_for_each.h"
 
-#include <omp.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -278,37 +278,34 @@ void ComputeDatasetStereoDepth(const StationDataset& dataset,
 
   const int num_stations = static_cast<int>(dataset.stations.size());
   std::vector<double> valid_fraction(dataset.stations.size(), 0);
-  std::vector<std::string> errors(dataset.stations.size());
   std::atomic<int> num_done{0};
   std::mutex print_mutex;
-  const int num_threads = options.num_threads > 0 ? options.num_threads : omp_get_max_threads();
-  // One station per thread; OpenCV's own threads off meanwhile (no oversubscription).
-  const int opencv_threads = cv::getNumThreads();
-  cv::setNumThreads(num_threads > 1 ? 1 : opencv_threads);
   const auto start = std::chrono::steady_clock::now();
-#pragma omp parallel for schedule(dynamic) num_threads(num_threads)
-  for (int i = 0; i < num_stations; ++i) {
-    const std::string& station = dataset.stations[i];
-    try {
-      const cv::Mat left = ReadImageOrThrow(dataset.LeftImagePath(i));
-      const cv::Mat right = ReadImageOrThrow(dataset.RightImagePath(i));
-      const StereoDepth depth = ComputeStereoDepth(left, right, rectifier, options);
-      WriteStationStereoDepth(output_path, station, depth);
-      valid_fraction[i] = depth.valid_fraction;
-      const int done = ++num_done;
-      const double seconds = SecondsSince(start);
-      std::lock_guard<std::mutex> lock(print_mutex);
-      std::cout << "  [" << done << "/" << num_stations << "] station " << station << ": "
-                << std::setprecision(1) << 100 * depth.valid_fraction << " % of pixels with depth ("
-                << std::setprecision(0) << seconds << " s)" << std::endl;
-    } catch (const std::exception& error) {
-      errors[i] = "station " + station + ": " + error.what();
-    }
-  }
-  cv::setNumThreads(opencv_threads);
-  for (const std::string& error : errors) {
-    if (!error.empty()) throw std::runtime_error(error);
-  }
+  // One station per thread. OpenCV's own parallel loops (remap, some SGBM modes) run in the calling
+  // thread while its pool is busy, so the stations do not oversubscribe the cores; the process's
+  // OpenCV thread setting is left alone.
+  ParallelForEach(
+      num_stations,
+      [&](int i) {
+        const std::string& station = dataset.stations[i];
+        try {
+          const cv::Mat left = ReadImageOrThrow(dataset.LeftImagePath(i));
+          const cv::Mat right = ReadImageOrThrow(dataset.RightImagePath(i));
+          const StereoDepth depth = ComputeStereoDepth(left, right, rectifier, options);
+          WriteStationStereoDepth(output_path, station, depth);
+          valid_fraction[i] = depth.valid_fraction;
+          const int done = ++num_done;
+          const double seconds = SecondsSince(start);
+          std::lock_guard<std::mutex> lock(print_mutex);
+          std::cout << "  [" << done << "/" << num_stations << "] station " << station << ": "
+                    << std::setprecision(1) << 100 * depth.valid_fraction
+                    << " % of pixels with depth (" << std::setprecision(0) << seconds << " s)"
+                    << std::endl;
+        } catch (const std::exception& error) {
+          throw std::runtime_error("station " + station + ": " + error.what());
+        }
+      },
+      options.num_threads);
 
   StereoDepthInfo info;
   info.rectified_focal_px = rectifier.RectifiedFocalLength();

@@ -1,6 +1,6 @@
 #include "colmap_ext/stereo_depth_files.h"
 
-#include "colmap_ext/atomic_file.h"
+#include "lidar/util/atomic_file.h"
 #include "colmap_ext/logging.h"
 
 #include "colmap/mvs/depth_map.h"

@@ -1,6 +1,6 @@
 #include "colmap_ext/trajectory_files.h"
 
-#include "colmap_ext/atomic_file.h"
+#include "lidar/util/atomic_file.h"
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/text_lines.h"
 

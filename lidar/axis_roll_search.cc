@@ -1,6 +1,6 @@
 #include "lidar/axis_roll_search.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 #include "lidar/cloud_io.h"
 
-#include "lidar/atomic_file.h"
+#include "lidar/util/atomic_file.h"
 #include "lidar/pcd_header.h"
-#include "lidar/statistics.h"
+#include "lidar/util/statistics.h"
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
@@ -658,7 +658,7 @@ void WritePointCloud(const std::string& path, const PointCloud& cloud) {
     throw std::invalid_argument("Cannot write point cloud " + path +
                                 ": extension must be .pcd or .ply");
   }
-  WriteLidarFileAtomically(path, [&](const std::string& temporary) {
+  WriteAtomically(path, [&](const std::string& temporary) {
     std::ofstream out(temporary, std::ios::binary);
     if (!out) return false;
     if (ext == ".pcd") {

@@ -1,6 +1,6 @@
 #include "lidar/depth_discontinuities.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 #include "lidar/spherical_range_image.h"
 
 #include <algorithm>

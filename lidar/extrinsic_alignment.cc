@@ -1,6 +1,6 @@
 #include "lidar/extrinsic_alignment.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 #include "lidar/point_to_plane_icp.h"
 
 #include <Eigen/Dense>

@@ -1,6 +1,6 @@
 #include "lidar/frame_selection.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include <cmath>
 

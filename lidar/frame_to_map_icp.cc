@@ -1,7 +1,7 @@
 #include "lidar/frame_to_map_icp.h"
 
-#include "lidar/check_option.h"
-#include "lidar/parallel_for_each.h"
+#include "lidar/util/check_option.h"
+#include "lidar/util/parallel_for_each.h"
 
 #include <Eigen/Eigenvalues>
 

@@ -1,6 +1,6 @@
 #include "lidar/keypoints.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include <Eigen/Eigenvalues>
 

@@ -1,6 +1,6 @@
 #include "lidar/lidar_odometry.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include <Eigen/Eigenvalues>
 

@@ -1,6 +1,6 @@
 #include "lidar/lidar_pose_graph.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 #include "lidar/pose_graph.h"
 
 #include <Eigen/Eigenvalues>

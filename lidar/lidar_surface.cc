@@ -1,6 +1,6 @@
 #include "lidar/lidar_surface.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 #include "lidar/kd_tree.h"
 #include "lidar/preprocessing.h"
 

@@ -1,6 +1,6 @@
 #include "lidar/perpendicular_direction.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>

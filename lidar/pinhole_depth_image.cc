@@ -1,6 +1,6 @@
 #include "lidar/pinhole_depth_image.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,7 +1,7 @@
 #include "lidar/plot.h"
 
-#include "lidar/atomic_file.h"
-#include "lidar/statistics.h"
+#include "lidar/util/atomic_file.h"
+#include "lidar/util/statistics.h"
 
 #include <Eigen/Eigenvalues>
 #include <opencv2/imgcodecs.hpp>
@@ -29,7 +29,7 @@ void PutText(cv::Mat* canvas, const std::string& text, const cv::Point& origin, 
 }
 
 void WritePngAtomically(const std::string& path, const cv::Mat& canvas) {
-  WriteLidarFileAtomically(
+  WriteAtomically(
       path, [&canvas](const std::string& temporary) { return cv::imwrite(temporary, canvas); });
 }
 

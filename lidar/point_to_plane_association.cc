@@ -1,6 +1,6 @@
 #include "lidar/point_to_plane_association.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include <algorithm>
 #include <numeric>

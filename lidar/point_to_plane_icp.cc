@@ -1,7 +1,7 @@
 #include "lidar/point_to_plane_icp.h"
 
-#include "lidar/check_option.h"
-#include "lidar/parallel_for_each.h"
+#include "lidar/util/check_option.h"
+#include "lidar/util/parallel_for_each.h"
 
 #include <Eigen/Dense>
 

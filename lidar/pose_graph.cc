@@ -1,6 +1,6 @@
 #include "lidar/pose_graph.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 #include "lidar/relative_pose_error.h"
 
 #include <ceres/ceres.h>

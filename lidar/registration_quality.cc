@@ -1,6 +1,6 @@
 #include "lidar/registration_quality.h"
 
-#include "lidar/parallel_for_each.h"
+#include "lidar/util/parallel_for_each.h"
 
 #include <Eigen/Eigenvalues>
 

@@ -1,6 +1,6 @@
 #include "lidar/revisit_closure.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 #include "lidar/cloud_io.h"
 #include "lidar/relative_pose_error.h"
 #include "lidar/sweep_pose_graph.h"

@@ -1,7 +1,7 @@
 #include "lidar/speed_consistency.h"
 
-#include "lidar/check_option.h"
-#include "lidar/statistics.h"
+#include "lidar/util/check_option.h"
+#include "lidar/util/statistics.h"
 
 #include <algorithm>
 #include <array>

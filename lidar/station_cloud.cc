@@ -1,6 +1,6 @@
 #include "lidar/station_cloud.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 #include "lidar/registration_quality.h"
 
 #include <stdexcept>

@@ -1,6 +1,6 @@
 #include "lidar/sweep_deskew.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include <algorithm>
 #include <cmath>

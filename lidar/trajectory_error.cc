@@ -1,7 +1,7 @@
 #include "lidar/trajectory_error.h"
 
-#include "lidar/check_option.h"
-#include "lidar/statistics.h"
+#include "lidar/util/check_option.h"
+#include "lidar/util/statistics.h"
 
 #include <Eigen/Geometry>
 

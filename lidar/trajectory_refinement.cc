@@ -1,6 +1,6 @@
 #include "lidar/trajectory_refinement.h"
 
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 #include "lidar/cloud_io.h"
 
 #include <algorithm>

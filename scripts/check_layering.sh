@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Fails when a layer includes (or links) what it must not:
 #   lidar/       no COLMAP, no colmap_ext/bridge/tests; its public headers (.h) include only Eigen and std
-#   colmap_ext/  no lidar/, bridge/ or tests/
+#   lidar/util/  the utilities base: nothing of lidar/ outside lidar/util/
+#   colmap_ext/  of lidar/ only lidar/util/; no bridge/ or tests/
 #   bridge/      no tests/; no source file outside its folders; the folders in levels, each including
 #                only folders of lower levels:
 #                  1  simulation (the simulator), initialization, joint, dense, baselines, evaluation
@@ -25,7 +26,9 @@ check_includes() {  # folder, regex of forbidden includes, what
 }
 
 check_includes lidar 'colmap/|colmap_ext/|bridge/|tests/' "COLMAP, colmap_ext, bridge or tests"
-check_includes colmap_ext 'lidar/|bridge/|tests/' "lidar, bridge or tests"
+check_includes colmap_ext 'lidar/[^u]|lidar/u[^t]|bridge/|tests/' \
+  "lidar (other than the utilities base lidar/util/), bridge or tests"
+check_includes lidar/util 'lidar/[^u]|lidar/u[^t]' "lidar/ outside the utilities base"
 hits=$(grep -rnE '^\s*#\s*include\s*"tests/' --include='*.h' --include='*.cc' bridge |
        grep -vE '_test\.cc:[0-9]+:\s*#\s*include\s*"tests/testing/' || true)
 [ -z "$hits" ] || violation "bridge/ must not include tests/:"$'\n'"$hits"
@@ -58,14 +61,17 @@ sed -n '/add_library(colmap_lidar_bridge/,/^)/p' bridge/CMakeLists.txt | grep -q
   violation "the bridge library compiles a command (they belong in bridge/exe/)"
 
 # lidar's public headers speak Eigen: no PCL, FLANN, nanoflann, OpenCV or Ceres in lidar/*.h.
-hits=$(grep -nE '^\s*#\s*include\s*<(pcl/|flann/|nanoflann|opencv2/|ceres/)' lidar/*.h || true)
+hits=$(grep -nE '^\s*#\s*include\s*<(pcl/|flann/|nanoflann|opencv2/|ceres/)' lidar/*.h lidar/util/*.h ||
+       true)
 [ -z "$hits" ] || violation "lidar public headers must include only Eigen and std:"$'\n'"$hits"
 
 # Link lines: lidar links no COLMAP; colmap_ext does not link lidar; bridge library no simulator.
 grep -qE 'colmap::colmap|colmap_lidar::(colmap_ext|bridge|simulator)' lidar/CMakeLists.txt &&
   violation "lidar/CMakeLists.txt links COLMAP or another layer"
 grep -qE 'colmap_lidar::(lidar|bridge|simulator)' colmap_ext/CMakeLists.txt &&
-  violation "colmap_ext/CMakeLists.txt links lidar, bridge or the simulator"
+  violation "colmap_ext/CMakeLists.txt links lidar (other than colmap_lidar::util), bridge or the simulator"
+grep -qE 'colmap::colmap|colmap_lidar::(lidar|colmap_ext|bridge|simulator)' lidar/util/CMakeLists.txt &&
+  violation "lidar/util/CMakeLists.txt links COLMAP or a layer above the utilities base"
 sed -n '/add_library(colmap_lidar_bridge/,/^)/p;/target_link_libraries(colmap_lidar_bridge/,/)/p' \
   bridge/CMakeLists.txt | grep -q 'simulator' &&
   violation "the bridge library links the simulator"
@@ -73,10 +79,11 @@ sed -n '/add_library(colmap_lidar_bridge/,/^)/p;/target_link_libraries(colmap_li
 # One definition per type name: the layers share the namespace colmap_lidar, and two headers defining
 # one struct or class name is an ODR violation the linker does not report (it merges their inline
 # functions: a vector of one type reallocated with the other's layout).
-hits=$(grep -HnoE '^(struct|class) [A-Za-z0-9_]+( final)? ?[:{]' lidar/*.h colmap_ext/*.h bridge/*/*.h \
+hits=$(grep -HnoE '^(struct|class) [A-Za-z0-9_]+( final)? ?[:{]' lidar/*.h lidar/util/*.h colmap_ext/*.h \
+         bridge/*/*.h \
          | awk -F'[: ]' '{print $4, $1 ":" $2}' | sort |
        awk '{n[$1]++; where[$1] = where[$1] " " $2} END {for (t in n) if (n[t] > 1) print t ":" where[t]}')
 [ -z "$hits" ] || violation "type names defined in more than one header:"$'\n'"$hits"
 
-[ $status -eq 0 ] && echo "layering: ok (lidar | colmap_ext -> bridge -> bridge/exe (CLI))"
+[ $status -eq 0 ] && echo "layering: ok (lidar/util -> lidar | colmap_ext -> bridge -> bridge/exe (CLI))"
 exit $status

@@ -6,7 +6,7 @@
 #include "bridge/simulation/simulate_dataset.h"
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/station_dataset.h"
-#include "lidar/statistics.h"
+#include "lidar/util/statistics.h"
 #include "tests/testing/file_bytes.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/scoped_temp_dir.h"

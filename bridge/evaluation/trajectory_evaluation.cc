@@ -1,7 +1,7 @@
 #include "bridge/evaluation/trajectory_evaluation.h"
 
 #include "bridge/evaluation/calibration_evaluation.h"
-#include "colmap_ext/atomic_file.h"
+#include "lidar/util/atomic_file.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "lidar/plot.h"
 

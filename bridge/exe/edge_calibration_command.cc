@@ -10,11 +10,11 @@
 #include "bridge/evaluation/calibration_evaluation.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
-#include "colmap_ext/atomic_file.h"
+#include "lidar/util/atomic_file.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
-#include "lidar/parallel_for_each.h"
+#include "lidar/util/parallel_for_each.h"
 #include "lidar/plot.h"
 
 #include "colmap/controllers/option_manager.h"

@@ -10,7 +10,7 @@
 #include "bridge/initialization/selected_frames.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include "colmap/controllers/option_manager.h"
 

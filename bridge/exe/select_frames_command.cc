@@ -3,7 +3,7 @@
 // (bridge/initialization/selected_frames.h).
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include "colmap/controllers/option_manager.h"
 

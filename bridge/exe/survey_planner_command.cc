@@ -4,7 +4,7 @@
 // candidates.txt (every candidate, best first).
 #include "bridge/exe/survey_planner_command.h"
 
-#include "colmap_ext/atomic_file.h"
+#include "lidar/util/atomic_file.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"

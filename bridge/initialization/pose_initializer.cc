@@ -7,7 +7,7 @@
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "lidar/pose_graph.h"
-#include "lidar/statistics.h"
+#include "lidar/util/statistics.h"
 
 #include "colmap/controllers/incremental_mapper.h"
 #include "colmap/estimators/cost_functions.h"

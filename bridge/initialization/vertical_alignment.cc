@@ -1,7 +1,7 @@
 #include "bridge/initialization/vertical_alignment.h"
 
 #include "colmap_ext/logging.h"
-#include "lidar/parallel_for_each.h"
+#include "lidar/util/parallel_for_each.h"
 
 #include "colmap/geometry/pose.h"
 #include "colmap/geometry/rigid3.h"

@@ -13,7 +13,7 @@
 #include "colmap_ext/elapsed.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
-#include "lidar/statistics.h"
+#include "lidar/util/statistics.h"
 
 #include "colmap/estimators/bundle_adjustment.h"
 #include "colmap/estimators/cost_functions.h"

@@ -4,7 +4,7 @@
 #include "lidar/cloud_io.h"
 #include "lidar/kd_tree.h"
 #include "lidar/model_evaluation.h"
-#include "lidar/statistics.h"
+#include "lidar/util/statistics.h"
 #include "bridge/simulation/renderer.h"
 #include "bridge/simulation/scene.h"
 #include "bridge/simulation/simulate_dataset.h"

@@ -2,7 +2,7 @@
 
 #include "lidar/kd_tree.h"
 #include "lidar/spherical_range_image.h"
-#include "lidar/statistics.h"
+#include "lidar/util/statistics.h"
 #include "lidar/voxel_accumulator.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "colmap_ext/atomic_file.h"
+#include "lidar/util/atomic_file.h"
 
 #include "tests/testing/scoped_temp_dir.h"
 

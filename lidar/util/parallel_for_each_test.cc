@@ -1,4 +1,4 @@
-#include "lidar/parallel_for_each.h"
+#include "lidar/util/parallel_for_each.h"
 
 #include <gtest/gtest.h>
 

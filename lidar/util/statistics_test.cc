@@ -1,4 +1,4 @@
-#include "lidar/statistics.h"
+#include "lidar/util/statistics.h"
 
 #include <gtest/gtest.h>
 

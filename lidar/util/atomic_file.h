@@ -1,7 +1,7 @@
 // Outputs written whole or not at all. Files: through a temporary file in the same folder and a
 // rename, so that a reader (or a run killed halfway) sees either the old file or the complete new one.
-// Folders: everything into OUTPUT.partial, renamed to OUTPUT at the end. (lidar/ has its
-// own, lidar/atomic_file.h: the layers may not include each other.)
+// Folders: everything into OUTPUT.partial, renamed to OUTPUT at the end. The one writer of every
+// layer (lidar/util is the base colmap_ext may use too).
 #pragma once
 
 #include <functional>

@@ -1,4 +1,4 @@
-#include "lidar/check_option.h"
+#include "lidar/util/check_option.h"
 
 #include <iostream>
 
