@@ -1,7 +1,7 @@
 # Install rules and the exported CMake package: after `cmake --install BUILD --prefix PREFIX`, a C++
 # project links our layers with
 #   find_package(colmap_lidar REQUIRED)   # CMAKE_PREFIX_PATH: PREFIX and COLMAP 3.10's prefix
-#   target_link_libraries(app PRIVATE colmap_lidar::bridge)   # or ::lidar, ::colmap_ext, ::util
+#   target_link_libraries(app PRIVATE colmap_lidar::pipeline)  # or ::bridge, ::lidar, ::colmap_ext, ::util
 # The CLI installs to PREFIX/bin/colmap-lidar; headers to PREFIX/include/{lidar,colmap_ext,bridge}.
 include(CMakePackageConfigHelpers)
 include(GNUInstallDirs)
@@ -10,7 +10,9 @@ set_target_properties(colmap_lidar_util PROPERTIES EXPORT_NAME util)
 set_target_properties(colmap_lidar_lidar PROPERTIES EXPORT_NAME lidar)
 set_target_properties(colmap_lidar_colmap_ext PROPERTIES EXPORT_NAME colmap_ext)
 set_target_properties(colmap_lidar_bridge PROPERTIES EXPORT_NAME bridge)
+set_target_properties(colmap_lidar_pipeline PROPERTIES EXPORT_NAME pipeline)
 install(TARGETS colmap_lidar_util colmap_lidar_lidar colmap_lidar_colmap_ext colmap_lidar_bridge
+                colmap_lidar_pipeline
         EXPORT colmap_lidarTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(TARGETS colmap_lidar_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

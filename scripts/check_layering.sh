@@ -6,7 +6,8 @@
 #   bridge/      no tests/; no source file outside its folders; the folders in levels, each including
 #                only folders of lower levels:
 #                  1  simulation (the simulator), initialization, joint, dense, baselines, evaluation
-#                  2  survey (the survey planner: the joint problem on the simulator's worlds)
+#                  2  survey (the survey planner: the joint problem on the simulator's worlds),
+#                     pipeline (the steps as library calls)
 #                  3  exe (the commands; nothing outside it includes it, and the bridge library's
 #                     sources list none of its files)
 #   all layers   no struct or class name defined in two headers (one namespace: an ODR violation)
@@ -38,7 +39,7 @@ hits=$(find bridge -maxdepth 1 -type f \( -name '*.h' -o -name '*.cc' \) | sort)
 
 # bridge/'s folders by level: a folder includes only folders of lower levels.
 declare -A level=([simulation]=1 [initialization]=1 [joint]=1 [dense]=1 [baselines]=1
-                  [evaluation]=1 [survey]=2 [exe]=3)
+                  [evaluation]=1 [survey]=2 [pipeline]=2 [exe]=3)
 folders=$(printf '%s\n' "${!level[@]}" | sort)
 for folder in $folders; do
   [ -d "bridge/$folder" ] || violation "bridge/$folder is missing (the levels name it)"

@@ -16,6 +16,7 @@
 #include "bridge/initialization/selected_frames.h"
 #include "bridge/joint/joint_adjuster.h"
 #include "bridge/joint/joint_problem_data.h"
+#include "bridge/pipeline/joint_step.h"
 #include "colmap_ext/dataset_import.h"
 #include "colmap_ext/depth_prior_evaluation.h"
 #include "colmap_ext/depth_prior_extractor.h"
@@ -184,27 +185,8 @@ inline constexpr char kRegistrationPathHelp[] =
     "the "
     "dataset's; empty: the dataset's clouds";
 
-// joint_adjuster: the joint problem on a sparse model.
-struct JointAdjusterStepOptions {
-  JointAdjusterOptions adjuster;
-  JointDataOptions data;
-  // joint | precalibrated | stereo_only; into `adjuster.mode` by AdjusterOptions(). Registered by the
-  // joint_adjuster command, not by AddJointAdjusterOptions (the pipeline's --mode sets it).
-  std::string mode = "joint";
-  // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by
-  // AdjusterOptions().
-  std::string hold_translation;
-  // On a moving platform (rig.json), estimate the LiDAR clock's offset from the cameras in E_m
-  // (JointAdjusterOptions::estimate_time_offset).
-  bool estimate_time_offset = true;
-  // Also write the model as text (cameras.txt, images.txt, points3D.txt).
-  bool write_text = false;
-
-  // Throws on a malformed mode or hold_translation.
-  bool Check() const;
-  // `adjuster` with `mode` and `hold_translation` parsed into it.
-  JointAdjusterOptions AdjusterOptions() const;
-};
+// joint_adjuster: the joint problem on a sparse model (JointAdjusterStepOptions, RunJointAdjusterStep:
+// bridge/pipeline/joint_step.h).
 void AddJointAdjusterOptions(const std::string& prefix,
                              colmap::OptionManager* manager,
                              JointAdjusterStepOptions* options);
@@ -212,17 +194,6 @@ void AddJointAdjusterOptions(const std::string& prefix,
 // takes (under `prefix`, e.g. "JointAdjuster." in the pipeline), on the command line or in the project
 // file of --project_path, and what decides its value now.
 void RefuseRemovedJointAdjusterOptions(int argc, char** argv, const std::string& prefix);
-struct JointAdjusterPaths {
-  std::string database_path;
-  std::string input_path;
-  // qw qx qy qz tx ty tz; empty: INPUT/cam_from_lidar.txt, else rig.json's guess.
-  std::string cam_from_lidar_path;
-  std::string output_path;
-};
-void RunJointAdjusterStep(const StationDataset& dataset,
-                          const JointAdjusterPaths& paths,
-                          JointAdjusterStepOptions options);
-
 // densifier: the dense model.
 void AddDensifierOptions(const std::string& prefix,
                          colmap::OptionManager* manager,

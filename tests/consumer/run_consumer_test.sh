@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the build tree into BUILD/test_install/prefix, then configures, builds and runs the consumer
-# project (find_package(colmap_lidar), colmap_lidar::bridge) against it.
-#   run_consumer_test.sh BUILD_DIR SOURCE_DIR COLMAP_PREFIX
+# project (find_package(colmap_lidar), colmap_lidar::pipeline) against it; with FIXTURE (the pipeline's
+# default workspace) the consumer also reruns the joint step there (tests/consumer/main.cc).
+#   run_consumer_test.sh BUILD_DIR SOURCE_DIR COLMAP_PREFIX [FIXTURE]
 set -euo pipefail
 readonly kBuild="$1" kSource="$2" kColmapPrefix="$3"
 readonly kWork="$kBuild/test_install"
@@ -13,4 +14,4 @@ test ! -e "$kWork/prefix/include/bridge/exe"
 cmake -S "$kSource/tests/consumer" -B "$kWork/build" -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$kWork/prefix;$kColmapPrefix" >/dev/null
 cmake --build "$kWork/build" >/dev/null
-"$kWork/build/consumer"
+"$kWork/build/consumer" ${4:+"$4"}

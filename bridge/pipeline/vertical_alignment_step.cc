@@ -1,4 +1,4 @@
-#include "bridge/exe/vertical_alignment_step.h"
+#include "bridge/pipeline/vertical_alignment_step.h"
 
 #include "colmap_ext/logging.h"
 #include "lidar/plot.h"

@@ -1,0 +1,50 @@
+// The joint adjuster as a pipeline step, a library call: reads a COLMAP sparse model and the data of
+// the joint problem (depth priors, clouds, the pose graph), decides from the rig and the stations'
+// motion what the problem holds (E_m and its weight, the vertical alignment, the LiDAR clock
+// offset), runs bridge/joint/joint_adjuster.h and writes OUTPUT/ atomically: the refined model,
+// cam_from_lidar.txt, camera_poses.*, report.json and its plots (docs/joint_adjuster.md). The
+// `joint_adjuster` command and `pipeline` call it; so can any program linking colmap_lidar::pipeline.
+#pragma once
+
+#include "bridge/joint/joint_adjuster.h"
+#include "bridge/joint/joint_problem_data.h"
+#include "colmap_ext/station_dataset.h"
+
+#include <string>
+
+namespace colmap_lidar {
+
+// The options of the joint adjuster as a step: the adjuster's and the data loading's, and what the
+// command line gives as text (parsed by AdjusterOptions()).
+struct JointAdjusterStepOptions {
+  JointAdjusterOptions adjuster;
+  JointDataOptions data;
+  // joint | precalibrated | stereo_only; into `adjuster.mode` by AdjusterOptions(). Registered by the
+  // joint_adjuster command, not by AddJointAdjusterOptions (the pipeline's --mode sets it).
+  std::string mode = "joint";
+  // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by
+  // AdjusterOptions().
+  std::string hold_translation;
+  // On a moving platform (rig.json), estimate the LiDAR clock's offset from the cameras in E_m
+  // (JointAdjusterOptions::estimate_time_offset).
+  bool estimate_time_offset = true;
+  // Also write the model as text (cameras.txt, images.txt, points3D.txt).
+  bool write_text = false;
+
+  // Throws on a malformed mode or hold_translation.
+  bool Check() const;
+  // `adjuster` with `mode` and `hold_translation` parsed into it.
+  JointAdjusterOptions AdjusterOptions() const;
+};
+struct JointAdjusterPaths {
+  std::string database_path;
+  std::string input_path;
+  // qw qx qy qz tx ty tz; empty: INPUT/cam_from_lidar.txt, else rig.json's guess.
+  std::string cam_from_lidar_path;
+  std::string output_path;
+};
+void RunJointAdjusterStep(const StationDataset& dataset,
+                          const JointAdjusterPaths& paths,
+                          JointAdjusterStepOptions options);
+
+}  // namespace colmap_lidar
