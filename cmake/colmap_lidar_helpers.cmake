@@ -4,6 +4,20 @@ function(colmap_lidar_set_warnings target)
                                            -Wno-sign-compare)
 endfunction()
 
+# colmap_lidar_add_library(NAME name SOURCES a.cc... [PUBLIC lib...] [PRIVATE lib...])
+# A static library colmap_lidar_<name> with its alias colmap_lidar::<name>: the repository's root as
+# its include directory (the install tree's include/ once installed), its links, our warnings.
+function(colmap_lidar_add_library)
+  cmake_parse_arguments(ARG "" "NAME" "SOURCES;PUBLIC;PRIVATE" ${ARGN})
+  set(target colmap_lidar_${ARG_NAME})
+  add_library(${target} STATIC ${ARG_SOURCES})
+  add_library(colmap_lidar::${ARG_NAME} ALIAS ${target})
+  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+                                              $<INSTALL_INTERFACE:include>)
+  target_link_libraries(${target} PUBLIC ${ARG_PUBLIC} PRIVATE ${ARG_PRIVATE})
+  colmap_lidar_set_warnings(${target})
+endfunction()
+
 # colmap_lidar_add_test(NAME module/name SOURCES a_test.cc LINKS lib... [FILTER gtest_filter]
 #                       [LABEL unit|integration|slow] [COST seconds]
 #                       [FIXTURES_SETUP name] [FIXTURES_REQUIRED name])

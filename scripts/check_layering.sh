@@ -58,7 +58,8 @@ done
 hits=$(grep -rnE '^\s*#\s*include\s*"bridge/exe/' --include='*.h' --include='*.cc' \
          lidar colmap_ext bridge tests | grep -v '^bridge/exe/' || true)
 [ -z "$hits" ] || violation "only the commands (bridge/exe/) may include bridge/exe/:"$'\n'"$hits"
-sed -n '/add_library(colmap_lidar_bridge/,/^)/p' bridge/CMakeLists.txt | grep -qE '_commands?\.cc|main\.cc' &&
+sed -n '/colmap_lidar_add_library(NAME bridge$/,/^)/p' bridge/CMakeLists.txt |
+  grep -qE '_commands?\.cc|main\.cc' &&
   violation "the bridge library compiles a command (they belong in bridge/exe/)"
 
 # lidar's public headers speak Eigen: no PCL, FLANN, nanoflann, OpenCV or Ceres in lidar/*.h.
@@ -73,8 +74,7 @@ grep -qE 'colmap_lidar::(lidar|bridge|simulator)' colmap_ext/CMakeLists.txt &&
   violation "colmap_ext/CMakeLists.txt links lidar (other than colmap_lidar::util), bridge or the simulator"
 grep -qE 'colmap::colmap|colmap_lidar::(lidar|colmap_ext|bridge|simulator)' lidar/util/CMakeLists.txt &&
   violation "lidar/util/CMakeLists.txt links COLMAP or a layer above the utilities base"
-sed -n '/add_library(colmap_lidar_bridge/,/^)/p;/target_link_libraries(colmap_lidar_bridge/,/)/p' \
-  bridge/CMakeLists.txt | grep -q 'simulator' &&
+sed -n '/colmap_lidar_add_library(NAME bridge$/,/^)/p' bridge/CMakeLists.txt | grep -q 'simulator' &&
   violation "the bridge library links the simulator"
 
 # One definition per type name: the layers share the namespace colmap_lidar, and two headers defining
