@@ -1,10 +1,10 @@
 #include "colmap_ext/kitti_import.h"
 
-#include "lidar/util/atomic_file.h"
 #include "colmap_ext/kitti_source.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/pose_perturbation.h"
 #include "colmap_ext/station_dataset.h"
+#include "lidar/util/atomic_file.h"
 
 #include <filesystem>
 #include <iostream>

@@ -1,7 +1,7 @@
 #include "colmap_ext/stereo_depth_files.h"
 
-#include "lidar/util/atomic_file.h"
 #include "colmap_ext/logging.h"
+#include "lidar/util/atomic_file.h"
 
 #include "colmap/mvs/depth_map.h"
 

@@ -1,8 +1,8 @@
 #include "colmap_ext/trajectory_files.h"
 
-#include "lidar/util/atomic_file.h"
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/text_lines.h"
+#include "lidar/util/atomic_file.h"
 
 #include <cmath>
 #include <filesystem>

@@ -1,7 +1,7 @@
 #include "lidar/cloud_io.h"
 
-#include "lidar/util/atomic_file.h"
 #include "lidar/pcd_header.h"
+#include "lidar/util/atomic_file.h"
 #include "lidar/util/statistics.h"
 
 #include <pcl/PCLPointCloud2.h>

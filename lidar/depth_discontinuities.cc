@@ -1,7 +1,7 @@
 #include "lidar/depth_discontinuities.h"
 
-#include "lidar/util/check_option.h"
 #include "lidar/spherical_range_image.h"
+#include "lidar/util/check_option.h"
 
 #include <algorithm>
 #include <cmath>

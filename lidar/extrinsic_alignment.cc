@@ -1,7 +1,7 @@
 #include "lidar/extrinsic_alignment.h"
 
-#include "lidar/util/check_option.h"
 #include "lidar/point_to_plane_icp.h"
+#include "lidar/util/check_option.h"
 
 #include <Eigen/Dense>
 

@@ -1,7 +1,7 @@
 #include "lidar/lidar_pose_graph.h"
 
-#include "lidar/util/check_option.h"
 #include "lidar/pose_graph.h"
+#include "lidar/util/check_option.h"
 
 #include <Eigen/Eigenvalues>
 

@@ -1,8 +1,8 @@
 #include "lidar/lidar_surface.h"
 
-#include "lidar/util/check_option.h"
 #include "lidar/kd_tree.h"
 #include "lidar/preprocessing.h"
+#include "lidar/util/check_option.h"
 
 #include <Eigen/Eigenvalues>
 

@@ -1,8 +1,8 @@
 #include "lidar/model_evaluation.h"
 
-#include "lidar/util/check_option.h"
 #include "lidar/kd_tree.h"
 #include "lidar/point_to_plane_icp.h"
+#include "lidar/util/check_option.h"
 #include "lidar/util/statistics.h"
 #include "lidar/voxel_accumulator.h"
 

@@ -1,8 +1,8 @@
 #include "lidar/moving_points.h"
 
+#include "lidar/spherical_range_image.h"
 #include "lidar/util/check_option.h"
 #include "lidar/util/parallel_for_each.h"
-#include "lidar/spherical_range_image.h"
 
 #include <memory>
 #include <stdexcept>

@@ -1,7 +1,7 @@
 #include "lidar/pose_graph.h"
 
-#include "lidar/util/check_option.h"
 #include "lidar/relative_pose_error.h"
+#include "lidar/util/check_option.h"
 
 #include <ceres/ceres.h>
 

@@ -1,9 +1,9 @@
 #include "lidar/revisit_closure.h"
 
-#include "lidar/util/check_option.h"
 #include "lidar/cloud_io.h"
 #include "lidar/relative_pose_error.h"
 #include "lidar/sweep_pose_graph.h"
+#include "lidar/util/check_option.h"
 
 #include <Eigen/Cholesky>
 

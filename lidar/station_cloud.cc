@@ -1,7 +1,7 @@
 #include "lidar/station_cloud.h"
 
-#include "lidar/util/check_option.h"
 #include "lidar/registration_quality.h"
+#include "lidar/util/check_option.h"
 
 #include <stdexcept>
 

@@ -1,7 +1,7 @@
 #include "lidar/trajectory_refinement.h"
 
-#include "lidar/util/check_option.h"
 #include "lidar/cloud_io.h"
+#include "lidar/util/check_option.h"
 
 #include <algorithm>
 #include <chrono>

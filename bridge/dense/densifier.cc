@@ -6,8 +6,8 @@
 #include "colmap_ext/logging.h"
 #include "colmap_ext/stereo_depth_files.h"
 #include "lidar/cloud_io.h"
-#include "lidar/util/parallel_for_each.h"
 #include "lidar/pinhole_depth_image.h"
+#include "lidar/util/parallel_for_each.h"
 #include "lidar/voxel_accumulator.h"
 
 #include "colmap/image/undistortion.h"

@@ -1,9 +1,9 @@
 #include "bridge/evaluation/trajectory_evaluation.h"
 
 #include "bridge/evaluation/calibration_evaluation.h"
-#include "lidar/util/atomic_file.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "lidar/plot.h"
+#include "lidar/util/atomic_file.h"
 
 #include "colmap/scene/reconstruction.h"
 

@@ -1,9 +1,9 @@
 // evaluate_dense_depth: a dense workspace's depth maps against the dataset's true depth maps.
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
-#include "lidar/util/atomic_file.h"
 #include "colmap_ext/dense_depth_evaluation.h"
 #include "lidar/plot.h"
+#include "lidar/util/atomic_file.h"
 
 #include "colmap/controllers/option_manager.h"
 

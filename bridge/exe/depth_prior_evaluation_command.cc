@@ -1,9 +1,9 @@
 // evaluate_depth_priors: the database's depth priors against the dataset's true depth maps.
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
-#include "lidar/util/atomic_file.h"
 #include "colmap_ext/depth_prior_evaluation.h"
 #include "lidar/plot.h"
+#include "lidar/util/atomic_file.h"
 
 #include "colmap/controllers/option_manager.h"
 

@@ -1,7 +1,6 @@
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "bridge/initialization/lidar_registration_files.h"
-#include "lidar/util/atomic_file.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "colmap_ext/station_dataset.h"
@@ -13,6 +12,7 @@
 #include "lidar/revisit_closure.h"
 #include "lidar/sweep_deskew.h"
 #include "lidar/trajectory_refinement.h"
+#include "lidar/util/atomic_file.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/scene/reconstruction.h"

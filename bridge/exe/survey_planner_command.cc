@@ -4,11 +4,11 @@
 // candidates.txt (every candidate, best first).
 #include "bridge/exe/survey_planner_command.h"
 
-#include "lidar/util/atomic_file.h"
+#include "bridge/survey/survey_planner.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
-#include "bridge/survey/survey_planner.h"
+#include "lidar/util/atomic_file.h"
 
 #include "colmap/controllers/option_manager.h"
 

@@ -1,10 +1,10 @@
 #include "bridge/initialization/selected_frames.h"
 
 #include "bridge/initialization/lidar_registration_files.h"
-#include "lidar/util/atomic_file.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/text_lines.h"
+#include "lidar/util/atomic_file.h"
 
 #include <algorithm>
 #include <filesystem>

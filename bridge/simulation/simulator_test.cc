@@ -1,13 +1,13 @@
 // Self-consistency of the simulator's ground truth: what it writes must agree with itself, because every
 // accuracy figure of the project is measured against it.
+#include "bridge/simulation/renderer.h"
+#include "bridge/simulation/scene.h"
+#include "bridge/simulation/simulate_dataset.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
 #include "lidar/kd_tree.h"
 #include "lidar/model_evaluation.h"
 #include "lidar/util/statistics.h"
-#include "bridge/simulation/renderer.h"
-#include "bridge/simulation/scene.h"
-#include "bridge/simulation/simulate_dataset.h"
 #include "tests/testing/scoped_temp_dir.h"
 
 #include "colmap/mvs/depth_map.h"
