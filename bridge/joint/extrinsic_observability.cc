@@ -236,16 +236,16 @@ ColumnLayout MakeColumnLayout(const ExtrinsicUncertaintyInputs& inputs,
   }
   if (rotation_free) {
     layout.blocks.push_back(inputs.cam_from_lidar_rotation);
-    THROW_CHECK_EQ(problem->ParameterBlockTangentSize(inputs.cam_from_lidar_rotation),
-                   FreeDirectionsBasis(inputs.held_rotation).cols());
-    AppendExtrinsicColumns(
-        FreeDirectionsBasis(inputs.held_rotation), 0, kTangentToRotationDeg, &layout);
+    const Eigen::MatrixXd free = FreeDirectionsBasis(inputs.held_rotation);
+    THROW_CHECK_EQ(problem->ParameterBlockTangentSize(inputs.cam_from_lidar_rotation), free.cols());
+    AppendExtrinsicColumns(free, 0, kTangentToRotationDeg, &layout);
   }
   if (translation_free) {
     layout.blocks.push_back(inputs.cam_from_lidar_translation);
+    const Eigen::MatrixXd free = FreeDirectionsBasis(inputs.held_translation);
     THROW_CHECK_EQ(problem->ParameterBlockTangentSize(inputs.cam_from_lidar_translation),
-                   FreeDirectionsBasis(inputs.held_translation).cols());
-    AppendExtrinsicColumns(FreeDirectionsBasis(inputs.held_translation), 3, 1000.0, &layout);
+                   free.cols());
+    AppendExtrinsicColumns(free, 3, 1000.0, &layout);
   }
   return layout;
 }
