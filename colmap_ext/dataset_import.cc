@@ -2,10 +2,12 @@
 
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/logging.h"
+#include "colmap_ext/pair_verification.h"
+#include "colmap_ext/sift_matching.h"
 
 #include "colmap/controllers/feature_extraction.h"
-#include "colmap/controllers/feature_matching.h"
 #include "colmap/controllers/image_reader.h"
+#include "colmap/feature/pairing.h"
 #include "colmap/geometry/gps.h"
 #include "colmap/scene/database.h"
 
@@ -25,6 +27,8 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr char kStationPlaceholder[] = "{station}";
+
+using ImagePair = std::pair<colmap::image_t, colmap::image_t>;
 
 void CheckImage(const std::string& station,
                 const std::string& side,
@@ -252,62 +256,78 @@ void WritePosePriors(const StationDataset& dataset,
             << image_ids.size() - written - kept << " stations without a position" << std::endl;
 }
 
-// COLMAP's exhaustive, sequential or spatial matcher on the database.
-void MatchFeatures(const DatasetImportOptions& options, const std::string& database_path) {
-  std::cout << "COLMAP " << ImageMatcherName(options.matcher) << " matching" << std::endl;
-  std::unique_ptr<colmap::Thread> matcher;
+// The image pairs of COLMAP's exhaustive, sequential or spatial pairing, each once, without those
+// that have matches already (a user's database keeps its own).
+std::vector<ImagePair> PairsToMatch(const DatasetImportOptions& options,
+                                    const std::string& database_path) {
+  const auto database = std::make_shared<colmap::Database>(database_path);
+  std::unique_ptr<colmap::PairGenerator> generator;
   if (options.matcher == ImageMatcher::kSequential) {
-    matcher = colmap::CreateSequentialFeatureMatcher(options.sequential_matching,
-                                                     options.sift_matching,
-                                                     options.two_view_geometry,
-                                                     database_path);
+    generator =
+        std::make_unique<colmap::SequentialPairGenerator>(options.sequential_matching, database);
   } else if (options.matcher == ImageMatcher::kSpatial) {
-    matcher = colmap::CreateSpatialFeatureMatcher(
-        options.spatial_matching, options.sift_matching, options.two_view_geometry, database_path);
+    generator = std::make_unique<colmap::SpatialPairGenerator>(options.spatial_matching, database);
   } else {
-    matcher = colmap::CreateExhaustiveFeatureMatcher(options.exhaustive_matching,
-                                                     options.sift_matching,
-                                                     options.two_view_geometry,
-                                                     database_path);
+    generator =
+        std::make_unique<colmap::ExhaustivePairGenerator>(options.exhaustive_matching, database);
   }
-  matcher->Start();
-  matcher->Wait();
+  std::set<colmap::image_pair_t> seen;
+  std::vector<ImagePair> pairs;
+  for (const ImagePair& pair : generator->AllPairs()) {
+    if (pair.first == pair.second) continue;
+    if (!seen.insert(colmap::Database::ImagePairToPairId(pair.first, pair.second)).second) continue;
+    if (!database->ExistsMatches(pair.first, pair.second)) pairs.push_back(pair);
+  }
+  return pairs;
+}
+
+// SIFT matching (sift_matching.h) of COLMAP's exhaustive, sequential or spatial pairs.
+void MatchFeatures(const DatasetImportOptions& options, const std::string& database_path) {
+  const std::vector<ImagePair> pairs = PairsToMatch(options, database_path);
+  std::cout << "SIFT matching, COLMAP's " << ImageMatcherName(options.matcher)
+            << " pairs: " << pairs.size() << " image pairs" << std::endl;
+  MatchImagePairs(
+      pairs, options.sift_matching, options.two_view_geometry.min_num_inliers, database_path);
 }
 
 // Spatial matching gives a station without a position (outside the LiDAR registration's largest
-// component) no pair: such stations are matched with every other image by COLMAP's image-pairs
-// matcher on a list (DATABASE.pairs.txt, removed with the partial database), so that they can still
+// component) no pair: such stations are matched with every other image, so that they can still
 // join the model through their images: (stations without a position) x N pairs at most.
 void MatchStationsWithoutPosition(const StationDataset& dataset,
-                                  const std::vector<std::string>& names,
+                                  const std::vector<colmap::image_t>& image_ids,
                                   const DatasetImportOptions& options,
                                   const std::string& database_path) {
   std::vector<size_t> unplaced;
-  for (size_t i = 0; i < names.size(); ++i) {
+  for (size_t i = 0; i < image_ids.size(); ++i) {
     if (options.station_positions.count(dataset.stations[i]) == 0) unplaced.push_back(i);
   }
   if (unplaced.empty()) return;
-  colmap::ImagePairsMatchingOptions pairs;
-  pairs.match_list_path = database_path + ".pairs.txt";
-  std::set<std::pair<size_t, size_t>> listed;
+  std::vector<ImagePair> pairs;
   {
-    std::ofstream list(pairs.match_list_path);
+    const colmap::Database database(database_path);
     for (size_t i : unplaced) {
-      for (size_t j = 0; j < names.size(); ++j) {
-        if (j != i && listed.insert({std::min(i, j), std::max(i, j)}).second) {
-          list << names[i] << " " << names[j] << "\n";
-        }
+      for (size_t j = 0; j < image_ids.size(); ++j) {
+        const bool listed = options.station_positions.count(dataset.stations[j]) == 0 && j < i;
+        if (j == i || listed || database.ExistsMatches(image_ids[i], image_ids[j])) continue;
+        pairs.emplace_back(image_ids[i], image_ids[j]);
       }
     }
-    if (!list.good()) throw std::runtime_error("Cannot write " + pairs.match_list_path);
   }
-  std::cout << "COLMAP image-pairs matching: " << unplaced.size()
-            << " stations without a LiDAR position, each with every image (" << listed.size()
+  std::cout << "SIFT matching: " << unplaced.size()
+            << " stations without a LiDAR position, each with every image (" << pairs.size()
             << " pairs)" << std::endl;
-  const std::unique_ptr<colmap::Thread> matcher = colmap::CreateImagePairsFeatureMatcher(
-      pairs, options.sift_matching, options.two_view_geometry, database_path);
-  matcher->Start();
-  matcher->Wait();
+  MatchImagePairs(
+      pairs, options.sift_matching, options.two_view_geometry.min_num_inliers, database_path);
+}
+
+// The pairs this import matched get their two-view geometries (pair_verification.h).
+void VerifyNewPairs(const DatasetImportOptions& options,
+                    const std::set<colmap::image_pair_t>& verified_before,
+                    const std::string& database_path) {
+  const size_t num_pairs = VerifyPairsDeterministically(
+      options.two_view_geometry, verified_before, database_path, options.sift_matching.num_threads);
+  std::cout << "Geometric verification (COLMAP's two-view geometry, RANSAC seeded per pair): "
+            << num_pairs << " pairs" << std::endl;
 }
 
 // Our tables: the stereo rig and each station's LiDAR frame.
@@ -429,10 +449,12 @@ DatasetImportSummary ImportIntoPartial(const StationDataset& dataset,
       ImportedImageIds(dataset, names, summary.camera_id, partial);
   if (options.matcher == ImageMatcher::kSpatial)
     WritePosePriors(dataset, image_ids, options, partial);
+  const std::set<colmap::image_pair_t> verified_before = VerifiedPairIds(partial);
   MatchFeatures(options, partial);
   if (options.matcher == ImageMatcher::kSpatial) {
-    MatchStationsWithoutPosition(dataset, names, options, partial);
+    MatchStationsWithoutPosition(dataset, image_ids, options, partial);
   }
+  VerifyNewPairs(options, verified_before, partial);
   WriteRigAndLidarFrames(dataset, summary.camera_id, image_ids, partial);
   const colmap::Database database(partial);
   summary.num_images = names.size();
@@ -447,6 +469,8 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
                                    const DatasetImportOptions& options) {
   THROW_CHECK(options.sift_extraction.Check());
   THROW_CHECK(options.sift_matching.Check());
+  THROW_CHECK(!options.sift_matching.guided_matching)
+      << "SiftMatching.guided_matching is not supported (sift_matching.h matches without it)";
   THROW_CHECK(options.two_view_geometry.Check());
   THROW_CHECK(options.Check());
   THROW_CHECK(options.matcher != ImageMatcher::kSpatial || !options.station_positions.empty())
@@ -460,7 +484,7 @@ DatasetImportSummary ImportDataset(const StationDataset& dataset,
   const std::string partial = database_path + ".import-partial";
   const auto remove_partial = [&partial]() {
     std::error_code ignored;
-    for (const char* suffix : {"", "-journal", "-wal", "-shm", ".pairs.txt"}) {
+    for (const char* suffix : {"", "-journal", "-wal", "-shm"}) {
       fs::remove(partial + suffix, ignored);
     }
   };

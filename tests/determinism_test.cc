@@ -1,6 +1,7 @@
-// The same output with one thread and with four: lidar_registrator, joint_adjuster and densifier on
-// the default pipeline workspace (tests/testing/pipeline_fixture.h), each run with OMP_NUM_THREADS=1
-// and =4 into folders of its own and compared byte by byte (report.json without its timings).
+// The same output with one thread and with four: import_dataset's matching and verification,
+// lidar_registrator, joint_adjuster and densifier on the default pipeline workspace
+// (tests/testing/pipeline_fixture.h), each run with OMP_NUM_THREADS=1 and =4 into folders of its own
+// and compared byte by byte (report.json without its timings).
 #include "tests/testing/file_bytes.h"
 #include "tests/testing/pipeline_fixture.h"
 
@@ -64,6 +65,42 @@ class DeterminismTest : public ::testing::Test {
 
   const testing::PipelineFixture fixture_;
 };
+
+// The fixture's database without its matches, so that import_dataset matches and verifies again
+// (its features are kept: extraction is COLMAP's and not in question here).
+std::string DatabaseWithoutMatches(const testing::PipelineFixture& f, const std::string& path) {
+  fs::create_directories(fs::path(path).parent_path());
+  const auto copy = RunCommand("sqlite3 " + f.File("database.db") + " \".backup '" + path + "'\"");
+  EXPECT_EQ(copy.exit_code, 0) << copy.output;
+  const auto clear =
+      RunCommand("sqlite3 " + path + " 'DELETE FROM matches; DELETE FROM two_view_geometries;'");
+  EXPECT_EQ(clear.exit_code, 0) << clear.output;
+  return path;
+}
+
+// Every matched pair's raw matches, and every verified pair's geometry, as text.
+std::string MatchTables(const std::string& database) {
+  return RunCommand("sqlite3 " + database +
+                    " 'SELECT pair_id, rows, hex(data) FROM matches ORDER BY pair_id;"
+                    " SELECT pair_id, rows, config, hex(data), hex(F), hex(E), hex(H)"
+                    " FROM two_view_geometries ORDER BY pair_id;'")
+      .output;
+}
+
+TEST_F(DeterminismTest, MatchesAndVerifiedPairsAreTheSameWithOneAndFourThreads) {
+  const testing::PipelineFixture& f = fixture_;
+  fs::remove_all(Output("import"));
+  for (const int threads : {1, 4}) {
+    const std::string database =
+        DatabaseWithoutMatches(f, Output("import/" + std::to_string(threads) + ".db"));
+    RunWithThreads(threads,
+                   "import_dataset --dataset_path " + f.dataset + " --database_path " + database +
+                       " --SiftMatching.num_threads " + std::to_string(threads));
+  }
+  const std::string one = MatchTables(Output("import/1.db"));
+  EXPECT_GT(one.size(), 1000u);  // the pairs are there
+  EXPECT_EQ(one, MatchTables(Output("import/4.db")));
+}
 
 TEST_F(DeterminismTest, RegistrationJointAdjustmentAndDenseModelAreTheSameWithOneAndFourThreads) {
   const testing::PipelineFixture& f = fixture_;

@@ -164,9 +164,7 @@ TEST(JointAdjusterTest, DefaultSceneWithNoise) {
   const JointResult stereo_only =
       RunJoint(ws, dir.File("stereo_only"), "--mode stereo_only --cam_from_lidar " + ws.guess);
 
-  // Measured over runs (COLMAP's threaded SIFT makes runs differ slightly): 0.004-0.007 deg,
-  // 2.2-2.9 mm, positions 0.65-0.72 mm mean; since the depth priors join in round 2 (2026-12-02):
-  // 0.0066 deg, 0.60 mm, positions 0.41 mm.
+  // Measured: 0.010 deg, 0.62 mm, positions 0.48 mm mean; bounds 2-3x.
   EXPECT_LE(joint.evaluation.cam_from_lidar_rotation_error_deg, 0.02);
   EXPECT_LE(joint.evaluation.cam_from_lidar_translation_error_mm, 2.0);
   EXPECT_LE(joint.evaluation.mean_position_error_mm, 1.2);
