@@ -16,6 +16,7 @@
 #include "bridge/initialization/selected_frames.h"
 #include "bridge/joint/joint_adjuster.h"
 #include "bridge/joint/joint_problem_data.h"
+#include "bridge/pipeline/initialization_step.h"
 #include "bridge/pipeline/joint_step.h"
 #include "colmap_ext/dataset_import.h"
 #include "colmap_ext/depth_prior_evaluation.h"
@@ -168,17 +169,6 @@ void RunSelectFramesStep(const std::string& registration_path,
 void AddPoseInitializerOptions(const std::string& prefix,
                                colmap::OptionManager* manager,
                                PoseInitializerOptions* options);
-struct PoseInitializerPaths {
-  std::string database_path;
-  std::string registration_path;  // may be empty: no LiDAR edges
-  std::string input_path;         // an existing model to rescale; empty: initialise
-  std::string output_path;
-  std::string depth_path;  // stereo_depth's output; empty: no stereo-LiDAR alignment
-};
-void RunPoseInitializerStep(const StationDataset& dataset,
-                            const PoseInitializerPaths& paths,
-                            const PoseInitializerOptions& options);
-
 // Help of the joint_adjuster and densifier commands' --registration_path.
 inline constexpr char kRegistrationPathHelp[] =
     "lidar_registrator's output: its static/ (moving points removed) or deskewed/ clouds replace "

@@ -3,6 +3,7 @@
 #include "bridge/evaluation/trajectory_evaluation.h"
 #include "bridge/joint/association_settling.h"
 #include "bridge/joint/start_departure.h"
+#include "bridge/pipeline/capture_profile.h"
 #include "bridge/pipeline/joint_report.h"
 #include "bridge/pipeline/vertical_alignment_step.h"
 #include "colmap_ext/elapsed.h"
@@ -57,24 +58,13 @@ colmap::Rigid3d InitialCamFromLidar(const std::string& cam_from_lidar_path,
       dataset.root + "/rig.json");
 }
 
-// What pose_initializer wrote about its start (INPUT/initialization.json), if anything.
-struct InitialisationFacts {
-  bool one_axis = false;  // every rotation about one axis (a driving platform)
-};
-
-// A model without one (e.g. the user's own) has no facts; an unreadable one is an error naming it.
-InitialisationFacts ReadInitialisationFacts(const std::string& input_path) {
-  InitialisationFacts facts;
-  const fs::path path = fs::path(input_path) / "initialization.json";
-  if (!fs::exists(path)) return facts;
-  std::ifstream file(path);
-  const nlohmann::json init = nlohmann::json::parse(file, nullptr, /*allow_exceptions=*/false);
-  if (!file || init.is_discarded() || !init.is_object()) {
-    throw std::runtime_error("cannot read " + path.string() + " (pose_initializer's report)");
-  }
-  facts.one_axis = init.contains("hand_eye") &&
-                   init["hand_eye"].contains("unobservable_translation_axis_in_cam");
-  return facts;
+// The capture profile the pose initialiser recorded beside the input model; for a model without
+// one (e.g. the user's own), the dataset's rig and platform, the stations' rotation then judged from
+// the model alone (DecideFromMotion).
+CaptureProfile InputCaptureProfile(const StationDataset& dataset, const std::string& input_path) {
+  const fs::path path = fs::path(input_path) / kCaptureProfileFile;
+  if (!fs::exists(path)) return DecideCaptureProfile(dataset, std::nullopt);
+  return ReadCaptureProfile(path.string());
 }
 
 // Each registered image's capture time (DATASET/timestamps.txt); empty without times.
@@ -109,14 +99,8 @@ ExtrinsicMeasurement GuessPrior(const StationRig& rig) {
   return prior;
 }
 
-// A moving platform: rig.json's clouds are sweeps, or initialization.json reports a one-axis
-// hand-eye.
-bool IsMovingPlatform(const StationDataset& dataset, const InitialisationFacts& facts) {
-  return dataset.rig.IsMovingPlatform() || facts.one_axis;
-}
-
 // Decided from the motion (DecideFromMotion). E_m: on for a monocular rig, and for a stereo rig on
-// a moving platform (rig.json's clouds are sweeps, or initialization.json's one-axis hand-eye) whose
+// a moving platform (capture_profile.json: rig.json's clouds are sweeps, or a one-axis hand-eye) whose
 // stations do not rotate about two axes (the uniqueness test of Zhen et al. 2019 on the input
 // model): the paper's terms then leave the roll about the driving direction and the translation to
 // the landmarks on the LiDAR surfaces. Not for tripod stations: there the tool asks for tilted stations,
@@ -165,12 +149,12 @@ std::optional<VerticalAlignment> AddExtrinsicMeasurements(
 // What the motion decides: E_m's weight (into `adjuster`) and whether the vertical alignment runs
 // (returned): both for a moving platform whose stations do not rotate about two axes.
 bool DecideFromMotion(const StationDataset& dataset,
-                      const InitialisationFacts& facts,
+                      const CaptureProfile& profile,
                       const colmap::Reconstruction& reconstruction,
                       JointAdjusterOptions* adjuster) {
   const MotionAnalysis motion = AnalyseMotion(reconstruction, adjuster->observability);
-  const bool degenerate_motion =
-      facts.one_axis || (!motion.unique && dataset.rig.IsMovingPlatform());
+  const bool degenerate_motion = profile.rotation == StationRotation::kOneAxis ||
+                                 (!motion.unique && profile.platform == Platform::kMoving);
   adjuster->landmark_lidar_weight =
       degenerate_motion ? kMovingPlatformLandmarkWeight : (dataset.rig.IsStereo() ? 0.0 : 1.0);
   if (degenerate_motion) {
@@ -205,11 +189,11 @@ colmap::Reconstruction ReadInputModel(const std::string& input_path) {
 // The clock offset between images and sweeps is estimated on a moving platform only (and when
 // asked); it needs each image's time.
 void DecideTimeOffset(const StationDataset& dataset,
-                      const InitialisationFacts& facts,
+                      const CaptureProfile& profile,
                       LoadedJointData* loaded,
                       JointAdjusterStepOptions* options) {
   options->adjuster.estimate_time_offset =
-      options->estimate_time_offset && IsMovingPlatform(dataset, facts);
+      options->estimate_time_offset && profile.IsMovingPlatform();
   if (options->adjuster.estimate_time_offset) {
     loaded->data.image_times = ImageTimes(dataset, *loaded);
   }
@@ -238,9 +222,9 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   }
   const auto start = std::chrono::steady_clock::now();
   colmap::Reconstruction reconstruction = ReadInputModel(paths.input_path);
-  const InitialisationFacts facts = ReadInitialisationFacts(paths.input_path);
+  const CaptureProfile profile = InputCaptureProfile(dataset, paths.input_path);
   const bool vertical_alignment =
-      DecideFromMotion(dataset, facts, reconstruction, &options.adjuster);
+      DecideFromMotion(dataset, profile, reconstruction, &options.adjuster);
   colmap::Rigid3d cam_from_lidar =
       InitialCamFromLidar(paths.cam_from_lidar_path, paths.input_path, dataset);
   const colmap::Rigid3d initial = cam_from_lidar;
@@ -255,7 +239,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
                            options.data);
   std::cout << "Loaded depth priors, clouds and the pose graph (" << SecondsSince(start) << " s)"
             << std::endl;
-  DecideTimeOffset(dataset, facts, loaded.get(), &options);
+  DecideTimeOffset(dataset, profile, loaded.get(), &options);
   const std::optional<VerticalAlignment> vertical = AddExtrinsicMeasurements(
       dataset, vertical_alignment, reconstruction, options, loaded.get(), &cam_from_lidar);
   const JointAdjustmentSummary summary =
@@ -271,7 +255,7 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   Trajectory cameras = ModelCameraTrajectory(reconstruction);
   AttachStationTimes(dataset.stations, dataset.frame_times, &cameras);
   WriteTrajectoryExports(partial.File("camera_poses"), cameras);
-  const std::string caveat = UncertaintyCaveat(summary.motion, IsMovingPlatform(dataset, facts));
+  const std::string caveat = UncertaintyCaveat(summary.motion, profile.IsMovingPlatform());
   WriteJointReport(partial.Path(),
                    options.adjuster,
                    *loaded,

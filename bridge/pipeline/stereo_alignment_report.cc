@@ -1,4 +1,4 @@
-#include "bridge/exe/stereo_alignment_report.h"
+#include "bridge/pipeline/stereo_alignment_report.h"
 
 #include <vector>
 
