@@ -1,5 +1,6 @@
 #include "colmap_ext/pair_verification.h"
 
+#include "tests/testing/feature_matches.h"
 #include "tests/testing/scoped_temp_dir.h"
 
 #include "colmap/scene/database.h"
@@ -85,16 +86,6 @@ class PairVerificationTest : public ::testing::Test {
   std::vector<colmap::image_t> ids_;
 };
 
-bool SameMatches(const colmap::FeatureMatches& a, const colmap::FeatureMatches& b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i) {
-    if (a[i].point2D_idx1 != b[i].point2D_idx1 || a[i].point2D_idx2 != b[i].point2D_idx2) {
-      return false;
-    }
-  }
-  return true;
-}
-
 TEST_F(PairVerificationTest, SameGeometriesForOneAndTwoThreads) {
   const std::string one = Copy("one.db"), two = Copy("two.db");
   colmap::TwoViewGeometryOptions options;
@@ -105,7 +96,8 @@ TEST_F(PairVerificationTest, SameGeometriesForOneAndTwoThreads) {
   ASSERT_EQ(geometries_two.size(), 6u);
   for (size_t i = 0; i < geometries_one.size(); ++i) {
     EXPECT_EQ(geometries_one[i].first, geometries_two[i].first) << "pair " << i;
-    EXPECT_TRUE(SameMatches(geometries_one[i].second, geometries_two[i].second)) << "pair " << i;
+    EXPECT_TRUE(testing::SameMatches(geometries_one[i].second, geometries_two[i].second))
+        << "pair " << i;
     // About 60 % of the 300 matches are true; the outliers that happen to fit stay few.
     EXPECT_GT(geometries_one[i].second.size(), 150u);
     EXPECT_LT(geometries_one[i].second.size(), 200u);

@@ -1,5 +1,6 @@
 #include "colmap_ext/sift_matching.h"
 
+#include "tests/testing/feature_matches.h"
 #include "tests/testing/scoped_temp_dir.h"
 
 #include "colmap/scene/database.h"
@@ -82,16 +83,6 @@ colmap::FeatureMatches ReferenceMatches(const colmap::FeatureDescriptors& a,
   return matches;
 }
 
-bool Same(const colmap::FeatureMatches& a, const colmap::FeatureMatches& b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i) {
-    if (a[i].point2D_idx1 != b[i].point2D_idx1 || a[i].point2D_idx2 != b[i].point2D_idx2) {
-      return false;
-    }
-  }
-  return true;
-}
-
 // 1300 features: three blocks of the matrix product, the last one partial.
 TEST(SiftMatchingTest, SameMatchesAsCOLMAPsTestsOnExactDotProducts) {
   std::mt19937 random(3);
@@ -105,7 +96,7 @@ TEST(SiftMatchingTest, SameMatchesAsCOLMAPsTestsOnExactDotProducts) {
     options.cross_check = cross_check;
     const colmap::FeatureMatches matches =
         MatchSiftDescriptors(first.cast<float>(), second.cast<float>(), options);
-    EXPECT_TRUE(Same(matches, ReferenceMatches(first, second, options)));
+    EXPECT_TRUE(testing::SameMatches(matches, ReferenceMatches(first, second, options)));
     // The 1000 shared features are found (a few may fail the ratio test), nothing else.
     EXPECT_GT(matches.size(), 950u);
     int wrong = 0;
