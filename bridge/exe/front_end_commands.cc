@@ -1,7 +1,6 @@
 // The front end's steps and commands: import_dataset, stereo_depth, depth_prior_extractor.
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
-#include "bridge/initialization/lidar_registration_files.h"
 #include "colmap_ext/logging.h"
 
 #include "colmap/feature/pairing.h"
@@ -40,13 +39,6 @@ void AddImportStepOptions(const std::string& prefix,
           "folder of the images named by --image_name_format; empty: DATASET/images");
 }
 
-bool ImportStepOptions::Check() const {
-  CHECK_OPTION(import.Check());
-  CHECK_OPTION(matcher == "exhaustive" || matcher == "sequential" || matcher == "spatial");
-  CHECK_OPTION(matcher != "spatial" || !lidar_registration_path.empty());
-  return true;
-}
-
 void TakeColmapImportOptions(const colmap::OptionManager& manager, ImportStepOptions* options) {
   options->import.sift_extraction = *manager.sift_extraction;
   options->import.sift_matching = *manager.sift_matching;
@@ -54,25 +46,6 @@ void TakeColmapImportOptions(const colmap::OptionManager& manager, ImportStepOpt
   options->import.exhaustive_matching = *manager.exhaustive_matching;
   options->import.sequential_matching = *manager.sequential_matching;
   options->import.spatial_matching = *manager.spatial_matching;
-}
-
-void RunImportStep(const StationDataset& dataset,
-                   const std::string& database_path,
-                   ImportStepOptions options) {
-  const auto start = std::chrono::steady_clock::now();
-  THROW_CHECK(options.Check());
-  options.import.matcher = ImageMatcherFromName(options.matcher);
-  if (options.import.matcher == ImageMatcher::kSpatial) {
-    options.import.station_positions =
-        StationCameraPositions(options.lidar_registration_path,
-                               dataset.rig.cam_from_lidar_guess.value_or(colmap::Rigid3d()));
-  }
-  const DatasetImportSummary summary = ImportDataset(dataset, database_path, options.import);
-  std::cout << "Imported " << dataset.root << " into " << database_path << ": "
-            << summary.num_images << " station images (" << summary.num_new_images
-            << " new), camera " << summary.camera_id << ", " << summary.num_verified_pairs
-            << " verified image pairs (" << std::fixed << std::setprecision(0)
-            << SecondsSince(start) << " s)" << std::endl;
 }
 
 int RunImportDataset(int argc, char** argv) {
@@ -109,17 +82,6 @@ void AddStereoDepthOptions(const std::string& prefix,
   add.Add("num_threads", &options->num_threads);
 }
 
-void RunStereoDepthStep(const StationDataset& dataset,
-                        const std::string& output_path,
-                        const StereoDepthOptions& options) {
-  THROW_CHECK(options.Check());
-  const auto start = std::chrono::steady_clock::now();
-  ComputeDatasetStereoDepth(dataset, output_path, options);
-  std::cout << "Depth maps of " << dataset.stations.size() << " stations written to " << output_path
-            << " (" << std::fixed << std::setprecision(0) << SecondsSince(start) << " s)"
-            << std::endl;
-}
-
 int RunStereoDepth(int argc, char** argv) {
   std::string dataset_path;
   std::string output_path;
@@ -141,28 +103,6 @@ void AddDepthPriorOptions(const std::string& prefix,
   add.Add("max_radius_px", &options->max_radius_px);
   add.Add("sigma_pixels", &options->sigma_pixels, "sigma_p of sigma_d = d^2/(b f) sigma_p");
   add.Add("max_relative_jump", &options->max_relative_jump);
-}
-
-void RunDepthPriorStep(const std::string& database_path,
-                       const std::string& depth_path,
-                       const DepthPriorOptions& options) {
-  THROW_CHECK(options.Check());
-  const std::vector<ImageDepthPriorCount> counts =
-      ExtractDatabaseDepthPriors(database_path, depth_path, options);
-  size_t num_keypoints = 0, num_priors = 0, num_without_map = 0;
-  for (const ImageDepthPriorCount& count : counts) {
-    num_keypoints += count.num_keypoints;
-    num_priors += count.num_priors;
-    if (!count.has_depth_map) ++num_without_map;
-  }
-  std::cout << "Depth priors: " << num_priors << " of " << num_keypoints << " keypoints ("
-            << std::fixed << std::setprecision(1)
-            << 100.0 * num_priors / std::max<size_t>(1, num_keypoints) << " %) in " << counts.size()
-            << " images";
-  if (num_without_map > 0) {
-    std::cout << "; " << num_without_map << " images had no depth map";
-  }
-  std::cout << std::endl;
 }
 
 int RunDepthPriorExtractor(int argc, char** argv) {

@@ -16,8 +16,11 @@
 #include "bridge/initialization/selected_frames.h"
 #include "bridge/joint/joint_adjuster.h"
 #include "bridge/joint/joint_problem_data.h"
+#include "bridge/pipeline/densifier_step.h"
+#include "bridge/pipeline/front_end_steps.h"
 #include "bridge/pipeline/initialization_step.h"
 #include "bridge/pipeline/joint_step.h"
+#include "bridge/pipeline/select_frames_step.h"
 #include "colmap_ext/dataset_import.h"
 #include "colmap_ext/depth_prior_evaluation.h"
 #include "colmap_ext/depth_prior_extractor.h"
@@ -57,17 +60,6 @@ class PrefixedOptions {
   std::string prefix_;
 };
 
-// import_dataset: COLMAP SIFT extraction and matching, our rig and lidar_frames rows.
-struct ImportStepOptions {
-  DatasetImportOptions import;
-  // The command line's matcher: exhaustive | sequential | spatial (the pipeline resolves its auto
-  // first); RunImportStep parses it into import.matcher.
-  std::string matcher = "exhaustive";
-  // lidar_registrator's output folder, for the spatial matcher.
-  std::string lidar_registration_path;
-
-  bool Check() const;
-};
 // Also registers COLMAP's SiftExtraction.*, SiftMatching.*, TwoViewGeometry.*, ExhaustiveMatching.*,
 // SequentialMatching.* and SpatialMatching.* sections (CPU SIFT by default: a headless build has no
 // OpenGL context); TakeColmapImportOptions copies them in after Parse().
@@ -75,25 +67,16 @@ void AddImportStepOptions(const std::string& prefix,
                           colmap::OptionManager* manager,
                           ImportStepOptions* options);
 void TakeColmapImportOptions(const colmap::OptionManager& manager, ImportStepOptions* options);
-void RunImportStep(const StationDataset& dataset,
-                   const std::string& database_path,
-                   ImportStepOptions options);
 
 // stereo_depth: SGM depth maps of every station.
 void AddStereoDepthOptions(const std::string& prefix,
                            colmap::OptionManager* manager,
                            StereoDepthOptions* options);
-void RunStereoDepthStep(const StationDataset& dataset,
-                        const std::string& output_path,
-                        const StereoDepthOptions& options);
 
 // depth_prior_extractor: depth priors of the database's keypoints.
 void AddDepthPriorOptions(const std::string& prefix,
                           colmap::OptionManager* manager,
                           DepthPriorOptions* options);
-void RunDepthPriorStep(const std::string& database_path,
-                       const std::string& depth_path,
-                       const DepthPriorOptions& options);
 
 // lidar_registrator: BSC + RANSAC + ICP over station pairs, the LiDAR pose graph A_l.
 // lidar_registrator's --method.
@@ -161,9 +144,6 @@ void RunLidarRegistratorStep(const std::string& lidar_path,
 void AddFrameSelectionOptions(const std::string& prefix,
                               colmap::OptionManager* manager,
                               FrameSelectionOptions* options);
-void RunSelectFramesStep(const std::string& registration_path,
-                         const std::string& output_path,
-                         const FrameSelectionOptions& options);
 
 // pose_initializer: initial poses, cam_from_lidar and landmarks; or an existing model rescaled.
 void AddPoseInitializerOptions(const std::string& prefix,
@@ -188,16 +168,6 @@ void RefuseRemovedJointAdjusterOptions(int argc, char** argv, const std::string&
 void AddDensifierOptions(const std::string& prefix,
                          colmap::OptionManager* manager,
                          DensifierOptions* options);
-struct DensifierPaths {
-  std::string input_path;
-  std::string cam_from_lidar_path;  // empty: INPUT/cam_from_lidar.txt
-  std::string depth_path;
-  std::string output_path;
-};
-void RunDensifierStep(const StationDataset& dataset,
-                      const DensifierPaths& paths,
-                      const DensifierOptions& options);
-
 // calibrate_edges --profile_axis: J along the rotation about one camera axis instead of the grid.
 struct EdgeAxisProfileRequest {
   Eigen::Vector3d axis_in_cam;
