@@ -20,6 +20,7 @@
 #include "bridge/pipeline/front_end_steps.h"
 #include "bridge/pipeline/initialization_step.h"
 #include "bridge/pipeline/joint_step.h"
+#include "bridge/pipeline/lidar_registration_step.h"
 #include "bridge/pipeline/select_frames_step.h"
 #include "colmap_ext/dataset_import.h"
 #include "colmap_ext/depth_prior_evaluation.h"
@@ -78,66 +79,11 @@ void AddDepthPriorOptions(const std::string& prefix,
                           colmap::OptionManager* manager,
                           DepthPriorOptions* options);
 
-// lidar_registrator: BSC + RANSAC + ICP over station pairs, the LiDAR pose graph A_l.
-// lidar_registrator's --method.
-enum class RegistrationMethod { kAuto, kPairwise, kOdometry };
-
-struct LidarRegistratorStepOptions {
-  StationCloudOptions cloud;
-  LidarGraphOptions graph;
-  // Parsed as int (the OptionManager has no size_t); GraphOptions() gives `graph` with them.
-  int max_neighbors = 0;
-  int sequential = 0;
-  int bridge_neighbors = 4;
-  // Sweeps of a moving platform (frames in name order): register, de-skew every sweep with the motion
-  // to its neighbour (lidar/sweep_deskew.h), write OUTPUT/deskewed/<station>.pcd and register again;
-  // the later steps of `pipeline` use the de-skewed clouds.
-  bool deskew_sweeps = false;
-  SweepTimingOptions sweep_timing;
-  // Each station's sweep middle in sweep durations (lidar/sweep_deskew.h SweepClockFromTimes of
-  // the dataset's sweep_times.txt); empty: frame indices from the station names.
-  std::vector<double> sweep_clock;
-  // Each station's frame time [s] (the dataset's timestamps.txt) for the TUM export; empty: none.
-  std::vector<double> station_times;
-  // auto | pairwise | odometry. Pairwise: BSC + RANSAC + ICP over station pairs (tripod stations,
-  // any prior). Odometry: sequential frame-to-map ICP (lidar/lidar_odometry.h) for the sweeps of a
-  // moving platform. Auto: odometry for sweeps (deskew_sweeps or moving_platform), else pairwise.
-  std::string method = "auto";
-  bool moving_platform = false;  // the dataset's rig.json says so
-  LidarOdometryOptions odometry;
-  // Odometry: revisit edges between keyframes near in space, far along the path, registered by BSC
-  // + RANSAC + ICP and accepted within the odometry's drift (lidar/revisit_closure.h); `revisit`'s
-  // cloud and pair options are this step's `cloud` and `graph.pair`.
-  bool revisits = true;
-  RevisitOptions revisit;
-  // Odometry: k > 0 refines the trajectory by ICP between each de-skewed sweep and its next
-  // `refine_neighbors` sweeps at `cloud`'s resolution (lidar/trajectory_refinement.h), then
-  // de-skews the sweeps again with the refined motion.
-  int refine_neighbors = 2;
-  // After registration, flag the points of moving objects by free space (lidar/moving_points.h) and
-  // write each cloud without them to OUTPUT/static/<station>.pcd (and all flagged points, in the
-  // first station's frame, to OUTPUT/moving_points.ply); the later steps of `pipeline` use them.
-  // auto: for sweeps of a moving platform (with deskew_sweeps); on (1); off (0).
-  std::string remove_moving_points = "auto";
-  MovingPointOptions moving;
-
-  bool Check() const;
-  // `graph` with max_neighbors, sequential and bridge_neighbors.
-  LidarGraphOptions GraphOptions() const;
-  // `method` parsed (Check() has validated it).
-  RegistrationMethod Method() const;
-  // Whether moving points are removed (remove_moving_points, auto decided by deskew_sweeps).
-  bool RemovesMovingPoints() const;
-};
+// lidar_registrator (LidarRegistratorStepOptions, RunLidarRegistratorStep:
+// bridge/pipeline/lidar_registration_step.h).
 void AddLidarRegistratorOptions(const std::string& prefix,
                                 colmap::OptionManager* manager,
                                 LidarRegistratorStepOptions* options);
-// Each station's sweep middle in sweep durations: from the dataset's sweep_times.txt, else the
-// frame index of numeric station names (else the position in name order).
-std::vector<double> SweepClock(const StationDataset& dataset);
-void RunLidarRegistratorStep(const std::string& lidar_path,
-                             const std::string& output_path,
-                             LidarRegistratorStepOptions options);
 
 // select_frames: the frames of a drive that go on to the camera steps (selected_frames.h), from
 // lidar_registrator's output folder into OUTPUT.
