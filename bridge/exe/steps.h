@@ -17,6 +17,7 @@
 #include "bridge/joint/joint_adjuster.h"
 #include "bridge/joint/joint_problem_data.h"
 #include "bridge/pipeline/densifier_step.h"
+#include "bridge/pipeline/evaluation_steps.h"
 #include "bridge/pipeline/front_end_steps.h"
 #include "bridge/pipeline/initialization_step.h"
 #include "bridge/pipeline/joint_step.h"
@@ -138,44 +139,6 @@ void RunCalibrateEdgesStep(const EdgeCalibrationPaths& paths,
                            const EdgeCalibrationOptions& options,
                            const std::optional<EdgeAxisProfileRequest>& profile = std::nullopt);
 
-// evaluate_calibration: cam_from_lidar and station poses against ground_truth/. `output_path` empty:
-// print the metrics only. `alignment`: rigid | similarity.
-void RunEvaluateCalibrationStep(const std::string& dataset_path,
-                                const std::string& input_path,
-                                const std::string& cam_from_lidar_path,
-                                const std::string& output_path,
-                                TrajectoryAlignment alignment);
-
-// evaluate_trajectory: a trajectory against a reference
-// (bridge/evaluation/trajectory_evaluation.h).
-struct TrajectoryEvaluationStepOptions {
-  std::string trajectory_path, reference_path, output_path;
-  std::string trajectory_format = "auto", reference_format = "auto";
-  // A pose file reference_sensor_from_sensor applied to every reference pose (empty: same sensor).
-  std::string reference_sensor_from_sensor_path;
-  // A dataset whose timestamps.txt times named poses (empty: none).
-  std::string timestamps_path;
-  TrajectoryAlignment alignment = TrajectoryAlignment::kRigid;
-  std::vector<double> lengths_m;  // empty: 10, 20, ... m
-  double max_time_difference_s = 0.01;
-
-  bool Check() const;
-};
-TrajectoryError RunEvaluateTrajectoryStep(const TrajectoryEvaluationStepOptions& options);
-
-// evaluate_depth_priors: the database's priors against DATASET/ground_truth/depth/, metrics.json
-// and a histogram into `output_path`.
-void RunEvaluateDepthPriorsStep(const std::string& database_path,
-                                const std::string& dataset_path,
-                                const std::string& output_path,
-                                const DepthPriorEvaluationOptions& options);
-
-// evaluate_dense_depth: DENSE's depth maps against DATASET/ground_truth/depth/, metrics.json and a
-// histogram into `output_path`.
-void RunEvaluateDenseDepthStep(const std::string& dense_path,
-                               const std::string& dataset_path,
-                               const std::string& output_path);
-
 // "0.002,0.005,0.01" -> numbers. Every token must be a positive number in full ("2mm" is refused,
 // not read as 2); an empty result means the list was malformed.
 std::vector<double> ParsePositiveNumbers(const std::string& csv);
@@ -184,11 +147,4 @@ std::vector<double> ParsePositiveNumbers(const std::string& csv);
 void AddModelEvaluationOptions(const std::string& prefix,
                                colmap::OptionManager* manager,
                                ModelEvaluationOptions* options);
-// evaluate_model: a cloud against ground_truth/surface.ply. `truth_from_model_path` may be empty.
-void RunEvaluateModelStep(const std::string& model_path,
-                          const std::string& ground_truth_path,
-                          const std::string& truth_from_model_path,
-                          const std::string& output_path,
-                          const ModelEvaluationOptions& options);
-
 }  // namespace colmap_lidar

@@ -12,42 +12,6 @@
 
 namespace colmap_lidar {
 
-bool TrajectoryEvaluationStepOptions::Check() const {
-  CHECK_OPTION_GT(max_time_difference_s, 0);
-  return true;
-}
-
-TrajectoryError RunEvaluateTrajectoryStep(const TrajectoryEvaluationStepOptions& options) {
-  THROW_CHECK(options.Check());
-  Trajectory estimate = LoadTrajectory(options.trajectory_path, options.trajectory_format);
-  Trajectory reference = LoadTrajectory(options.reference_path, options.reference_format);
-  if (!options.reference_sensor_from_sensor_path.empty()) {
-    const colmap::Rigid3d sensor = ReadPoseFile(options.reference_sensor_from_sensor_path);
-    for (colmap::Rigid3d& pose : reference.world_from_sensor) pose = pose * sensor;
-  }
-  if (!options.timestamps_path.empty()) {
-    const StationDataset times = ReadStationDataset(options.timestamps_path);
-    AttachStationTimes(times.stations, times.frame_times, &estimate);
-    AttachStationTimes(times.stations, times.frame_times, &reference);
-  }
-  const MatchedTrajectories matched = MatchTrajectories(estimate,
-                                                        options.trajectory_path,
-                                                        reference,
-                                                        options.reference_path,
-                                                        options.max_time_difference_s);
-  TrajectoryErrorOptions error_options;
-  error_options.lengths_m = options.lengths_m;
-  error_options.alignment = options.alignment;
-  const TrajectoryError error =
-      EvaluateTrajectoryError(matched.estimate, matched.reference, error_options);
-  WriteTrajectoryEvaluation(options.output_path, matched, error, error_options);
-  std::cout << "evaluate_trajectory: " << matched.names.size() << " frames matched by "
-            << matched.matched_by << " (" << matched.num_estimate_unmatched << " of "
-            << options.trajectory_path << " and " << matched.num_reference_unmatched
-            << " of the reference unmatched); " << TrajectoryErrorSummary(error) << std::endl;
-  return error;
-}
-
 int RunEvaluateTrajectory(int argc, char** argv) {
   TrajectoryEvaluationStepOptions options;
   std::string lengths, alignment = "rigid";

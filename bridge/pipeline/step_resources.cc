@@ -1,4 +1,4 @@
-#include "bridge/exe/step_resources.h"
+#include "bridge/pipeline/step_resources.h"
 
 #include <sys/resource.h>
 

@@ -1,4 +1,4 @@
-#include "bridge/exe/workspace_lock.h"
+#include "bridge/pipeline/workspace_lock.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
