@@ -1,5 +1,6 @@
 #include "colmap_ext/sift_matching.h"
 
+#include "colmap_ext/logging.h"
 #include "lidar/util/parallel_for_each.h"
 
 #include "colmap/scene/database.h"
@@ -60,6 +61,8 @@ colmap::FeatureMatches MatchSiftDescriptors(const SiftDescriptorsFloat& descript
                                             const SiftDescriptorsFloat& descriptors2,
                                             const colmap::SiftMatchingOptions& options) {
   const int n1 = static_cast<int>(descriptors1.rows()), n2 = static_cast<int>(descriptors2.rows());
+  if (n1 == 0 || n2 == 0) return {};  // an image without features (its descriptors may be 0 x 0)
+  THROW_CHECK_EQ(descriptors1.cols(), descriptors2.cols()) << "descriptors of different lengths";
   std::vector<TwoNearest> rows(n1), columns(n2);
   SiftDescriptorsFloat dots;
   for (int r0 = 0; r0 < n1; r0 += kRowBlock) {

@@ -122,6 +122,16 @@ TEST(SiftMatchingTest, AnAmbiguousFeatureFailsTheRatioTest) {
       1u);
 }
 
+TEST(SiftMatchingTest, AnImageWithoutFeaturesHasNoMatches) {
+  std::mt19937 random(7);
+  const SiftDescriptorsFloat some = RandomDescriptors(20, &random).cast<float>();
+  const colmap::SiftMatchingOptions options;
+  EXPECT_TRUE(MatchSiftDescriptors(some, SiftDescriptorsFloat(0, 0), options).empty());
+  EXPECT_TRUE(MatchSiftDescriptors(SiftDescriptorsFloat(0, 128), some, options).empty());
+  EXPECT_THROW(MatchSiftDescriptors(some, SiftDescriptorsFloat::Zero(3, 64), options),
+               std::exception);
+}
+
 TEST(SiftMatchingTest, WritesEachPairsMatchesAndNoneBelowTheMinimum) {
   testing::ScopedTempDir dir;
   const std::string path = dir.File("database.db");
