@@ -90,12 +90,9 @@ void AddPipelineOptions(colmap::OptionManager* manager, PipelineOptions* options
       "mode",
       &options->mode,
       "joint | precalibrated | stereo_only (stereo_only also fuses unrefined stereo)");
-  // At 3 MP COLMAP's 8192 SIFT features (more with their second orientations) make matching the
-  // import's cost; with 4096 the LiDAR, not the feature count, still sets the accuracy of
-  // cam_from_lidar (docs/benchmarks/pipeline.md). Images of up to 1 MP rarely have more.
-  manager->sift_extraction->max_num_features = 4096;
-  options->import.matcher = "auto";
-  options->import.import.spatial_matching.max_num_neighbors = 12;
+  // The pipeline's own defaults (PipelineOptions()) for COLMAP's sections too.
+  *manager->sift_extraction = options->import.import.sift_extraction;
+  *manager->sift_matching = options->import.import.sift_matching;
   AddImportStepOptions("Import.", manager, &options->import);
   manager->AddDefaultOption(
       "Import.max_exhaustive_stations",
@@ -103,8 +100,6 @@ void AddPipelineOptions(colmap::OptionManager* manager, PipelineOptions* options
       "Import.matcher auto: exhaustive matching up to this many stations, spatial beyond");
   AddStereoDepthOptions("StereoDepth.", manager, &options->stereo);
   AddDepthPriorOptions("DepthPrior.", manager, &options->depth_prior);
-  // All pairs grow as N^2: the pipeline registers each station with its 4 most similar ones.
-  options->registrator.max_neighbors = 4;
   AddLidarRegistratorOptions("LidarRegistrator.", manager, &options->registrator);
   AddPoseInitializerOptions("PoseInitializer.", manager, &options->initializer);
   AddJointAdjusterOptions("JointAdjuster.", manager, &options->joint);

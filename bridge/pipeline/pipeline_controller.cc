@@ -309,6 +309,20 @@ void DecideFromDataset(const StationDataset& dataset, PipelineOptions* pipeline)
 
 }  // namespace
 
+PipelineOptions::PipelineOptions() {
+  // At 3 MP COLMAP's 8192 SIFT features (more with their second orientations) make matching the
+  // import's cost; with 4096 the LiDAR, not the feature count, still sets the accuracy of
+  // cam_from_lidar (docs/benchmarks/pipeline.md). Images of up to 1 MP rarely have more.
+  import.import.sift_extraction.max_num_features = 4096;
+  // GPU SIFT needs CUDA or an OpenGL context; a headless build has neither.
+  import.import.sift_extraction.use_gpu = false;
+  import.import.sift_matching.use_gpu = false;
+  import.matcher = "auto";
+  import.import.spatial_matching.max_num_neighbors = 12;
+  // All pairs grow as N^2: the pipeline registers each station with its 4 most similar ones.
+  registrator.max_neighbors = 4;
+}
+
 void RunFullPipeline(PipelineOptions pipeline) {
   CheckStepOptions(&pipeline);
   const StationDataset dataset = ReadStationDataset(pipeline.dataset_path);

@@ -19,6 +19,10 @@ namespace colmap_lidar {
 
 // The options of `pipeline`: its own, and every step's under the step's section.
 struct PipelineOptions {
+  // The steps' defaults, but where the pipeline's differ: 4096 SIFT features, CPU SIFT, Import.matcher
+  // auto with 12 spatial neighbours, each station registered with its 4 most similar ones.
+  PipelineOptions();
+
   std::string dataset_path;
   std::string workspace_path;
   bool overwrite = false;
