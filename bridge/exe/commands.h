@@ -46,7 +46,8 @@ int RunPoseInitializer(int argc, char** argv);
 // dense workspace (bridge/dense/densifier.h).
 int RunDensifier(int argc, char** argv);
 
-// Every step from a station dataset to the refined model, restartable (bridge/pipeline_commands.cc).
+// Every step from a station dataset to the refined model, restartable
+// (RunFullPipeline, bridge/pipeline/pipeline_controller.h).
 int RunPipeline(int argc, char** argv);
 
 // Accuracy of a cloud against ground_truth/surface.ply: distances, completeness, density, plots.
