@@ -28,10 +28,6 @@ std::string MillimetreLabel(double threshold_m) {
   return label.str() + "mm";
 }
 
-}  // namespace
-
-namespace {
-
 // The console summary of a model evaluation with evaluated points.
 void PrintModelEvaluation(const ModelEvaluation& result) {
   std::cout << std::fixed << std::setprecision(2) << "evaluate_model: mean " << result.mean * 1000
@@ -132,6 +128,45 @@ void PrintCalibrationEvaluation(const CalibrationEvaluation& result) {
     std::cout << "evaluate_calibration: " << result.missing_stations.size()
               << " stations of the truth are not in the model" << std::endl;
   }
+}
+
+nlohmann::json StatisticsJson(const DenseDepthStatistics& s) {
+  return {{"num_pixels", s.num_pixels},
+          {"num_with_depth", s.num_with_depth},
+          {"num_compared", s.num_compared},
+          {"coverage", s.coverage},
+          {"mean_error_m", s.mean_error_m},
+          {"median_abs_error_m", s.median_abs_error_m},
+          {"p90_abs_error_m", s.p90_abs_error_m},
+          {"p99_abs_error_m", s.p99_abs_error_m},
+          {"median_abs_relative_error", s.median_abs_relative_error},
+          {"within_1cm", s.within_1cm},
+          {"within_5cm", s.within_5cm}};
+}
+
+nlohmann::json StatisticsJson(const DepthPriorStatistics& statistics) {
+  nlohmann::json json;
+  json["num_priors"] = statistics.num_priors;
+  json["median_abs_relative_error"] = statistics.median_abs_relative_error;
+  json["mean_relative_error"] = statistics.mean_relative_error;
+  json["mean_normalized_error"] = statistics.mean_normalized_error;
+  json["within_1_sigma"] = statistics.within_1_sigma;
+  json["within_2_sigma"] = statistics.within_2_sigma;
+  json["within_3_sigma"] = statistics.within_3_sigma;
+  json["beyond_10_sigma"] = statistics.beyond_10_sigma;
+  return json;
+}
+
+void PrintStatistics(const std::string& label, const DepthPriorStatistics& statistics) {
+  std::cout << std::fixed << std::setprecision(1) << "  " << label << ": " << statistics.num_priors
+            << " priors, median |error| " << 100 * statistics.median_abs_relative_error
+            << " % of the depth, mean error " << 100 * statistics.mean_relative_error << " % ("
+            << std::setprecision(2) << statistics.mean_normalized_error
+            << " sigma); within 1/2/3 sigma " << std::setprecision(1)
+            << 100 * statistics.within_1_sigma << " / " << 100 * statistics.within_2_sigma << " / "
+            << 100 * statistics.within_3_sigma
+            << " % (Gaussian 68.3 / 95.4 / 99.7), beyond 10 sigma "
+            << 100 * statistics.beyond_10_sigma << " %" << std::endl;
 }
 
 }  // namespace
@@ -260,24 +295,6 @@ TrajectoryError RunEvaluateTrajectoryStep(const TrajectoryEvaluationStepOptions&
   return error;
 }
 
-namespace {
-
-nlohmann::json StatisticsJson(const DenseDepthStatistics& s) {
-  return {{"num_pixels", s.num_pixels},
-          {"num_with_depth", s.num_with_depth},
-          {"num_compared", s.num_compared},
-          {"coverage", s.coverage},
-          {"mean_error_m", s.mean_error_m},
-          {"median_abs_error_m", s.median_abs_error_m},
-          {"p90_abs_error_m", s.p90_abs_error_m},
-          {"p99_abs_error_m", s.p99_abs_error_m},
-          {"median_abs_relative_error", s.median_abs_relative_error},
-          {"within_1cm", s.within_1cm},
-          {"within_5cm", s.within_5cm}};
-}
-
-}  // namespace
-
 void RunEvaluateDenseDepthStep(const std::string& dense_path,
                                const std::string& dataset_path,
                                const std::string& output_path) {
@@ -314,35 +331,6 @@ void RunEvaluateDenseDepthStep(const std::string& dense_path,
   std::cout << "evaluate_dense_depth: wrote " << output_path
             << "/{metrics.json, error_histogram.png}" << std::endl;
 }
-
-namespace {
-
-nlohmann::json StatisticsJson(const DepthPriorStatistics& statistics) {
-  nlohmann::json json;
-  json["num_priors"] = statistics.num_priors;
-  json["median_abs_relative_error"] = statistics.median_abs_relative_error;
-  json["mean_relative_error"] = statistics.mean_relative_error;
-  json["mean_normalized_error"] = statistics.mean_normalized_error;
-  json["within_1_sigma"] = statistics.within_1_sigma;
-  json["within_2_sigma"] = statistics.within_2_sigma;
-  json["within_3_sigma"] = statistics.within_3_sigma;
-  json["beyond_10_sigma"] = statistics.beyond_10_sigma;
-  return json;
-}
-
-void PrintStatistics(const std::string& label, const DepthPriorStatistics& statistics) {
-  std::cout << std::fixed << std::setprecision(1) << "  " << label << ": " << statistics.num_priors
-            << " priors, median |error| " << 100 * statistics.median_abs_relative_error
-            << " % of the depth, mean error " << 100 * statistics.mean_relative_error << " % ("
-            << std::setprecision(2) << statistics.mean_normalized_error
-            << " sigma); within 1/2/3 sigma " << std::setprecision(1)
-            << 100 * statistics.within_1_sigma << " / " << 100 * statistics.within_2_sigma << " / "
-            << 100 * statistics.within_3_sigma
-            << " % (Gaussian 68.3 / 95.4 / 99.7), beyond 10 sigma "
-            << 100 * statistics.beyond_10_sigma << " %" << std::endl;
-}
-
-}  // namespace
 
 void RunEvaluateDepthPriorsStep(const std::string& database_path,
                                 const std::string& dataset_path,
