@@ -98,7 +98,8 @@ TEST_F(PairVerificationTest, SameGeometriesForOneAndTwoThreads) {
     EXPECT_EQ(geometries_one[i].first, geometries_two[i].first) << "pair " << i;
     EXPECT_TRUE(testing::SameMatches(geometries_one[i].second, geometries_two[i].second))
         << "pair " << i;
-    // About 60 % of the 300 matches are true; the outliers that happen to fit stay few.
+    // About 60 % of the 300 matches are true; the outliers that happen to fit stay few (measured
+    // 160-191 inliers per pair).
     EXPECT_GT(geometries_one[i].second.size(), 150u);
     EXPECT_LT(geometries_one[i].second.size(), 200u);
   }
