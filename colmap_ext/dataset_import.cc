@@ -381,23 +381,11 @@ std::string DatasetImportOptions::ImageName(const StationDataset& dataset, size_
 }
 
 ImageMatcher ImageMatcherFromName(const std::string& name) {
-  if (name == "exhaustive") return ImageMatcher::kExhaustive;
-  if (name == "sequential") return ImageMatcher::kSequential;
-  if (name == "spatial") return ImageMatcher::kSpatial;
-  throw std::invalid_argument("unknown matcher '" + name +
-                              "' (expected exhaustive, sequential or spatial)");
+  return ChoiceFromName(kImageMatcherNames, name, "matcher");
 }
 
 const char* ImageMatcherName(ImageMatcher matcher) {
-  switch (matcher) {
-    case ImageMatcher::kExhaustive:
-      return "exhaustive";
-    case ImageMatcher::kSequential:
-      return "sequential";
-    case ImageMatcher::kSpatial:
-      return "spatial";
-  }
-  return "exhaustive";
+  return ChoiceName(kImageMatcherNames, matcher);
 }
 
 colmap::SpatialMatchingOptions LidarSpatialMatchingOptions() {

@@ -13,6 +13,7 @@
 #pragma once
 
 #include "colmap_ext/station_dataset.h"
+#include "lidar/util/named_choice.h"
 
 #include "colmap/estimators/two_view_geometry.h"
 #include "colmap/feature/pairing.h"
@@ -30,6 +31,10 @@ colmap::SpatialMatchingOptions LidarSpatialMatchingOptions();
 // How the imported images are paired for matching: every pair; each image with its successors by
 // name (frames of a moving platform); each image with the images whose stations are near.
 enum class ImageMatcher { kExhaustive, kSequential, kSpatial };
+inline constexpr NamedChoices<ImageMatcher, 3> kImageMatcherNames = {
+    {{"exhaustive", ImageMatcher::kExhaustive},
+     {"sequential", ImageMatcher::kSequential},
+     {"spatial", ImageMatcher::kSpatial}}};
 // "exhaustive" | "sequential" | "spatial"; throws std::invalid_argument naming any other.
 ImageMatcher ImageMatcherFromName(const std::string& name);
 const char* ImageMatcherName(ImageMatcher matcher);

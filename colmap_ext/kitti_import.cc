@@ -93,12 +93,6 @@ void WriteReferences(const KittiSource& source, int camera, const fs::path& part
 
 }  // namespace
 
-KittiFormat KittiFormatFromName(const std::string& name) {
-  if (name == "raw") return KittiFormat::kRaw;
-  if (name == "odometry") return KittiFormat::kOdometry;
-  throw std::invalid_argument("unknown KITTI format '" + name + "' (raw, odometry)");
-}
-
 bool KittiImportOptions::Check() const {
   CHECK_OPTION(!kitti_path.empty());
   CHECK_OPTION(format == KittiFormat::kOdometry || !calib_path.empty());

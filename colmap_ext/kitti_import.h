@@ -14,15 +14,16 @@
 // cam_from_lidar_guess only with `write_guess` (the reference perturbed, seeded).
 #pragma once
 
+#include "lidar/util/named_choice.h"
+
 #include <cstdint>
 #include <string>
 
 namespace colmap_lidar {
 
 enum class KittiFormat { kRaw, kOdometry };
-
-// "raw" or "odometry"; throws std::invalid_argument on another name.
-KittiFormat KittiFormatFromName(const std::string& name);
+inline constexpr NamedChoices<KittiFormat, 2> kKittiFormatNames = {
+    {{"raw", KittiFormat::kRaw}, {"odometry", KittiFormat::kOdometry}}};
 
 struct KittiImportOptions {
   KittiFormat format = KittiFormat::kRaw;

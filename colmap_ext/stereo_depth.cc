@@ -25,12 +25,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int SgbmMode(const std::string& mode) {
-  if (mode == "sgbm") return cv::StereoSGBM::MODE_SGBM;
-  if (mode == "hh") return cv::StereoSGBM::MODE_HH;
-  if (mode == "3way") return cv::StereoSGBM::MODE_SGBM_3WAY;
-  if (mode == "hh4") return cv::StereoSGBM::MODE_HH4;
-  throw std::invalid_argument("unknown SGBM mode '" + mode + "' (sgbm, hh, 3way, hh4)");
+int OpenCvSgbmMode(SgbmMode mode) {
+  switch (mode) {
+    case SgbmMode::kSgbm:
+      return cv::StereoSGBM::MODE_SGBM;
+    case SgbmMode::kHh:
+      return cv::StereoSGBM::MODE_HH;
+    case SgbmMode::kSgbm3Way:
+      return cv::StereoSGBM::MODE_SGBM_3WAY;
+    case SgbmMode::kHh4:
+      return cv::StereoSGBM::MODE_HH4;
+  }
+  return cv::StereoSGBM::MODE_SGBM;
 }
 
 // Disparity search range [min, min + num) from the depth range: num is a multiple of 16 (OpenCV).
@@ -166,7 +172,7 @@ cv::Ptr<cv::StereoSGBM> MakeSgbm(int min_disparity,
       options.uniqueness_ratio,
       options.speckle_window_size,
       static_cast<int>(std::ceil(options.speckle_range_px)),
-      SgbmMode(options.mode));
+      OpenCvSgbmMode(options.mode));
 }
 
 void PrintStereoSetup(const StationDataset& dataset,
@@ -179,14 +185,13 @@ void PrintStereoSetup(const StationDataset& dataset,
             << ", rectified f " << std::fixed << std::setprecision(1)
             << rectifier.RectifiedFocalLength() << " px, baseline " << std::setprecision(3)
             << rectifier.BaselineMeters() << " m, disparities " << min_disparity << ".."
-            << min_disparity + num_disparities - 1 << " px, SGBM mode " << options.mode
-            << std::endl;
+            << min_disparity + num_disparities - 1 << " px, SGBM mode "
+            << ChoiceName(kSgbmModeNames, options.mode) << std::endl;
 }
 
 }  // namespace
 
 bool StereoDepthOptions::Check() const {
-  SgbmMode(mode);
   CHECK_OPTION_GT(min_depth_m, 0);
   CHECK_OPTION_GT(max_depth_m, min_depth_m);
   CHECK_OPTION_GE(block_size, 1);

@@ -5,6 +5,7 @@
 
 #include "colmap_ext/station_dataset.h"
 #include "colmap_ext/stereo_rectifier.h"
+#include "lidar/util/named_choice.h"
 
 #include <opencv2/core.hpp>
 
@@ -12,10 +13,16 @@
 
 namespace colmap_lidar {
 
+// OpenCV StereoSGBM's modes: 5 paths, 8 paths (full cost volume: much memory), the faster 3-way
+// and 4-path HH.
+enum class SgbmMode { kSgbm, kHh, kSgbm3Way, kHh4 };
+inline constexpr NamedChoices<SgbmMode, 4> kSgbmModeNames = {{{"sgbm", SgbmMode::kSgbm},
+                                                              {"hh", SgbmMode::kHh},
+                                                              {"3way", SgbmMode::kSgbm3Way},
+                                                              {"hh4", SgbmMode::kHh4}}};
+
 struct StereoDepthOptions {
-  // OpenCV StereoSGBM mode: "sgbm" (5 paths), "hh" (8 paths, full cost volume: much memory), "3way"
-  // (faster), "hh4".
-  std::string mode = "sgbm";
+  SgbmMode mode = SgbmMode::kSgbm;
   // The disparity search range follows from a depth range and the rectified rig: for the 0.38 m baseline
   // at 1028 px width this is about 14..300 px (1.5 m .. 30 m).
   double min_depth_m = 1.5;

@@ -12,15 +12,6 @@
 
 namespace colmap_lidar {
 
-std::string TrajectoryAlignmentName(TrajectoryAlignment alignment) {
-  return alignment == TrajectoryAlignment::kSimilarity ? "similarity" : "rigid";
-}
-
-TrajectoryAlignment TrajectoryAlignmentFromName(const std::string& name) {
-  if (name == "rigid") return TrajectoryAlignment::kRigid;
-  if (name == "similarity") return TrajectoryAlignment::kSimilarity;
-  throw std::invalid_argument("unknown alignment '" + name + "' (rigid, similarity)");
-}
 namespace {
 
 using Poses = std::vector<Eigen::Isometry3d>;

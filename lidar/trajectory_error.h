@@ -13,6 +13,8 @@
 // End-to-end drift: |t(E)| of the first and last frame over the reference's path length (%).
 #pragma once
 
+#include "lidar/util/named_choice.h"
+
 #include <Eigen/Geometry>
 
 #include <string>
@@ -21,10 +23,11 @@
 namespace colmap_lidar {
 
 enum class TrajectoryAlignment { kRigid, kSimilarity };
-
-// "rigid" | "similarity" and back; an unknown name throws std::invalid_argument naming the choices.
-std::string TrajectoryAlignmentName(TrajectoryAlignment alignment);
-TrajectoryAlignment TrajectoryAlignmentFromName(const std::string& name);
+inline constexpr NamedChoices<TrajectoryAlignment, 2> kTrajectoryAlignmentNames = {
+    {{"rigid", TrajectoryAlignment::kRigid}, {"similarity", TrajectoryAlignment::kSimilarity}}};
+inline std::string TrajectoryAlignmentName(TrajectoryAlignment alignment) {
+  return ChoiceName(kTrajectoryAlignmentNames, alignment);
+}
 
 struct TrajectoryErrorOptions {
   // Segment lengths [m]; empty: 10, 20, ... up to the reference's path length (at most 800).

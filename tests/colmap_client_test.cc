@@ -116,6 +116,47 @@ TEST(ColmapClientTest, ColmapSiftMatchesNeighbouringStationsOfTheDefaultDataset)
   EXPECT_GE(num_matched_neighbours, 18);
 }
 
+// Closed choices are given by name and parsed once, after the command line: an unknown name is one
+// error naming the option and its choices, before any file is read; "auto" is the pipeline's alone.
+TEST(CliTest, ClosedChoicesAreRefusedByNameBeforeAnyFileIsRead) {
+  const std::string cli = COLMAP_LIDAR_CLI_EXE;
+  testing::ScopedTempDir dir;
+  const std::string pipeline =
+      cli + " pipeline --dataset_path " + dir.File("d") + " --workspace_path " + dir.File("ws");
+  const auto bad_mode = RunCommand(pipeline + " --mode bogus");
+  EXPECT_NE(bad_mode.exit_code, 0);
+  EXPECT_NE(
+      bad_mode.output.find("unknown --mode 'bogus' (expected joint, precalibrated or stereo_only)"),
+      std::string::npos)
+      << bad_mode.output;
+  // Accepted choices get as far as the missing dataset.
+  const auto auto_matcher =
+      RunCommand(pipeline + " --Import.matcher auto --LidarRegistrator.method odometry");
+  EXPECT_NE(auto_matcher.exit_code, 0);
+  EXPECT_NE(auto_matcher.output.find("dataset directory does not exist"), std::string::npos)
+      << auto_matcher.output;
+  const auto import_auto = RunCommand(cli + " import_dataset --dataset_path " + dir.File("d") +
+                                      " --database_path " + dir.File("x.db") + " --matcher auto");
+  EXPECT_NE(import_auto.exit_code, 0);
+  EXPECT_NE(import_auto.output.find("unknown --matcher 'auto'"), std::string::npos)
+      << import_auto.output;
+  const auto bad_removal =
+      RunCommand(cli + " lidar_registrator --lidar_path " + dir.File("l") + " --output_path " +
+                 dir.File("o") + " --remove_moving_points maybe");
+  EXPECT_NE(bad_removal.output.find("unknown --remove_moving_points 'maybe'"), std::string::npos)
+      << bad_removal.output;
+  const auto bad_axis =
+      RunCommand(cli + " joint_adjuster --database_path " + dir.File("x.db") + " --input_path " +
+                 dir.File("m") + " --dataset_path " + dir.File("d") + " --output_path " +
+                 dir.File("o") + " --hold_translation x,q");
+  EXPECT_NE(bad_axis.exit_code, 0);
+  EXPECT_NE(bad_axis.output.find("--hold_translation: unknown axis 'q'"), std::string::npos)
+      << bad_axis.output;
+  EXPECT_FALSE(fs::exists(dir.File("ws")));
+  EXPECT_FALSE(fs::exists(dir.File("o")));
+  EXPECT_FALSE(fs::exists(dir.File("x.db")));
+}
+
 TEST(CliTest, HelpVersionAndErrors) {
   const std::string cli = COLMAP_LIDAR_CLI_EXE;
   const auto help = RunCommand(cli + " help");

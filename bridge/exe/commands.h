@@ -1,5 +1,5 @@
 // The colmap-lidar commands implemented in bridge/. Each is `int RunX(int argc, char** argv)` in COLMAP's
-// style: argv[0] is the command name, options are parsed with colmap::OptionManager (so `--project_path
+// style: argv[0] is the command name, options are parsed with CommandOptions (so `--project_path
 // file.ini` works as in COLMAP), and the return value is the process exit code. Errors are thrown as
 // exceptions; the dispatcher turns them into one "ERROR: ..." line and a non-zero exit. Each command parses
 // its options and calls its step's typed function (steps.h), which `pipeline` calls as well.

@@ -1,8 +1,8 @@
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "colmap_ext/extension_database.h"
 #include "colmap_ext/logging.h"
 
-#include "colmap/controllers/option_manager.h"
 #include "colmap/scene/database.h"
 
 #include <filesystem>
@@ -11,7 +11,7 @@
 namespace colmap_lidar {
 
 int RunDatabaseCreator(int argc, char** argv) {
-  colmap::OptionManager options;
+  CommandOptions options;
   options.AddDatabaseOptions();
   options.Parse(argc, argv);
   {
@@ -26,7 +26,7 @@ int RunDatabaseCreator(int argc, char** argv) {
 }
 
 int RunDatabaseInfo(int argc, char** argv) {
-  colmap::OptionManager options;
+  CommandOptions options;
   options.AddDatabaseOptions();
   options.Parse(argc, argv);
   const std::string& path = *options.database_path;

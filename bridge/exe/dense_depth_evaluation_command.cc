@@ -1,15 +1,14 @@
 // evaluate_dense_depth: a dense workspace's depth maps against the dataset's true depth maps.
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "colmap_ext/dense_depth_evaluation.h"
-
-#include "colmap/controllers/option_manager.h"
 
 namespace colmap_lidar {
 
 int RunEvaluateDenseDepth(int argc, char** argv) {
   std::string dense_path, dataset_path, output_path;
-  colmap::OptionManager manager;
+  CommandOptions manager;
   manager.AddRequiredOption(
       "dense_path", &dense_path, "densifier's output (COLMAP dense workspace)");
   manager.AddRequiredOption("dataset_path", &dataset_path, "dataset with ground_truth/depth/");

@@ -7,7 +7,7 @@
 namespace colmap_lidar {
 
 void AddDensifierOptions(const std::string& prefix,
-                         colmap::OptionManager* manager,
+                         CommandOptions* manager,
                          DensifierOptions* options) {
   PrefixedOptions add(manager, prefix);
   LidarDepthRefinementOptions& refinement = options->refinement;
@@ -48,7 +48,7 @@ int RunDensifier(int argc, char** argv) {
   std::string dataset_path, registration_path;
   DensifierPaths paths;
   DensifierOptions densifier;
-  colmap::OptionManager options;
+  CommandOptions options;
   options.AddRequiredOption(
       "input_path", &paths.input_path, "refined sparse model (joint_adjuster)");
   options.AddRequiredOption("dataset_path", &dataset_path);

@@ -8,6 +8,7 @@
 #include "bridge/baselines/edge_axis_profile.h"
 #include "bridge/baselines/edge_calibration.h"
 #include "bridge/evaluation/calibration_evaluation.h"
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "colmap_ext/logging.h"
@@ -17,7 +18,6 @@
 #include "lidar/util/atomic_file.h"
 #include "lidar/util/parallel_for_each.h"
 
-#include "colmap/controllers/option_manager.h"
 #include "colmap/scene/reconstruction.h"
 #include "colmap/util/misc.h"
 
@@ -190,7 +190,7 @@ int RunCalibrateEdges(int argc, char** argv) {
   EdgeCalibrationOptions options;
   DepthDiscontinuityOptions& lidar = options.discontinuities;
   int max_points = static_cast<int>(lidar.max_points);
-  colmap::OptionManager manager;
+  CommandOptions manager;
   manager.AddRequiredOption("dataset_path", &dataset_path);
   manager.AddRequiredOption("output_path", &output_path);
   manager.AddDefaultOption("input_path", &input_path, "sparse model: only its stations are summed");

@@ -1,11 +1,11 @@
 #include "bridge/evaluation/calibration_evaluation.h"
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/model_evaluation.h"
 
-#include "colmap/controllers/option_manager.h"
 #include "colmap/util/misc.h"
 
 #include <filesystem>
@@ -28,7 +28,7 @@ std::vector<double> ParsePositiveNumbers(const std::string& csv) {
 }
 
 void AddModelEvaluationOptions(const std::string& prefix,
-                               colmap::OptionManager* manager,
+                               CommandOptions* manager,
                                ModelEvaluationOptions* options) {
   PrefixedOptions add(manager, prefix);
   add.Add("align_icp", &options->align_icp, "rigid point-to-plane ICP first");
@@ -39,7 +39,7 @@ int RunEvaluateModel(int argc, char** argv) {
   std::string model_path, ground_truth_path, output_path, thresholds = "0.002,0.005,0.01";
   std::string truth_from_model_path;
   ModelEvaluationOptions options;
-  colmap::OptionManager manager;
+  CommandOptions manager;
   manager.AddRequiredOption("model_path", &model_path, "reconstructed cloud (.ply/.pcd)");
   manager.AddRequiredOption("ground_truth_path", &ground_truth_path, "surface.ply with normals");
   manager.AddRequiredOption("output_path", &output_path, "directory for metrics.json and plots");
@@ -58,21 +58,18 @@ int RunEvaluateModel(int argc, char** argv) {
 }
 
 int RunEvaluateCalibration(int argc, char** argv) {
-  std::string dataset_path, input_path, cam_from_lidar_path, output_path, alignment = "rigid";
-  colmap::OptionManager manager;
+  std::string dataset_path, input_path, cam_from_lidar_path, output_path;
+  TrajectoryAlignment alignment = TrajectoryAlignment::kRigid;
+  CommandOptions manager;
   manager.AddRequiredOption("dataset_path", &dataset_path, "dataset with ground_truth/");
   manager.AddRequiredOption("input_path", &input_path, "sparse COLMAP model");
   manager.AddDefaultOption("cam_from_lidar",
                            &cam_from_lidar_path,
                            "estimate (qw qx qy qz tx ty tz); default INPUT/cam_from_lidar.txt");
   manager.AddDefaultOption("output_path", &output_path, "directory for metrics.json (optional)");
-  manager.AddDefaultOption("alignment", &alignment, "rigid | similarity");
+  manager.AddChoiceOption("alignment", &alignment, kTrajectoryAlignmentNames);
   manager.Parse(argc, argv);
-  RunEvaluateCalibrationStep(dataset_path,
-                             input_path,
-                             cam_from_lidar_path,
-                             output_path,
-                             TrajectoryAlignmentFromName(alignment));
+  RunEvaluateCalibrationStep(dataset_path, input_path, cam_from_lidar_path, output_path, alignment);
   return EXIT_SUCCESS;
 }
 

@@ -10,9 +10,36 @@
 #include <iostream>
 
 namespace colmap_lidar {
+namespace {
+
+// --matcher exhaustive | sequential | spatial, and auto with `choose_matcher`.
+void AddMatcherOption(const std::string& name,
+                      CommandOptions* manager,
+                      ImageMatcher* matcher,
+                      bool* choose_matcher) {
+  const std::string help =
+      "exhaustive | sequential (frames of a moving platform, by name) | spatial (stations near in "
+      "--lidar_registration_path)";
+  if (choose_matcher == nullptr) {
+    manager->AddChoiceOption(name, matcher, kImageMatcherNames, help);
+    return;
+  }
+  manager->AddParsedOption(
+      name,
+      *choose_matcher ? "auto" : ImageMatcherName(*matcher),
+      [=](const std::string& text) {
+        *choose_matcher = text == "auto";
+        if (!*choose_matcher) *matcher = ChoiceFromName(kImageMatcherNames, text, "--" + name);
+      },
+      help + " | auto (exhaustive up to Import.max_exhaustive_stations, spatial beyond)");
+}
+
+}  // namespace
+
 void AddImportStepOptions(const std::string& prefix,
-                          colmap::OptionManager* manager,
-                          ImportStepOptions* options) {
+                          CommandOptions* manager,
+                          ImportStepOptions* options,
+                          bool* choose_matcher) {
   // GPU SIFT needs CUDA or an OpenGL context; a headless build has neither.
   manager->sift_extraction->use_gpu = false;
   manager->sift_matching->use_gpu = false;
@@ -22,11 +49,7 @@ void AddImportStepOptions(const std::string& prefix,
   *manager->spatial_matching = options->import.spatial_matching;
   manager->AddSpatialMatchingOptions();
   PrefixedOptions add(manager, prefix);
-  add.Add("matcher",
-          &options->matcher,
-          "exhaustive | sequential (frames of a moving platform, by name) | spatial "
-          "(stations near in --lidar_registration_path); pipeline: auto (exhaustive up to "
-          "Import.max_exhaustive_stations, spatial beyond)");
+  AddMatcherOption(prefix + "matcher", manager, &options->import.matcher, choose_matcher);
   add.Add("lidar_registration_path",
           &options->lidar_registration_path,
           "lidar_registrator's output folder, for --matcher spatial");
@@ -39,7 +62,7 @@ void AddImportStepOptions(const std::string& prefix,
           "folder of the images named by --image_name_format; empty: DATASET/images");
 }
 
-void TakeColmapImportOptions(const colmap::OptionManager& manager, ImportStepOptions* options) {
+void TakeColmapImportOptions(const CommandOptions& manager, ImportStepOptions* options) {
   options->import.sift_extraction = *manager.sift_extraction;
   options->import.sift_matching = *manager.sift_matching;
   options->import.two_view_geometry = *manager.two_view_geometry;
@@ -51,7 +74,7 @@ void TakeColmapImportOptions(const colmap::OptionManager& manager, ImportStepOpt
 int RunImportDataset(int argc, char** argv) {
   std::string dataset_path;
   ImportStepOptions import;
-  colmap::OptionManager options;
+  CommandOptions options;
   options.AddRequiredOption("dataset_path", &dataset_path);
   options.AddDatabaseOptions();
   AddImportStepOptions("", &options, &import);
@@ -63,10 +86,10 @@ int RunImportDataset(int argc, char** argv) {
 }
 
 void AddStereoDepthOptions(const std::string& prefix,
-                           colmap::OptionManager* manager,
+                           CommandOptions* manager,
                            StereoDepthOptions* options) {
   PrefixedOptions add(manager, prefix);
-  add.Add("mode", &options->mode, "sgbm | hh | 3way | hh4");
+  add.AddChoice("mode", &options->mode, kSgbmModeNames, "OpenCV StereoSGBM's mode");
   add.Add("min_depth_m", &options->min_depth_m);
   add.Add("max_depth_m", &options->max_depth_m);
   add.Add("vertically_symmetric", &options->vertically_symmetric);
@@ -86,7 +109,7 @@ int RunStereoDepth(int argc, char** argv) {
   std::string dataset_path;
   std::string output_path;
   StereoDepthOptions stereo;
-  colmap::OptionManager options;
+  CommandOptions options;
   options.AddRequiredOption("dataset_path", &dataset_path);
   options.AddRequiredOption("output_path", &output_path);
   AddStereoDepthOptions("", &options, &stereo);
@@ -97,7 +120,7 @@ int RunStereoDepth(int argc, char** argv) {
 }
 
 void AddDepthPriorOptions(const std::string& prefix,
-                          colmap::OptionManager* manager,
+                          CommandOptions* manager,
                           DepthPriorOptions* options) {
   PrefixedOptions add(manager, prefix);
   add.Add("max_radius_px", &options->max_radius_px);
@@ -108,7 +131,7 @@ void AddDepthPriorOptions(const std::string& prefix,
 int RunDepthPriorExtractor(int argc, char** argv) {
   std::string depth_path;
   DepthPriorOptions prior_options;
-  colmap::OptionManager options;
+  CommandOptions options;
   options.AddDatabaseOptions();
   options.AddRequiredOption("depth_path", &depth_path);
   AddDepthPriorOptions("", &options, &prior_options);

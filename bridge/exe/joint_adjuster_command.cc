@@ -1,5 +1,6 @@
 // colmap-lidar joint_adjuster: the joint problem on a COLMAP sparse model
 // (bridge/joint/joint_adjuster.h).
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "bridge/initialization/lidar_registration_files.h"
@@ -12,11 +13,11 @@
 #include "colmap_ext/station_dataset.h"
 #include "lidar/plot.h"
 
-#include "colmap/controllers/option_manager.h"
 #include "colmap/scene/reconstruction.h"
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -28,8 +29,28 @@
 
 namespace colmap_lidar {
 
+namespace {
+
+// --hold_translation: comma-separated camera axes ("y", "x,z").
+std::array<bool, 3> ParseHeldAxes(const std::string& text) {
+  std::array<bool, 3> held = {false, false, false};
+  std::stringstream stream(text);
+  std::string axis;
+  while (std::getline(stream, axis, ',')) {
+    if (axis.size() == 1 && axis[0] >= 'x' && axis[0] <= 'z') {
+      held[axis[0] - 'x'] = true;
+    } else if (!axis.empty()) {
+      throw std::invalid_argument("--hold_translation: unknown axis '" + axis +
+                                  "' (a comma-separated subset of x,y,z)");
+    }
+  }
+  return held;
+}
+
+}  // namespace
+
 void AddJointAdjusterOptions(const std::string& prefix,
-                             colmap::OptionManager* manager,
+                             CommandOptions* manager,
                              JointAdjusterStepOptions* options) {
   PrefixedOptions add(manager, prefix);
   JointAdjusterOptions& adjuster = options->adjuster;
@@ -40,9 +61,12 @@ void AddJointAdjusterOptions(const std::string& prefix,
           &options->estimate_time_offset,
           "on a moving platform, estimate the LiDAR clock's offset from the cameras");
   add.Add("hold_rotation", &adjuster.hold_rotation, "hold cam_from_lidar's rotation at its start");
-  add.Add("hold_translation",
-          &options->hold_translation,
-          "camera axes of cam_from_lidar's translation held at their start, e.g. y or x,z");
+  std::array<bool, 3>* held = &adjuster.hold_translation;
+  manager->AddParsedOption(
+      prefix + "hold_translation",
+      "",
+      [held](const std::string& text) { *held = ParseHeldAxes(text); },
+      "camera axes of cam_from_lidar's translation held at their start, e.g. y or x,z");
   add.Add("hold_rotation_deg",
           &adjuster.hold_rotation_deg,
           "sigma above which a rotation direction is held at its start and named undetermined");
@@ -181,12 +205,12 @@ int RunJointAdjuster(int argc, char** argv) {
   std::string dataset_path, registration_path;
   JointAdjusterPaths paths;
   JointAdjusterStepOptions joint;
-  colmap::OptionManager options;
+  CommandOptions options;
   options.AddDatabaseOptions();
   options.AddRequiredOption("input_path", &paths.input_path);
   options.AddRequiredOption("dataset_path", &dataset_path);
   options.AddRequiredOption("output_path", &paths.output_path);
-  options.AddDefaultOption("mode", &joint.mode, "joint | precalibrated | stereo_only");
+  options.AddChoiceOption("mode", &joint.adjuster.mode, kJointModeNames);
   options.AddDefaultOption("cam_from_lidar",
                            &paths.cam_from_lidar_path,
                            "qw qx qy qz tx ty tz file; default: INPUT/cam_from_lidar.txt, else "

@@ -1,10 +1,9 @@
 // import_kitti: a KITTI raw drive or odometry sequence into our station dataset
 // (colmap_ext/kitti_import.h).
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "colmap_ext/kitti_import.h"
 #include "colmap_ext/logging.h"
-
-#include "colmap/controllers/option_manager.h"
 
 #include <iostream>
 
@@ -13,10 +12,10 @@ namespace colmap_lidar {
 int RunImportKitti(int argc, char** argv) {
   KittiImportOptions import;
   int seed = 0;
-  std::string format = "raw", sequence_path;
-  colmap::OptionManager options;
-  options.AddDefaultOption(
-      "format", &format, "raw (a raw drive) or odometry (a benchmark sequence)");
+  std::string sequence_path;
+  CommandOptions options;
+  options.AddChoiceOption(
+      "format", &import.format, kKittiFormatNames, "a raw drive or an odometry benchmark sequence");
   options.AddDefaultOption("kitti_path", &import.kitti_path, "raw: the drive folder (..._sync)");
   options.AddDefaultOption(
       "sequence_path", &sequence_path, "odometry: the sequence folder (calib.txt, image_2, ...)");
@@ -41,7 +40,6 @@ int RunImportKitti(int argc, char** argv) {
   options.AddDefaultOption("seed", &seed);
   options.AddDefaultOption("overwrite", &import.overwrite);
   options.Parse(argc, argv);
-  import.format = KittiFormatFromName(format);
   if (import.format == KittiFormat::kOdometry) {
     THROW_CHECK(import.kitti_path.empty() || sequence_path.empty())
         << "give the sequence as --sequence_path only";

@@ -1,10 +1,9 @@
 // lidar_registrator and deskew_sweeps: option registration and argv parsing; the steps are
 // bridge/pipeline/lidar_registration_step.h.
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "colmap_ext/logging.h"
-
-#include "colmap/controllers/option_manager.h"
 
 #include <filesystem>
 
@@ -15,10 +14,11 @@ namespace {
 // The method's choice and the odometry's options (refinement, revisits) of lidar_registrator.
 void AddOdometryOptions(PrefixedOptions* options_of, LidarRegistratorStepOptions* options) {
   PrefixedOptions& add = *options_of;
-  add.Add("method",
-          &options->method,
-          "auto | pairwise (BSC + RANSAC + ICP per pair) | odometry (sweeps: frame-to-map ICP); "
-          "auto: odometry for sweeps, pairwise for stations");
+  add.AddChoice("method",
+                &options->method,
+                kRegistrationMethodNames,
+                "pairwise (BSC + RANSAC + ICP per pair), odometry (sweeps: frame-to-map ICP), "
+                "auto (odometry for sweeps, pairwise for stations)");
   add.Add("odometry_max_range_m", &options->odometry.max_range_m);
   add.Add("odometry_min_range_m", &options->odometry.min_range_m, "nearer returns: the platform");
   add.Add("odometry_voxel_size_m", &options->odometry.voxel_size_m, "0: max range / 100");
@@ -46,7 +46,7 @@ void AddOdometryOptions(PrefixedOptions* options_of, LidarRegistratorStepOptions
 }  // namespace
 
 void AddLidarRegistratorOptions(const std::string& prefix,
-                                colmap::OptionManager* manager,
+                                CommandOptions* manager,
                                 LidarRegistratorStepOptions* options) {
   PrefixedOptions add(manager, prefix);
   StationCloudOptions& cloud = options->cloud;
@@ -86,10 +86,12 @@ void AddLidarRegistratorOptions(const std::string& prefix,
           &options->sweep_timing.start_azimuth_deg,
           "where a revolution starts (LiDAR frame; 180: behind)");
   add.Add("sweep_counter_clockwise", &options->sweep_timing.counter_clockwise);
-  add.Add("remove_moving_points",
-          &options->remove_moving_points,
-          "on (1): flag moving objects by free space, write static/<station>.pcd without them; "
-          "off (0); auto: with deskew_sweeps");
+  add.AddChoice(
+      "remove_moving_points",
+      &options->remove_moving_points,
+      kMovingPointRemovalNames,
+      "on: flag moving objects by free space and write static/<station>.pcd without them; "
+      "auto: on with deskew_sweeps");
   add.Add("moving_neighbour_clouds",
           &options->moving.num_neighbour_clouds,
           "clouds compared on each side (name order)");
@@ -100,7 +102,7 @@ void AddLidarRegistratorOptions(const std::string& prefix,
 
 int RunDeskewSweeps(int argc, char** argv) {
   std::string dataset_path, input_path, output_path;
-  colmap::OptionManager manager;
+  CommandOptions manager;
   manager.AddRequiredOption(
       "dataset_path", &dataset_path, "raw sweeps in DATASET/lidar; rig.json with lidar.sweep");
   manager.AddRequiredOption(
@@ -114,7 +116,7 @@ int RunDeskewSweeps(int argc, char** argv) {
 int RunLidarRegistrator(int argc, char** argv) {
   std::string lidar_path, output_path;
   LidarRegistratorStepOptions registrator;
-  colmap::OptionManager manager;
+  CommandOptions manager;
   manager.AddRequiredOption("lidar_path", &lidar_path, "folder of station clouds (.pcd/.ply/.bin)");
   manager.AddRequiredOption("output_path", &output_path, "folder for pairs.txt, lidar_poses.txt");
   AddLidarRegistratorOptions("", &manager, &registrator);

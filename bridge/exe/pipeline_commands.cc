@@ -1,4 +1,5 @@
 // pose_initializer and pipeline: from raw stations to a metric sparse model with cam_from_lidar.
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "bridge/initialization/pose_initializer.h"
@@ -6,8 +7,6 @@
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/util/check_option.h"
-
-#include "colmap/controllers/option_manager.h"
 
 #include <filesystem>
 #include <iomanip>
@@ -19,7 +18,7 @@ namespace colmap_lidar {
 namespace fs = std::filesystem;
 
 void AddPoseInitializerOptions(const std::string& prefix,
-                               colmap::OptionManager* manager,
+                               CommandOptions* manager,
                                PoseInitializerOptions* options) {
   PrefixedOptions add(manager, prefix);
   add.Add("use_guess",
@@ -51,7 +50,7 @@ int RunPoseInitializer(int argc, char** argv) {
   std::string dataset_path;
   PoseInitializerPaths paths;
   PoseInitializerOptions initializer;
-  colmap::OptionManager options;
+  CommandOptions options;
   options.AddDatabaseOptions();
   options.AddRequiredOption("dataset_path", &dataset_path);
   options.AddDefaultOption("registration_path",
@@ -82,18 +81,16 @@ int RunPoseInitializer(int argc, char** argv) {
 
 namespace {
 
-void AddPipelineOptions(colmap::OptionManager* manager, PipelineOptions* options) {
+void AddPipelineOptions(CommandOptions* manager, PipelineOptions* options) {
   manager->AddRequiredOption("dataset_path", &options->dataset_path);
   manager->AddRequiredOption("workspace_path", &options->workspace_path);
   manager->AddDefaultOption("overwrite", &options->overwrite, "rerun finished steps");
-  manager->AddDefaultOption(
-      "mode",
-      &options->mode,
-      "joint | precalibrated | stereo_only (stereo_only also fuses unrefined stereo)");
+  manager->AddChoiceOption(
+      "mode", &options->mode, kJointModeNames, "stereo_only also fuses unrefined stereo");
   // The pipeline's own defaults (PipelineOptions()) for COLMAP's sections too.
   *manager->sift_extraction = options->import.import.sift_extraction;
   *manager->sift_matching = options->import.import.sift_matching;
-  AddImportStepOptions("Import.", manager, &options->import);
+  AddImportStepOptions("Import.", manager, &options->import, &options->choose_matcher);
   manager->AddDefaultOption(
       "Import.max_exhaustive_stations",
       &options->max_exhaustive_stations,
@@ -112,7 +109,7 @@ void AddPipelineOptions(colmap::OptionManager* manager, PipelineOptions* options
 
 int RunPipeline(int argc, char** argv) {
   PipelineOptions pipeline;
-  colmap::OptionManager manager;
+  CommandOptions manager;
   AddPipelineOptions(&manager, &pipeline);
   RefuseRemovedJointAdjusterOptions(argc, argv, "JointAdjuster.");
   manager.Parse(argc, argv);

@@ -1,16 +1,15 @@
 // select_frames: the frames of a drive that go on to the camera steps (SIFT matching, the joint
 // problem, the densifier), written as a registration folder of their own
 // (bridge/initialization/selected_frames.h).
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "lidar/util/check_option.h"
 
-#include "colmap/controllers/option_manager.h"
-
 namespace colmap_lidar {
 
 void AddFrameSelectionOptions(const std::string& prefix,
-                              colmap::OptionManager* manager,
+                              CommandOptions* manager,
                               FrameSelectionOptions* options) {
   PrefixedOptions add(manager, prefix);
   add.Add("min_distance_m",
@@ -26,7 +25,7 @@ void AddFrameSelectionOptions(const std::string& prefix,
 int RunSelectFrames(int argc, char** argv) {
   std::string registration_path, output_path;
   FrameSelectionOptions options;
-  colmap::OptionManager manager;
+  CommandOptions manager;
   manager.AddRequiredOption(
       "registration_path", &registration_path, "lidar_registrator's output folder");
   manager.AddRequiredOption("output_path",

@@ -1,8 +1,7 @@
 #include "bridge/exe/simulator_commands.h"
 
+#include "bridge/exe/command_options.h"
 #include "bridge/simulation/simulate_dataset.h"
-
-#include "colmap/controllers/option_manager.h"
 
 #include <iostream>
 
@@ -12,7 +11,7 @@ int RunSimulateDataset(int argc, char** argv) {
   sim::SimulationOptions options;
   int seed = 0;
   int lidar_points = static_cast<int>(options.lidar_points);
-  colmap::OptionManager manager;
+  CommandOptions manager;
   manager.AddRequiredOption("output_path", &options.output_path);
   manager.AddDefaultOption("scene",
                            &options.scene,

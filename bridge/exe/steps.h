@@ -1,6 +1,6 @@
 // The steps of the pipeline as typed calls. Each step has its options (an algorithm's Options struct, or
 // a small struct around it for what only the command needs), a function that registers them in a
-// colmap::OptionManager under a prefix, and a Run*Step function that prints progress and writes the
+// CommandOptions under a prefix, and a Run*Step function that prints progress and writes the
 // step's outputs. A command (`colmap-lidar joint_adjuster ...`, commands.h) registers its step's options
 // without a prefix; `pipeline` registers every step's options in one manager under the step's section
 // ("JointAdjuster.hold_translation_mm", "StereoDepth.block_size", ...; COLMAP's own SiftExtraction.* etc. keep
@@ -12,6 +12,7 @@
 #include "bridge/baselines/edge_calibration.h"
 #include "bridge/dense/densifier.h"
 #include "bridge/evaluation/trajectory_evaluation.h"
+#include "bridge/exe/command_options.h"
 #include "bridge/initialization/pose_initializer.h"
 #include "bridge/initialization/selected_frames.h"
 #include "bridge/joint/joint_adjuster.h"
@@ -38,8 +39,6 @@
 #include "lidar/sweep_deskew.h"
 #include "lidar/trajectory_refinement.h"
 
-#include "colmap/controllers/option_manager.h"
-
 #include <chrono>
 #include <optional>
 #include <string>
@@ -49,52 +48,61 @@ namespace colmap_lidar {
 // Registers options as "<prefix><name>" with their current values as defaults.
 class PrefixedOptions {
  public:
-  PrefixedOptions(colmap::OptionManager* manager, std::string prefix)
+  PrefixedOptions(CommandOptions* manager, std::string prefix)
       : manager_(manager), prefix_(std::move(prefix)) {}
 
   template <typename T>
   void Add(const std::string& name, T* value, const std::string& help = "") {
     manager_->AddDefaultOption(prefix_ + name, value, help);
   }
+  template <typename Enum, size_t N>
+  void AddChoice(const std::string& name,
+                 Enum* value,
+                 const NamedChoices<Enum, N>& table,
+                 const std::string& help = "") {
+    manager_->AddChoiceOption(prefix_ + name, value, table, help);
+  }
 
  private:
-  colmap::OptionManager* manager_;
+  CommandOptions* manager_;
   std::string prefix_;
 };
 
 // Also registers COLMAP's SiftExtraction.*, SiftMatching.*, TwoViewGeometry.*, ExhaustiveMatching.*,
 // SequentialMatching.* and SpatialMatching.* sections (CPU SIFT by default: a headless build has no
-// OpenGL context); TakeColmapImportOptions copies them in after Parse().
+// OpenGL context); TakeColmapImportOptions copies them in after Parse(). With `choose_matcher`
+// (the pipeline's), --matcher also takes "auto", which sets it.
 void AddImportStepOptions(const std::string& prefix,
-                          colmap::OptionManager* manager,
-                          ImportStepOptions* options);
-void TakeColmapImportOptions(const colmap::OptionManager& manager, ImportStepOptions* options);
+                          CommandOptions* manager,
+                          ImportStepOptions* options,
+                          bool* choose_matcher = nullptr);
+void TakeColmapImportOptions(const CommandOptions& manager, ImportStepOptions* options);
 
 // stereo_depth: SGM depth maps of every station.
 void AddStereoDepthOptions(const std::string& prefix,
-                           colmap::OptionManager* manager,
+                           CommandOptions* manager,
                            StereoDepthOptions* options);
 
 // depth_prior_extractor: depth priors of the database's keypoints.
 void AddDepthPriorOptions(const std::string& prefix,
-                          colmap::OptionManager* manager,
+                          CommandOptions* manager,
                           DepthPriorOptions* options);
 
 // lidar_registrator (LidarRegistratorStepOptions, RunLidarRegistratorStep:
 // bridge/pipeline/lidar_registration_step.h).
 void AddLidarRegistratorOptions(const std::string& prefix,
-                                colmap::OptionManager* manager,
+                                CommandOptions* manager,
                                 LidarRegistratorStepOptions* options);
 
 // select_frames: the frames of a drive that go on to the camera steps (selected_frames.h), from
 // lidar_registrator's output folder into OUTPUT.
 void AddFrameSelectionOptions(const std::string& prefix,
-                              colmap::OptionManager* manager,
+                              CommandOptions* manager,
                               FrameSelectionOptions* options);
 
 // pose_initializer: initial poses, cam_from_lidar and landmarks; or an existing model rescaled.
 void AddPoseInitializerOptions(const std::string& prefix,
-                               colmap::OptionManager* manager,
+                               CommandOptions* manager,
                                PoseInitializerOptions* options);
 // Help of the joint_adjuster and densifier commands' --registration_path.
 inline constexpr char kRegistrationPathHelp[] =
@@ -105,7 +113,7 @@ inline constexpr char kRegistrationPathHelp[] =
 // joint_adjuster: the joint problem on a sparse model (JointAdjusterStepOptions, RunJointAdjusterStep:
 // bridge/pipeline/joint_step.h).
 void AddJointAdjusterOptions(const std::string& prefix,
-                             colmap::OptionManager* manager,
+                             CommandOptions* manager,
                              JointAdjusterStepOptions* options);
 // Throws std::invalid_argument naming the first of argv that is an option joint_adjuster no longer
 // takes (under `prefix`, e.g. "JointAdjuster." in the pipeline), on the command line or in the project
@@ -113,7 +121,7 @@ void AddJointAdjusterOptions(const std::string& prefix,
 void RefuseRemovedJointAdjusterOptions(int argc, char** argv, const std::string& prefix);
 // densifier: the dense model.
 void AddDensifierOptions(const std::string& prefix,
-                         colmap::OptionManager* manager,
+                         CommandOptions* manager,
                          DensifierOptions* options);
 // calibrate_edges --profile_axis: J along the rotation about one camera axis instead of the grid.
 struct EdgeAxisProfileRequest {
@@ -145,6 +153,6 @@ std::vector<double> ParsePositiveNumbers(const std::string& csv);
 
 // evaluate_model's options but the thresholds (a list, parsed by the command).
 void AddModelEvaluationOptions(const std::string& prefix,
-                               colmap::OptionManager* manager,
+                               CommandOptions* manager,
                                ModelEvaluationOptions* options);
 }  // namespace colmap_lidar

@@ -4,13 +4,12 @@
 // candidates.txt (every candidate, best first).
 #include "bridge/exe/survey_planner_command.h"
 
+#include "bridge/exe/command_options.h"
 #include "bridge/survey/survey_planner.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
 #include "lidar/util/atomic_file.h"
-
-#include "colmap/controllers/option_manager.h"
 
 #include <nlohmann/json.hpp>
 
@@ -99,7 +98,7 @@ int RunPlanSurvey(int argc, char** argv) {
   std::string scene_name = "t_specimen", surface_path, stations_path, output_path;
   sim::SurveyPlanOptions options;
   int lidar_points = static_cast<int>(options.lidar_points), seed = 1;
-  colmap::OptionManager manager;
+  CommandOptions manager;
   manager.AddDefaultOption(
       "scene", &scene_name, "t_specimen | square_pillar | cylinder_pillar | bridge_pier | street");
   manager.AddDefaultOption(

@@ -1,12 +1,11 @@
 // evaluate_trajectory: a trajectory against a reference
 // (bridge/evaluation/trajectory_evaluation.h).
 #include "bridge/evaluation/trajectory_evaluation.h"
+#include "bridge/exe/command_options.h"
 #include "bridge/exe/commands.h"
 #include "bridge/exe/steps.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/station_dataset.h"
-
-#include "colmap/controllers/option_manager.h"
 
 #include <iostream>
 
@@ -14,8 +13,8 @@ namespace colmap_lidar {
 
 int RunEvaluateTrajectory(int argc, char** argv) {
   TrajectoryEvaluationStepOptions options;
-  std::string lengths, alignment = "rigid";
-  colmap::OptionManager manager;
+  std::string lengths;
+  CommandOptions manager;
   manager.AddRequiredOption("trajectory_path",
                             &options.trajectory_path,
                             "lidar_poses.txt, a COLMAP model folder, KITTI or TUM poses");
@@ -34,14 +33,14 @@ int RunEvaluateTrajectory(int argc, char** argv) {
   manager.AddDefaultOption("timestamps_path",
                            &options.timestamps_path,
                            "a dataset whose timestamps.txt times named poses (to match TUM files)");
-  manager.AddDefaultOption("alignment", &alignment, "rigid or similarity (monocular)");
+  manager.AddChoiceOption(
+      "alignment", &options.alignment, kTrajectoryAlignmentNames, "similarity: monocular");
   manager.AddDefaultOption("lengths_m", &lengths, "segment lengths; empty: 10, 20, ... m");
   manager.AddDefaultOption("max_time_difference_s", &options.max_time_difference_s);
   manager.Parse(argc, argv);
   options.lengths_m = ParsePositiveNumbers(lengths);
   THROW_CHECK(lengths.empty() || !options.lengths_m.empty())
       << "--lengths_m must be comma-separated positive lengths in metres, not '" << lengths << "'";
-  options.alignment = TrajectoryAlignmentFromName(alignment);
   RunEvaluateTrajectoryStep(options);
   return EXIT_SUCCESS;
 }

@@ -996,25 +996,6 @@ bool JointProblemData::HasExtrinsicPrior() const {
                      [](const ExtrinsicMeasurement& measurement) { return measurement.prior; });
 }
 
-JointMode JointModeFromName(const std::string& name) {
-  if (name == "joint") return JointMode::kJoint;
-  if (name == "precalibrated") return JointMode::kPrecalibrated;
-  if (name == "stereo_only") return JointMode::kStereoOnly;
-  throw std::invalid_argument("unknown mode '" + name + "' (joint, precalibrated, stereo_only)");
-}
-
-std::string JointModeName(JointMode mode) {
-  switch (mode) {
-    case JointMode::kJoint:
-      return "joint";
-    case JointMode::kPrecalibrated:
-      return "precalibrated";
-    case JointMode::kStereoOnly:
-      return "stereo_only";
-  }
-  return "";
-}
-
 bool JointAdjusterOptions::Check() const {
   CHECK_OPTION_GT(sigma_lidar_m, 0);
   CHECK_OPTION_GE(depth_weight, 0);

@@ -35,6 +35,7 @@
 #include "lidar/point_to_plane_association.h"
 #include "lidar/robust_loss.h"
 #include "lidar/station_cloud.h"
+#include "lidar/util/named_choice.h"
 
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/reconstruction.h"
@@ -57,8 +58,10 @@ enum class JointMode {
   kPrecalibrated,  // T_e held constant
   kStereoOnly,     // no LiDAR term (weight 0), T_e constant
 };
-JointMode JointModeFromName(const std::string& name);  // joint | precalibrated | stereo_only
-std::string JointModeName(JointMode mode);
+inline constexpr NamedChoices<JointMode, 3> kJointModeNames = {
+    {{"joint", JointMode::kJoint},
+     {"precalibrated", JointMode::kPrecalibrated},
+     {"stereo_only", JointMode::kStereoOnly}}};
 
 struct JointAdjusterOptions {
   JointMode mode = JointMode::kJoint;

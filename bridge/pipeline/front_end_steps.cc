@@ -14,8 +14,7 @@ namespace colmap_lidar {
 
 bool ImportStepOptions::Check() const {
   CHECK_OPTION(import.Check());
-  CHECK_OPTION(matcher == "exhaustive" || matcher == "sequential" || matcher == "spatial");
-  CHECK_OPTION(matcher != "spatial" || !lidar_registration_path.empty());
+  CHECK_OPTION(import.matcher != ImageMatcher::kSpatial || !lidar_registration_path.empty());
   return true;
 }
 
@@ -24,7 +23,6 @@ void RunImportStep(const StationDataset& dataset,
                    ImportStepOptions options) {
   const auto start = std::chrono::steady_clock::now();
   THROW_CHECK(options.Check());
-  options.import.matcher = ImageMatcherFromName(options.matcher);
   if (options.import.matcher == ImageMatcher::kSpatial) {
     options.import.station_positions =
         StationCameraPositions(options.lidar_registration_path,

@@ -16,10 +16,7 @@ namespace colmap_lidar {
 // import_dataset: COLMAP SIFT extraction and matching, our rig and lidar_frames rows.
 struct ImportStepOptions {
   DatasetImportOptions import;
-  // The command line's matcher: exhaustive | sequential | spatial (the pipeline resolves its auto
-  // first); RunImportStep parses it into import.matcher.
-  std::string matcher = "exhaustive";
-  // lidar_registrator's output folder, for the spatial matcher.
+  // lidar_registrator's output folder, for the spatial matcher (import.matcher).
   std::string lidar_registration_path;
 
   bool Check() const;

@@ -224,7 +224,8 @@ std::string ObservabilityVerdict(const JointAdjusterOptions& options,
                                  const JointAdjustmentSummary& summary) {
   const ExtrinsicUncertainty& u = summary.uncertainty;
   if (options.mode != JointMode::kJoint) {
-    return "cam_from_lidar held constant (" + JointModeName(options.mode) + ")";
+    return "cam_from_lidar held constant (" +
+           std::string(ChoiceName(kJointModeNames, options.mode)) + ")";
   }
   if (u.unobservable.empty() && summary.motion.unique) return "cam_from_lidar is observable";
   // A degenerate motion whose directions the data observe all the same (a car through the
@@ -249,7 +250,7 @@ void WriteJointReport(const std::string& directory,
   const std::optional<VerticalAlignment>& vertical = outcome.vertical;
   nlohmann::json report;
   if (vertical) report["vertical_alignment"] = VerticalAlignmentJson(*vertical);
-  report["mode"] = JointModeName(options.mode);
+  report["mode"] = std::string(ChoiceName(kJointModeNames, options.mode));
   report["conventions"] =
       "cam_from_lidar maps LiDAR points into the left camera; quaternions w "
       "first; covariance over (rotation vector about the camera axes [deg], "

@@ -26,25 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::array<bool, 3> ParseHeldAxes(const std::string& text) {
-  std::array<bool, 3> held = {false, false, false};
-  std::stringstream stream(text);
-  std::string axis;
-  while (std::getline(stream, axis, ',')) {
-    if (axis == "x") {
-      held[0] = true;
-    } else if (axis == "y") {
-      held[1] = true;
-    } else if (axis == "z") {
-      held[2] = true;
-    } else if (!axis.empty()) {
-      throw std::invalid_argument("--hold_translation: unknown axis '" + axis +
-                                  "' (a comma-separated subset of x,y,z)");
-    }
-  }
-  return held;
-}
-
 // --cam_from_lidar FILE, else INPUT/cam_from_lidar.txt (pose_initializer's), else rig.json's guess.
 colmap::Rigid3d InitialCamFromLidar(const std::string& cam_from_lidar_path,
                                     const std::string& input_path,
@@ -201,20 +182,13 @@ void DecideTimeOffset(const StationDataset& dataset,
 
 }  // namespace
 
-bool JointAdjusterStepOptions::Check() const { return AdjusterOptions().Check() && data.Check(); }
-
-JointAdjusterOptions JointAdjusterStepOptions::AdjusterOptions() const {
-  JointAdjusterOptions resolved = adjuster;
-  resolved.mode = JointModeFromName(mode);
-  resolved.hold_translation = ParseHeldAxes(hold_translation);
-  return resolved;
-}
+bool JointAdjusterStepOptions::Check() const { return adjuster.Check() && data.Check(); }
 
 void RunJointAdjusterStep(const StationDataset& dataset,
                           const JointAdjusterPaths& paths,
                           JointAdjusterStepOptions options) {
   THROW_CHECK(options.Check());
-  options.adjuster = options.AdjusterOptions();
+  const std::string mode = ChoiceName(kJointModeNames, options.adjuster.mode);
   options.adjuster.sigma_lidar_m = dataset.rig.LidarRangeNoiseM();
   if (!dataset.rig.IsStereo() && options.adjuster.mode == JointMode::kStereoOnly) {
     throw std::invalid_argument("--mode stereo_only needs a stereo rig; " + dataset.root +
@@ -228,8 +202,8 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   colmap::Rigid3d cam_from_lidar =
       InitialCamFromLidar(paths.cam_from_lidar_path, paths.input_path, dataset);
   const colmap::Rigid3d initial = cam_from_lidar;
-  std::cout << "Joint adjuster (" << options.mode << "): " << reconstruction.NumRegImages()
-            << " images, " << reconstruction.NumPoints3D() << " landmarks" << std::endl;
+  std::cout << "Joint adjuster (" << mode << "): " << reconstruction.NumRegImages() << " images, "
+            << reconstruction.NumPoints3D() << " landmarks" << std::endl;
   const std::unique_ptr<LoadedJointData> loaded =
       LoadJointProblemData(paths.database_path,
                            dataset,
@@ -248,10 +222,10 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   PartialOutputFolder partial(paths.output_path);
   reconstruction.WriteBinary(partial.Path());
   if (options.write_text) reconstruction.WriteText(partial.Path());
-  WritePoseFile(partial.File("cam_from_lidar.txt"),
-                "cam_from_lidar refined by colmap-lidar joint_adjuster (" + options.mode +
-                    "); qw qx qy qz tx ty tz",
-                cam_from_lidar);
+  WritePoseFile(
+      partial.File("cam_from_lidar.txt"),
+      "cam_from_lidar refined by colmap-lidar joint_adjuster (" + mode + "); qw qx qy qz tx ty tz",
+      cam_from_lidar);
   Trajectory cameras = ModelCameraTrajectory(reconstruction);
   AttachStationTimes(dataset.stations, dataset.frame_times, &cameras);
   WriteTrajectoryExports(partial.File("camera_poses"), cameras);

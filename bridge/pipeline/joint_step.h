@@ -14,27 +14,18 @@
 
 namespace colmap_lidar {
 
-// The options of the joint adjuster as a step: the adjuster's and the data loading's, and what the
-// command line gives as text (parsed by AdjusterOptions()).
+// The options of the joint adjuster as a step: the adjuster's (its mode, the held axes) and the data
+// loading's.
 struct JointAdjusterStepOptions {
   JointAdjusterOptions adjuster;
   JointDataOptions data;
-  // joint | precalibrated | stereo_only; into `adjuster.mode` by AdjusterOptions(). Registered by the
-  // joint_adjuster command, not by AddJointAdjusterOptions (the pipeline's --mode sets it).
-  std::string mode = "joint";
-  // Comma-separated camera axes held at their initial value ("y", "x,z"); into `adjuster` by
-  // AdjusterOptions().
-  std::string hold_translation;
   // On a moving platform (rig.json), estimate the LiDAR clock's offset from the cameras in E_m
   // (JointAdjusterOptions::estimate_time_offset).
   bool estimate_time_offset = true;
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
   bool write_text = false;
 
-  // Throws on a malformed mode or hold_translation.
   bool Check() const;
-  // `adjuster` with `mode` and `hold_translation` parsed into it.
-  JointAdjusterOptions AdjusterOptions() const;
 };
 struct JointAdjusterPaths {
   std::string database_path;

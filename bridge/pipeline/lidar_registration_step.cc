@@ -100,15 +100,6 @@ std::string Summary(const std::vector<std::string>& names,
   return summary.str();
 }
 
-// --remove_moving_points: on, off, or none (auto: decided by deskew_sweeps).
-const std::map<std::string, std::optional<bool>> kMovingPointRemoval = {
-    {"auto", std::nullopt}, {"on", true}, {"1", true}, {"off", false}, {"0", false}};
-
-const std::map<std::string, RegistrationMethod> kRegistrationMethods = {
-    {"auto", RegistrationMethod::kAuto},
-    {"pairwise", RegistrationMethod::kPairwise},
-    {"odometry", RegistrationMethod::kOdometry}};
-
 }  // namespace
 
 std::vector<fs::path> StationCloudFiles(const std::string& lidar_path) {
@@ -135,18 +126,12 @@ bool LidarRegistratorStepOptions::Check() const {
   CHECK_OPTION_GE(sequential, 0);
   CHECK_OPTION_GE(bridge_neighbors, 0);
   CHECK_OPTION_GE(refine_neighbors, 0);
-  CHECK_OPTION(kMovingPointRemoval.count(remove_moving_points) > 0);
-  CHECK_OPTION(kRegistrationMethods.count(method) > 0);
   return sweep_timing.Check() && moving.Check() && odometry.Check() && revisit.Check();
 }
 
-RegistrationMethod LidarRegistratorStepOptions::Method() const {
-  return kRegistrationMethods.at(method);
-}
-
 bool LidarRegistratorStepOptions::RemovesMovingPoints() const {
-  const std::optional<bool> on = kMovingPointRemoval.at(remove_moving_points);
-  return on.value_or(deskew_sweeps);
+  if (remove_moving_points == MovingPointRemoval::kAuto) return deskew_sweeps;
+  return remove_moving_points == MovingPointRemoval::kOn;
 }
 
 LidarGraphOptions LidarRegistratorStepOptions::GraphOptions() const {
@@ -281,8 +266,9 @@ void RemoveMovingPoints(const std::vector<std::string>& names,
 // The method asked for; auto: the odometry for the sweeps of a moving platform (de-skewed, or
 // rig.json says the platform moves), the pairwise path for tripod stations. Says which and why.
 bool UseOdometry(const LidarRegistratorStepOptions& options) {
-  const RegistrationMethod method = options.Method();
-  if (method != RegistrationMethod::kAuto) return method == RegistrationMethod::kOdometry;
+  if (options.method != RegistrationMethod::kAuto) {
+    return options.method == RegistrationMethod::kOdometry;
+  }
   const bool sweeps = options.deskew_sweeps || options.moving_platform;
   std::cout << "lidar_registrator: "
             << (sweeps ? "odometry (frame-to-map ICP): the clouds are sweeps of a moving platform"

@@ -12,6 +12,7 @@
 #include "lidar/revisit_closure.h"
 #include "lidar/station_cloud.h"
 #include "lidar/sweep_deskew.h"
+#include "lidar/util/named_choice.h"
 
 #include <filesystem>
 #include <string>
@@ -20,8 +21,20 @@
 namespace colmap_lidar {
 
 // lidar_registrator: BSC + RANSAC + ICP over station pairs, the LiDAR pose graph A_l.
-// lidar_registrator's --method.
+// lidar_registrator's --method (see LidarRegistratorStepOptions::method).
 enum class RegistrationMethod { kAuto, kPairwise, kOdometry };
+inline constexpr NamedChoices<RegistrationMethod, 3> kRegistrationMethodNames = {
+    {{"auto", RegistrationMethod::kAuto},
+     {"pairwise", RegistrationMethod::kPairwise},
+     {"odometry", RegistrationMethod::kOdometry}}};
+// lidar_registrator's --remove_moving_points (see LidarRegistratorStepOptions).
+enum class MovingPointRemoval { kAuto, kOn, kOff };
+inline constexpr NamedChoices<MovingPointRemoval, 5> kMovingPointRemovalNames = {
+    {{"auto", MovingPointRemoval::kAuto},
+     {"on", MovingPointRemoval::kOn},
+     {"off", MovingPointRemoval::kOff},
+     {"1", MovingPointRemoval::kOn},
+     {"0", MovingPointRemoval::kOff}}};
 
 struct LidarRegistratorStepOptions {
   StationCloudOptions cloud;
@@ -47,7 +60,7 @@ struct LidarRegistratorStepOptions {
   // auto | pairwise | odometry. Pairwise: BSC + RANSAC + ICP over station pairs (tripod stations,
   // any prior). Odometry: sequential frame-to-map ICP (lidar/lidar_odometry.h) for the sweeps of a
   // moving platform. Auto: odometry for sweeps (deskew_sweeps or moving_platform), else pairwise.
-  std::string method = "auto";
+  RegistrationMethod method = RegistrationMethod::kAuto;
   bool moving_platform = false;  // the dataset's rig.json says so
   LidarOdometryOptions odometry;
   // Odometry: revisit edges between keyframes near in space, far along the path, registered by BSC
@@ -62,16 +75,14 @@ struct LidarRegistratorStepOptions {
   // After registration, flag the points of moving objects by free space (lidar/moving_points.h) and
   // write each cloud without them to OUTPUT/static/<station>.pcd (and all flagged points, in the
   // first station's frame, to OUTPUT/moving_points.ply); the later steps of `pipeline` use them.
-  // auto: for sweeps of a moving platform (with deskew_sweeps); on (1); off (0).
-  std::string remove_moving_points = "auto";
+  // Auto: for sweeps of a moving platform (with deskew_sweeps).
+  MovingPointRemoval remove_moving_points = MovingPointRemoval::kAuto;
   MovingPointOptions moving;
 
   bool Check() const;
   // `graph` with max_neighbors, sequential and bridge_neighbors.
   LidarGraphOptions GraphOptions() const;
-  // `method` parsed (Check() has validated it).
-  RegistrationMethod Method() const;
-  // Whether moving points are removed (remove_moving_points, auto decided by deskew_sweeps).
+  // Whether moving points are removed (remove_moving_points; auto decided by deskew_sweeps).
   bool RemovesMovingPoints() const;
 };
 // The station clouds of a folder (.pcd, .ply, .bin), sorted by name; throws naming the folder

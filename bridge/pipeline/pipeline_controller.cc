@@ -137,7 +137,7 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
       }};
   // The spatial matcher matches only images of stations near in the LiDAR registration: the LiDAR
   // registration runs first (no N^2 image pairs on large surveys).
-  const bool lidar_first = options.import.matcher == "spatial" || select;
+  const bool lidar_first = options.import.import.matcher == ImageMatcher::kSpatial || select;
   std::vector<PipelineStep> steps;
   if (lidar_first) steps.push_back(registrator);
   if (select) {
@@ -242,7 +242,8 @@ void RunSteps(const std::vector<PipelineStep>& steps, const fs::path& ws, bool o
 // Import.matcher spatial without a registration path: the pipeline's own LiDAR registration (of
 // the selected frames), which then runs before the import (PipelineSteps).
 void SetSpatialMatchingRegistration(const StationDataset& dataset, PipelineOptions* pipeline) {
-  if (pipeline->import.matcher != "spatial" || !pipeline->import.lidar_registration_path.empty()) {
+  if (pipeline->import.import.matcher != ImageMatcher::kSpatial ||
+      !pipeline->import.lidar_registration_path.empty()) {
     return;
   }
   const WorkspacePaths paths(pipeline->workspace_path);
@@ -252,10 +253,9 @@ void SetSpatialMatchingRegistration(const StationDataset& dataset, PipelineOptio
 
 // Import.matcher auto (see PipelineOptions::max_exhaustive_stations).
 void ResolveAutoMatcher(size_t num_stations, PipelineOptions* pipeline) {
-  std::string& matcher = pipeline->import.matcher;
-  if (matcher != "auto") return;
+  if (!pipeline->choose_matcher) return;
   const bool exhaustive = num_stations <= static_cast<size_t>(pipeline->max_exhaustive_stations);
-  matcher = exhaustive ? "exhaustive" : "spatial";
+  pipeline->import.import.matcher = exhaustive ? ImageMatcher::kExhaustive : ImageMatcher::kSpatial;
   std::cout << "Import.matcher auto: " << num_stations << " stations, "
             << (exhaustive ? "exhaustive matching"
                            : "spatial matching (each image with its " +
@@ -267,8 +267,8 @@ void ResolveAutoMatcher(size_t num_stations, PipelineOptions* pipeline) {
 
 // Every step's options checked before the first step runs; the mode into the steps it concerns.
 void CheckStepOptions(PipelineOptions* pipeline) {
-  pipeline->joint.mode = pipeline->mode;
-  if (pipeline->mode == "stereo_only") pipeline->densifier.refine_with_lidar = false;
+  pipeline->joint.adjuster.mode = pipeline->mode;
+  if (pipeline->mode == JointMode::kStereoOnly) pipeline->densifier.refine_with_lidar = false;
   THROW_CHECK(pipeline->stereo.Check());
   THROW_CHECK(pipeline->depth_prior.Check());
   THROW_CHECK(pipeline->registrator.Check());
@@ -284,7 +284,7 @@ void DecideFromDataset(const StationDataset& dataset, PipelineOptions* pipeline)
   ResolveAutoMatcher(dataset.stations.size(), pipeline);
   SetSpatialMatchingRegistration(dataset, pipeline);
   THROW_CHECK(pipeline->import.Check());
-  if (!dataset.rig.IsStereo() && pipeline->mode == "stereo_only") {
+  if (!dataset.rig.IsStereo() && pipeline->mode == JointMode::kStereoOnly) {
     throw std::invalid_argument("--mode stereo_only needs a stereo rig; " + dataset.root +
                                 "/rig.json has one camera");
   }
@@ -317,7 +317,6 @@ PipelineOptions::PipelineOptions() {
   // GPU SIFT needs CUDA or an OpenGL context; a headless build has neither.
   import.import.sift_extraction.use_gpu = false;
   import.import.sift_matching.use_gpu = false;
-  import.matcher = "auto";
   import.import.spatial_matching.max_num_neighbors = 12;
   // All pairs grow as N^2: the pipeline registers each station with its 4 most similar ones.
   registrator.max_neighbors = 4;

@@ -26,7 +26,8 @@ struct PipelineOptions {
   std::string dataset_path;
   std::string workspace_path;
   bool overwrite = false;
-  std::string mode = "joint";
+  // The joint step's mode; stereo_only also fuses the unrefined stereo (no LiDAR in the densifier).
+  JointMode mode = JointMode::kJoint;
   ImportStepOptions import;
   StereoDepthOptions stereo;
   DepthPriorOptions depth_prior;
@@ -37,9 +38,11 @@ struct PipelineOptions {
   ModelEvaluationOptions evaluation;
   // Which frames of a moving platform's drive go on to the camera steps (select_frames).
   FrameSelectionOptions selection;
-  // Import.matcher auto: COLMAP's exhaustive matcher up to this many stations; beyond, the spatial
-  // matcher on the LiDAR registration's station positions (each image with its
-  // SpatialMatching.max_num_neighbors nearest), so that image pairs grow as N, not N^2.
+  // Import.matcher auto: the import's matcher chosen by the number of stations, COLMAP's exhaustive
+  // matcher up to max_exhaustive_stations; beyond, the spatial matcher on the LiDAR registration's
+  // station positions (each image with its SpatialMatching.max_num_neighbors nearest), so that
+  // image pairs grow as N, not N^2. Otherwise import.import.matcher.
+  bool choose_matcher = true;
   int max_exhaustive_stations = 16;
 };
 
