@@ -1,85 +1,129 @@
 #!/usr/bin/env bash
-# End-to-end coverage of the reported cam_from_lidar uncertainty: the front end, LiDAR registration,
-# initialisation (hand-eye, no guess) and the joint adjuster on several seeds of simulated scenes; per
-# run and axis the error against the truth in units of the reported sigma, then the 2-sigma coverage per
-# axis. Writes docs/benchmarks/uncertainty.md (DOC to write another page).
-#   SEEDS (default 10), SCENES (default "t_specimen bridge_pier"), STATIONS (default 8),
-#   SCENES="street_drive": the simulated street drive instead (one camera, DRIVE_FRAMES frames,
-#                  default 40, 120000 rays per sweep, no guess; the whole `pipeline` with sequential
-#                  matching), e.g. SEEDS=4 SCENES=street_drive DOC=docs/benchmarks/drive_uncertainty.md
-#   SCENES="street_drive_stereo": the same drive with the second camera (stereo depth, depth priors,
-#                  the stereo-LiDAR alignment of the pose initialiser)
-#   LIDAR_POINTS per station (default 300000), BUILD_DIR (default build),
-#   WORK_DIR       keep the runs there (default: a temporary folder, removed); steps already done in
-#                  WORK_DIR are not run again, so that a changed joint adjuster can be re-evaluated on the
-#                  same front ends by deleting the runs' ws/joint folders
+# Whether the reported cam_from_lidar sigmas hold, over seeds and scene families: per family and seed
+# the front end is made once (simulation, the pipeline's steps up to the initial model), then the
+# joint adjuster alone runs on it; per run and camera axis the error against the truth, the reported
+# sigma and z = error / sigma; per family how many errors lie beyond 2 sigma, the rms z and the
+# undetermined axes. Writes docs/benchmarks/uncertainty.md (DOC to write another page).
+#   SCENES  families (default: all of them):
+#     t_specimen, bridge_pier  tripod stations of a stereo pod (STATIONS, default 8; LIDAR_POINTS per
+#                              station, default 300000), hand-eye initialisation without a guess
+#     street_drive             the simulated street drive, one camera (DRIVE_FRAMES, default 40;
+#                              120000 rays per sweep), no guess, the whole pipeline's front end
+#     street_drive_stereo      the same drive with the second camera
+#     kitti_layout_drive       20 frames of the street drive written in KITTI raw's layout (one
+#                              camera), imported by import_kitti with its seeded 1 deg / 5 cm guess
+#     kitti_odometry           the real sample ../shared/data/kitti_odometry_04_sample, stereo and
+#                              mono, no guess, against KITTI's calibration (one run per rig, no seeds)
+#   SEEDS   seeds 1..SEEDS of the simulated families (default 10); DRIVE_SEEDS those of the drives
+#           (default SEEDS)
+#   VARIANT the joint adjuster's run is RUN/joint-VARIANT (default: default), with JOINT_OPTIONS
+#           (extra joint_adjuster options): variants of the estimator compared on the same front ends
+#   WORK_DIR  keep the runs there (default: a temporary folder, removed); front ends and joint runs
+#           already there are not made again
+#   BUILD_DIR (default build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
 source scripts/configure.sh
 readonly kBuild="${BUILD_DIR:-build}"
 build_cli "$kBuild"
-cli="$kBuild/bin/colmap-lidar"
+cli="$PWD/$kBuild/bin/colmap-lidar"
+readonly kSample="$PWD/../shared/data/kitti_odometry_04_sample"
+readonly kVariant="${VARIANT:-default}"
 use_work_dir
-results="$work/results.tsv"
+results="$work/results-$kVariant.tsv"
 : > "$results"
-# One seed of tripod stations: the steps one by one (uses scene, seed, run, ws, joint, step).
-run_stations() {
-  step "$run/dataset" $cli simulate_dataset --scene "$scene" --seed "$seed" \
-    --num_stations "${STATIONS:-8}" --lidar_points "${LIDAR_POINTS:-300000}" \
-    --output_path "$run/dataset" &&
-  step "$ws/stereo" $cli stereo_depth --dataset_path "$run/dataset" --output_path "$ws/stereo" &&
-  step "$ws/db.db" $cli import_dataset --dataset_path "$run/dataset" --database_path "$ws/db.db" \
-    --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2 &&
-  step "$ws/priors.done" $cli depth_prior_extractor --database_path "$ws/db.db" \
-    --depth_path "$ws/stereo" && touch "$ws/priors.done" &&
-  step "$ws/lidar" $cli lidar_registrator --lidar_path "$run/dataset/lidar" \
-    --output_path "$ws/lidar" --max_neighbors 4 &&
-  step "$ws/initial" $cli pose_initializer --database_path "$ws/db.db" \
-    --dataset_path "$run/dataset" --registration_path "$ws/lidar" --output_path "$ws/initial" \
-    --use_guess 0 &&
-  step "$joint" $cli joint_adjuster --database_path "$ws/db.db" --input_path "$ws/initial" \
-    --dataset_path "$run/dataset" --output_path "$joint"
+
+# step OUTPUT COMMAND...: runs COMMAND (output to RUN/log.txt) unless OUTPUT exists.
+step() {
+  local output="$1"
+  shift
+  [ -e "$output" ] || "$@" >> "$run/log.txt" 2>&1
 }
-# One seed of the street drive (mono unless the scene is street_drive_stereo): the whole pipeline.
-run_drive() {
+# Each front end sets the joint adjuster's inputs: dataset, ws (database.db, initial model) and
+# registration (lidar_registrator's folder, empty: the dataset's clouds).
+stations_front_end() {
+  dataset="$run/dataset" registration="$run/ws/lidar"
+  step "$dataset" "$cli" simulate_dataset --scene "$scene" --seed "$seed" \
+    --num_stations "${STATIONS:-8}" --lidar_points "${LIDAR_POINTS:-300000}" --output_path "$dataset" &&
+  step "$run/ws/stereo" "$cli" stereo_depth --dataset_path "$dataset" --output_path "$run/ws/stereo" &&
+  step "$run/ws/db.db" "$cli" import_dataset --dataset_path "$dataset" --database_path "$run/ws/db.db" \
+    --SiftExtraction.num_threads 2 --SiftMatching.num_threads 2 &&
+  step "$run/ws/priors.done" "$cli" depth_prior_extractor --database_path "$run/ws/db.db" \
+    --depth_path "$run/ws/stereo" && touch "$run/ws/priors.done" &&
+  step "$registration" "$cli" lidar_registrator --lidar_path "$dataset/lidar" \
+    --output_path "$registration" --max_neighbors 4 &&
+  step "$run/ws/initial" "$cli" pose_initializer --database_path "$run/ws/db.db" \
+    --dataset_path "$dataset" --registration_path "$registration" --output_path "$run/ws/initial" \
+    --use_guess 0 &&
+  database="$run/ws/db.db" initial="$run/ws/initial"
+}
+# The pipeline on DATASET into RUN/ws (its own joint step included; the benchmark's runs from its
+# initial model).
+pipeline_front_end() {
+  database="$run/ws/database.db" initial="$run/ws/sparse/initial" registration="$run/ws/lidar"
+  step "$run/ws/steps/pose_initializer.done" "$cli" pipeline --dataset_path "$dataset" \
+    --workspace_path "$run/ws" --Import.matcher sequential
+}
+drive_front_end() {
   local mono=1
   [ "$scene" = street_drive_stereo ] && mono=0
-  step "$run/dataset" $cli simulate_dataset --scene street --motion drive --mono "$mono" \
-    --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 \
-    --write_guess 0 --output_path "$run/dataset" &&
-  step "$joint" $cli pipeline --dataset_path "$run/dataset" --workspace_path "$ws" \
-    --Import.matcher sequential
+  dataset="$run/dataset"
+  step "$dataset" "$cli" simulate_dataset --scene street --motion drive --mono "$mono" \
+    --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 --write_guess 0 \
+    --output_path "$dataset" && pipeline_front_end
 }
-for scene in ${SCENES:-t_specimen bridge_pier}; do
-  for seed in $(seq 1 "${SEEDS:-10}"); do
+kitti_layout_front_end() {
+  dataset="$run/dataset"
+  step "$run/kitti" "$cli" simulate_dataset --scene street --motion drive --layout kitti --mono 1 \
+    --seed "$seed" --num_stations 20 --lidar_points 120000 --output_path "$run/kitti" &&
+  step "$dataset" "$cli" import_kitti --kitti_path "$run/kitti/drive" \
+    --calib_path "$run/kitti/calibration" --output_path "$dataset" --write_guess 1 \
+    --guess_rotation_deg 1 --seed "$seed" && pipeline_front_end
+}
+kitti_odometry_front_end() {  # seed: stereo | mono
+  local use_right=1
+  [ "$seed" = mono ] && use_right=0
+  dataset="$run/dataset"
+  step "$dataset" "$cli" import_kitti --format odometry --sequence_path "$kSample" \
+    --poses_path "$kSample/poses/04.txt" --output_path "$dataset" --use_right "$use_right" &&
+  pipeline_front_end
+}
+
+for scene in ${SCENES:-t_specimen bridge_pier street_drive street_drive_stereo kitti_layout_drive kitti_odometry}; do
+  seeds=$(seq 1 "${SEEDS:-10}")
+  case "$scene" in
+    t_specimen | bridge_pier) front_end=stations_front_end ;;
+    street_drive | street_drive_stereo)
+      front_end=drive_front_end seeds=$(seq 1 "${DRIVE_SEEDS:-${SEEDS:-10}}") ;;
+    kitti_layout_drive)
+      front_end=kitti_layout_front_end seeds=$(seq 1 "${DRIVE_SEEDS:-${SEEDS:-10}}") ;;
+    kitti_odometry) front_end=kitti_odometry_front_end seeds="stereo mono" ;;
+    *) echo "unknown scene $scene" >&2; exit 2 ;;
+  esac
+  if [ "$scene" = kitti_odometry ] && [ ! -d "$kSample" ]; then
+    echo "[$scene] skipped: $kSample is missing"
+    continue
+  fi
+  for seed in $seeds; do
     run="$work/$scene-$seed"
-    echo "[$scene seed $seed] simulating and running the pipeline ..."
-    ws="$run/ws"
-    mkdir -p "$ws"
-    step() {  # step OUTPUT COMMAND...: runs COMMAND unless OUTPUT exists
-      local output="$1"
-      shift
-      [ -e "$output" ] || "$@" >> "$run/log.txt" 2>&1
-    }
-    if [ "$scene" = street_drive ] || [ "$scene" = street_drive_stereo ]; then
-      joint="$ws/sparse/joint"
-      front_and_back_end=run_drive
-    else
-      joint="$ws/joint"
-      front_and_back_end=run_stations
-    fi
-    if ! "$front_and_back_end"; then
+    joint="$run/joint-$kVariant"
+    mkdir -p "$run"
+    echo "[$scene $seed] front end and joint adjuster ($kVariant) ..."
+    # shellcheck disable=SC2086
+    if ! "$front_end" || ! step "$joint" "$cli" joint_adjuster --database_path "$database" \
+        --input_path "$initial" --dataset_path "$dataset" --registration_path "$registration" \
+        --output_path "$joint" ${JOINT_OPTIONS:-}; then
       echo "  failed (see the log below)"; tail -5 "$run/log.txt"
       printf '%s\t%s\tFAILED\n' "$scene" "$seed" >> "$results"
       continue
     fi
-    python3 scripts/extrinsic_error.py "$run/dataset/ground_truth/cam_from_lidar.txt" \
+    python3 scripts/extrinsic_error.py "$dataset/ground_truth/cam_from_lidar.txt" \
       "$joint/cam_from_lidar.txt" "$joint/report.json" "$scene" "$seed" >> "$results"
     tail -1 "$results"
   done
 done
 mkdir -p docs/benchmarks
 readonly kDoc="${DOC:-docs/benchmarks/uncertainty.md}"
-python3 scripts/uncertainty_table.py "$results" "${STATIONS:-8}" "${LIDAR_POINTS:-300000}" > "$kDoc"
+python3 scripts/uncertainty_table.py "$results" "$kVariant" "${JOINT_OPTIONS:-}" > "$kDoc"
 cat "$kDoc"
