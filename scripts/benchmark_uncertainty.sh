@@ -20,14 +20,15 @@
 #           (extra joint_adjuster options): variants of the estimator compared on the same front ends
 #   WORK_DIR  keep the runs there (default: a temporary folder, removed); front ends and joint runs
 #           already there are not made again
-#   BUILD_DIR (default build)
+#   BUILD_DIR (default build); CLI: another colmap-lidar executable instead of building one (a
+#           variant of the estimator built elsewhere)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
 source scripts/configure.sh
 readonly kBuild="${BUILD_DIR:-build}"
-build_cli "$kBuild"
-cli="$PWD/$kBuild/bin/colmap-lidar"
+if [ -z "${CLI:-}" ]; then build_cli "$kBuild"; fi
+cli="${CLI:-$PWD/$kBuild/bin/colmap-lidar}"
 readonly kSample="$PWD/../shared/data/kitti_odometry_04_sample"
 readonly kVariant="${VARIANT:-default}"
 use_work_dir
