@@ -40,7 +40,7 @@ const std::string kSift = " --SiftExtraction.num_threads 2 --SiftMatching.num_th
 std::string Simulate(const testing::ScopedTempDir& dir,
                      const std::string& name,
                      int num_stations,
-                     const std::string& motion,
+                     sim::Motion motion,
                      double image_scale) {
   sim::SimulationOptions options;
   options.output_path = dir.File(name);
@@ -55,7 +55,7 @@ std::string Simulate(const testing::ScopedTempDir& dir,
 // The default scene and rig at full resolution (6 stations of the default two-axes motion).
 TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
   testing::ScopedTempDir dir;
-  const std::string dataset_path = Simulate(dir, "dataset", 6, "two_axes", 1.0);
+  const std::string dataset_path = Simulate(dir, "dataset", 6, sim::Motion::kTwoAxes, 1.0);
   const StationDataset dataset = ReadStationDataset(dataset_path);
 
   auto result = RunCommand(kCli + " stereo_depth --dataset_path " + dataset_path +
@@ -174,7 +174,7 @@ TEST(FrontEndTest, DepthPriorsOfTheDefaultSceneMatchTheTruth) {
 // COLMAP's own mapper reconstructs from the imported database; a second import adds nothing.
 TEST(FrontEndTest, ImportedDatabaseIsIdempotentAndUsableByColmapMapper) {
   testing::ScopedTempDir dir;
-  const std::string dataset_path = Simulate(dir, "dataset", 4, "fixed_rotation", 0.6);
+  const std::string dataset_path = Simulate(dir, "dataset", 4, sim::Motion::kFixedRotation, 0.6);
   const std::string db = dir.File("db.db");
   const std::string import =
       kCli + " import_dataset --dataset_path " + dataset_path + " --database_path " + db + kSift;
@@ -237,7 +237,7 @@ TEST(FrontEndTest, ImportedDatabaseIsIdempotentAndUsableByColmapMapper) {
 void SimulateStreet(const testing::ScopedTempDir& dir) {
   sim::SimulationOptions options;
   options.scene = "street";
-  options.motion = "drive";
+  options.motion = sim::Motion::kDrive;
   options.output_path = dir.File("street");
   options.num_stations = 8;
   options.image_scale = 0.5;
@@ -344,7 +344,7 @@ TEST(FrontEndTest, SpatialMatcherPairsStationsNearInTheLidarRegistration) {
 // Bad stereo pairs: one clear error naming the station; the database is left exactly as it was.
 TEST(FrontEndTest, BadInputNamesTheStationAndLeavesTheDatabaseUnchanged) {
   testing::ScopedTempDir dir;
-  const std::string dataset_path = Simulate(dir, "dataset", 3, "fixed_rotation", 0.3);
+  const std::string dataset_path = Simulate(dir, "dataset", 3, sim::Motion::kFixedRotation, 0.3);
   const std::string db = dir.File("db.db");
   ASSERT_EQ(RunCommand(kCli + " database_creator --database_path " + db).exit_code, 0);
   const std::string before = FileBytes(db);
@@ -402,7 +402,7 @@ TEST(FrontEndTest, BadInputNamesTheStationAndLeavesTheDatabaseUnchanged) {
   sim::SimulationOptions other;
   other.output_path = dir.File("other");
   other.num_stations = 2;
-  other.motion = "fixed_rotation";
+  other.motion = sim::Motion::kFixedRotation;
   other.image_scale = 0.2;
   other.lidar_points = 2000;
   sim::SimulateDataset(other);

@@ -146,7 +146,7 @@ JointResult RunJoint(const Workspace& ws, const std::string& output, const std::
   return result;
 }
 
-sim::SimulationOptions Stations(int num_stations, const std::string& motion) {
+sim::SimulationOptions Stations(int num_stations, sim::Motion motion) {
   sim::SimulationOptions options;
   options.num_stations = num_stations;
   options.motion = motion;
@@ -156,7 +156,7 @@ sim::SimulationOptions Stations(int num_stations, const std::string& motion) {
 
 TEST(JointAdjusterTest, DefaultSceneWithNoise) {
   testing::ScopedTempDir dir;
-  const Workspace ws = Prepare(dir, Stations(10, "two_axes"), 0.3, 0.01);
+  const Workspace ws = Prepare(dir, Stations(10, sim::Motion::kTwoAxes), 0.3, 0.01);
   const JointResult joint = RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess);
   std::cout << joint.output.substr(joint.output.find("Round 1/")) << std::endl;
   const JointResult precalibrated =
@@ -186,7 +186,7 @@ TEST(JointAdjusterTest, DefaultSceneWithNoise) {
 // Results do not depend on the thread count: OpenMP's (associations) and Ceres' (the solves).
 TEST(JointAdjusterTest, SameOutputWithOneAndFourThreads) {
   testing::ScopedTempDir dir;
-  sim::SimulationOptions options = Stations(10, "one_axis");
+  sim::SimulationOptions options = Stations(10, sim::Motion::kOneAxis);
   options.image_scale = 0.6;
   const Workspace ws = Prepare(dir, options, 0.3, 0.01);
   for (const char* threads : {"1", "4"}) {
@@ -205,7 +205,7 @@ TEST(JointAdjusterTest, SameOutputWithOneAndFourThreads) {
 // Degenerate motion: the report names what cannot be observed.
 TEST(JointAdjusterTest, OneAxisMotionLeavesTranslationAlongTheAxisUnobservable) {
   testing::ScopedTempDir dir;
-  sim::SimulationOptions options = Stations(10, "one_axis");
+  sim::SimulationOptions options = Stations(10, sim::Motion::kOneAxis);
   options.image_scale = 0.6;
   const Workspace ws = Prepare(dir, options, 0.3, 0.01);
   // A given hold threshold is the one used (a start from the guess once overrode it).
@@ -225,7 +225,7 @@ TEST(JointAdjusterTest, OneAxisMotionLeavesTranslationAlongTheAxisUnobservable) 
 // a moving platform; on these stations it once ended 128 mm off with a reported sigma of 7 mm).
 TEST(JointAdjusterTest, FixedRotationLeavesAllTranslationUnobservable) {
   testing::ScopedTempDir dir;
-  sim::SimulationOptions options = Stations(4, "fixed_rotation");
+  sim::SimulationOptions options = Stations(4, sim::Motion::kFixedRotation);
   options.image_scale = 0.6;
   const Workspace ws = Prepare(dir, options, 0.3, 0.01);
   const JointResult joint = RunJoint(ws, dir.File("joint"), "--cam_from_lidar " + ws.guess);

@@ -30,8 +30,8 @@ class KittiImportTest : public ::testing::Test {
     dir_ = new testing::ScopedTempDir("colmap_lidar_kitti_import");
     sim::SimulationOptions options;
     options.scene = "street";
-    options.motion = "drive";
-    options.layout = "kitti";
+    options.motion = sim::Motion::kDrive;
+    options.layout = sim::DatasetLayout::kKitti;
     options.output_path = dir_->File("kitti");
     options.num_stations = 5;
     options.image_scale = 0.5;

@@ -263,7 +263,7 @@ std::map<std::string, Eigen::Isometry3d> TrueWorldFromLidar(const std::string& d
 std::string SimulateMonoDrive(const testing::ScopedTempDir& dir, int num_frames, bool frozen) {
   sim::SimulationOptions options;
   options.scene = "street";
-  options.motion = "drive";
+  options.motion = sim::Motion::kDrive;
   options.mono = true;
   options.seed = 1;
   options.num_stations = num_frames;
@@ -287,7 +287,7 @@ class StreetDriveTest : public ::testing::Test {
     dir_ = new testing::ScopedTempDir("colmap_lidar_street");
     sim::SimulationOptions options;
     options.scene = "street";
-    options.motion = "drive";
+    options.motion = sim::Motion::kDrive;
     options.output_path = dir_->File("dataset");
     options.num_stations = 10;
     options.image_scale = 0.25;
@@ -521,7 +521,7 @@ TEST(RevisitDriveTest, RevisitsAreRightAndPullADriftedWayBackOntoTheWayOut) {
   testing::ScopedTempDir dir("colmap_lidar_revisit");
   sim::SimulationOptions options;
   options.scene = "street";
-  options.motion = "drive_return";
+  options.motion = sim::Motion::kDriveReturn;
   options.output_path = dir.File("dataset");
   options.num_stations = 80;
   options.image_scale = 0.2;

@@ -88,8 +88,8 @@ TEST(PipelineMonoTest, StationsCalibrateWithoutAGuessOrAStereoPair) {
 std::string RunDrive(const testing::ScopedTempDir& dir, int num_frames, bool guess) {
   sim::SimulationOptions drive;
   drive.scene = "street";
-  drive.motion = "drive";
-  drive.layout = "kitti";
+  drive.motion = sim::Motion::kDrive;
+  drive.layout = sim::DatasetLayout::kKitti;
   drive.mono = true;
   drive.num_stations = num_frames;
   drive.lidar_points = 120000;

@@ -43,7 +43,7 @@ TEST(PipelineStereoDriveTest, FortyFrameStereoDriveCalibratesFromItsStereoDepthW
   testing::ScopedTempDir dir;
   sim::SimulationOptions drive;
   drive.scene = "street";
-  drive.motion = "drive";
+  drive.motion = sim::Motion::kDrive;
   drive.num_stations = 40;
   drive.lidar_points = 120000;
   drive.write_guess = false;

@@ -172,13 +172,15 @@ Trajectory ModelCameraTrajectory(const colmap::Reconstruction& model) {
   return trajectory;
 }
 
-Trajectory LoadTrajectory(const std::string& path, const std::string& format) {
-  if (format == "colmap" || (format == "auto" && fs::is_directory(path))) {
+Trajectory LoadTrajectory(const std::string& path, TrajectorySource source) {
+  const bool automatic = source == TrajectorySource::kAuto;
+  if (source == TrajectorySource::kColmapModel || (automatic && fs::is_directory(path))) {
     return LoadColmapModel(path);
   }
   if (!fs::is_regular_file(path)) throw std::runtime_error(path + ": no such trajectory file");
   const TrajectoryFileFormat file_format =
-      format == "auto" ? DetectTrajectoryFileFormat(path) : TrajectoryFileFormatFromName(format);
+      automatic ? DetectTrajectoryFileFormat(path)
+                : TrajectoryFileFormatFromName(ChoiceName(kTrajectorySourceNames, source));
   return ReadTrajectoryFile(path, file_format);
 }
 

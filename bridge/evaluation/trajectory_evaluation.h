@@ -7,6 +7,7 @@
 
 #include "colmap_ext/trajectory_files.h"
 #include "lidar/trajectory_error.h"
+#include "lidar/util/named_choice.h"
 
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/reconstruction.h"
@@ -17,9 +18,27 @@
 
 namespace colmap_lidar {
 
-// "auto" (a folder: a COLMAP model; a file: colmap_ext's DetectTrajectoryFileFormat), "colmap" or a
-// TrajectoryFileFormatName. Throws naming the path when it cannot be read.
-Trajectory LoadTrajectory(const std::string& path, const std::string& format);
+// How a trajectory is read: by its path (a folder: a COLMAP model; a file: colmap_ext's
+// DetectTrajectoryFileFormat), as a COLMAP model, or as a file of one of colmap_ext's formats (the
+// names are TrajectoryFileFormatName's).
+enum class TrajectorySource {
+  kAuto,
+  kColmapModel,
+  kNamedWorldFromSensor,
+  kNamedSensorFromWorld,
+  kKitti,
+  kTum
+};
+inline constexpr NamedChoices<TrajectorySource, 6> kTrajectorySourceNames = {
+    {{"auto", TrajectorySource::kAuto},
+     {"colmap", TrajectorySource::kColmapModel},
+     {"named_world_from_sensor", TrajectorySource::kNamedWorldFromSensor},
+     {"named_sensor_from_world", TrajectorySource::kNamedSensorFromWorld},
+     {"kitti", TrajectorySource::kKitti},
+     {"tum", TrajectorySource::kTum}}};
+
+// Throws naming the path when it cannot be read.
+Trajectory LoadTrajectory(const std::string& path, TrajectorySource source);
 
 // The camera poses world_from_cam of a model's registered images, named by station, in name order.
 Trajectory ModelCameraTrajectory(const colmap::Reconstruction& model);

@@ -17,16 +17,17 @@ int RunSimulateDataset(int argc, char** argv) {
                            &options.scene,
                            "t_specimen | square_pillar | cylinder_pillar | bridge_pier | street");
   manager.AddDefaultOption("num_stations", &options.num_stations);
-  manager.AddDefaultOption(
-      "motion", &options.motion, "two_axes | one_axis | fixed_rotation | drive | drive_return");
+  manager.AddChoiceOption("motion", &options.motion, sim::kMotionNames);
   manager.AddDefaultOption(
       "sweep_motion", &options.sweep_motion, "drive: the pod moves during each sweep");
   manager.AddDefaultOption(
       "moving_cars", &options.moving_cars, "drive: the street's two cars move between frames");
   manager.AddDefaultOption(
       "image_scale", &options.image_scale, "1 = 1028x752 per camera, 4 = 4112x3008");
-  manager.AddDefaultOption(
-      "layout", &options.layout, "dataset | kitti (KITTI raw's folders and calibration files)");
+  manager.AddChoiceOption("layout",
+                          &options.layout,
+                          sim::kDatasetLayoutNames,
+                          "kitti: KITTI raw's folders and calibration files");
   manager.AddDefaultOption(
       "mono", &options.mono, "one camera: no right images, no 'right' in rig.json");
   manager.AddDefaultOption("lidar_points", &lidar_points, "LiDAR rays per station");

@@ -21,11 +21,11 @@ int RunEvaluateTrajectory(int argc, char** argv) {
   manager.AddRequiredOption(
       "reference_path", &options.reference_path, "e.g. DATASET/ground_truth/cam_from_world.txt");
   manager.AddRequiredOption("output_path", &options.output_path, "folder for metrics.json, PNGs");
-  manager.AddDefaultOption("trajectory_format",
-                           &options.trajectory_format,
-                           "auto, colmap, named_world_from_sensor, named_sensor_from_world, "
-                           "kitti, tum");
-  manager.AddDefaultOption("reference_format", &options.reference_format, "as trajectory_format");
+  manager.AddChoiceOption("trajectory_format",
+                          &options.trajectory_format,
+                          kTrajectorySourceNames,
+                          "auto: a folder is a COLMAP model, a file's format is detected");
+  manager.AddChoiceOption("reference_format", &options.reference_format, kTrajectorySourceNames);
   manager.AddDefaultOption("reference_sensor_from_sensor_path",
                            &options.reference_sensor_from_sensor_path,
                            "pose file taking the reference to the trajectory's sensor (e.g. "

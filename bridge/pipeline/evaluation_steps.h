@@ -30,7 +30,8 @@ void RunEvaluateCalibrationStep(const std::string& dataset_path,
 // (bridge/evaluation/trajectory_evaluation.h).
 struct TrajectoryEvaluationStepOptions {
   std::string trajectory_path, reference_path, output_path;
-  std::string trajectory_format = "auto", reference_format = "auto";
+  TrajectorySource trajectory_format = TrajectorySource::kAuto;
+  TrajectorySource reference_format = TrajectorySource::kAuto;
   // A pose file reference_sensor_from_sensor applied to every reference pose (empty: same sensor).
   std::string reference_sensor_from_sensor_path;
   // A dataset whose timestamps.txt times named poses (empty: none).

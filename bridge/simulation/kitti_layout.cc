@@ -1,9 +1,9 @@
 #include "bridge/simulation/kitti_layout.h"
 
+#include "bridge/simulation/sensor_pod.h"
 #include "colmap_ext/kitti_calibration.h"
 #include "colmap_ext/station_dataset.h"
 #include "lidar/cloud_io.h"
-#include "bridge/simulation/sensor_pod.h"
 
 #include <cstdio>
 #include <filesystem>

@@ -1,8 +1,8 @@
 // Ray-cast rendering of a station's images and true depth, and of its LiDAR cloud.
 #pragma once
 
-#include "lidar/point_cloud.h"
 #include "bridge/simulation/scene.h"
+#include "lidar/point_cloud.h"
 
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/camera.h"

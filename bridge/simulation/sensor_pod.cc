@@ -35,17 +35,6 @@ colmap::Rigid3d CamFromWorld(const Eigen::Matrix3d& world_from_cam, const Eigen:
 
 }  // namespace
 
-Motion MotionFromName(const std::string& name) {
-  if (name == "two_axes") return Motion::kTwoAxes;
-  if (name == "one_axis") return Motion::kOneAxis;
-  if (name == "fixed_rotation") return Motion::kFixedRotation;
-  if (name == "drive") return Motion::kDrive;
-  if (name == "drive_return") return Motion::kDriveReturn;
-  throw std::invalid_argument(
-      "Unknown --motion '" + name +
-      "'; expected two_axes, one_axis, fixed_rotation, drive or drive_return");
-}
-
 bool IsDrive(Motion motion) { return motion == Motion::kDrive || motion == Motion::kDriveReturn; }
 
 namespace {

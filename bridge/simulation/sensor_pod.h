@@ -3,9 +3,10 @@
 // Transforms are target_from_source; quaternions are Eigen (xyzw storage) in memory.
 #pragma once
 
+#include "bridge/simulation/scene.h"
 #include "colmap_ext/pose_perturbation.h"
 #include "colmap_ext/station_dataset.h"
-#include "bridge/simulation/scene.h"
+#include "lidar/util/named_choice.h"
 
 #include "colmap/geometry/rigid3.h"
 
@@ -24,8 +25,12 @@ enum class Motion {
   // far end and returning in the other lane: it passes every place of its way out again (revisits)
   kDriveReturn,
 };
-// "two_axes", "one_axis", "fixed_rotation", "drive", "drive_return"
-Motion MotionFromName(const std::string& name);
+inline constexpr NamedChoices<Motion, 5> kMotionNames = {
+    {{"two_axes", Motion::kTwoAxes},
+     {"one_axis", Motion::kOneAxis},
+     {"fixed_rotation", Motion::kFixedRotation},
+     {"drive", Motion::kDrive},
+     {"drive_return", Motion::kDriveReturn}}};
 // The motions of a car (frames of one sweep each, in the street).
 bool IsDrive(Motion motion);
 

@@ -79,7 +79,6 @@ bool SimulationOptions::Check() const {
   CHECK_OPTION_GE(guess_rotation_deg, 0);
   CHECK_OPTION_GE(guess_translation_m, 0);
   CHECK_OPTION_GT(surface_spacing_m, 1e-4);
-  CHECK_OPTION(layout == "dataset" || layout == "kitti");
   return true;
 }
 
@@ -114,7 +113,8 @@ StationRig MakeStereoRigOf(const SimulationOptions& options,
   // so, as import_kitti does, so that the pipeline de-skews them.
   if (drive && options.sweep_motion) rig.lidar_sweep = StationRig::LidarSweep();
   // KITTI's images are rectified: the right camera is not turned against the left one.
-  if (options.layout == "kitti") rig.right_from_left.rotation = Eigen::Quaterniond::Identity();
+  if (options.layout == DatasetLayout::kKitti)
+    rig.right_from_left.rotation = Eigen::Quaterniond::Identity();
   return rig;
 }
 
@@ -157,7 +157,7 @@ size_t ScanStation(const SimulationOptions& options,
   lidar_options.mixed_edge_points = options.mixed_edge_points;
   lidar_options.seed = options.seed * 1000 + i;
   const PointCloud cloud =
-      IsDrive(MotionFromName(options.motion))
+      IsDrive(options.motion)
           ? ScanSweep(
                 frame_scene, SweepPath(world_from_lidar, i, options.sweep_motion), lidar_options)
           : ScanLidar(scene, world_from_lidar[i], lidar_options);
@@ -187,7 +187,7 @@ size_t WriteGroundTruth(const SimulationOptions& options,
 // OUTPUT.partial (in KITTI's layout if asked) renamed to OUTPUT.
 void FinishOutput(const SimulationOptions& options, const fs::path& partial) {
   const fs::path output(options.output_path);
-  if (options.layout == "kitti") {
+  if (options.layout == DatasetLayout::kKitti) {
     const fs::path kitti_partial = output.string() + ".kitti.partial";
     fs::remove_all(kitti_partial);
     WriteKittiLayout(partial.string(), kitti_partial.string());
@@ -204,7 +204,7 @@ SimulationResult SimulateDataset(const SimulationOptions& options) {
   THROW_CHECK(options.Check()) << "Invalid simulation options";
   const auto start = std::chrono::steady_clock::now();
   const Scene scene = Scene::Create(options.scene);
-  const Motion motion = MotionFromName(options.motion);
+  const Motion motion = options.motion;
   const fs::path partial = MakePartialFolder(options);
   const bool drive = IsDrive(motion);
   const colmap::Rigid3d cam_from_lidar = TrueCamFromLidar();

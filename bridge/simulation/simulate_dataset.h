@@ -1,19 +1,28 @@
 // Writes a complete station dataset (docs/dataset_format.md) with ground truth for a simulated capture.
 #pragma once
 
+#include "bridge/simulation/sensor_pod.h"
+#include "lidar/util/named_choice.h"
+
 #include <cstdint>
 #include <string>
 
 namespace colmap_lidar {
 namespace sim {
 
+// How the dataset is written: docs/dataset_format.md, or KITTI raw's layout and calibration files
+// with a rectified right camera (bridge/simulation/kitti_layout.h).
+enum class DatasetLayout { kDataset, kKitti };
+inline constexpr NamedChoices<DatasetLayout, 2> kDatasetLayoutNames = {
+    {{"dataset", DatasetLayout::kDataset}, {"kitti", DatasetLayout::kKitti}}};
+
 struct SimulationOptions {
   std::string scene = "t_specimen";
   std::string output_path;
   int num_stations = 25;
-  // two_axes | one_axis | fixed_rotation | drive (frames of a car: MakeDriveRig, one ScanSweep per
-  // frame with the frame's pose at mid-sweep, cars moving between frames; scene "street")
-  std::string motion = "two_axes";
+  // Drives (IsDrive): frames of a car (MakeDriveRig), one ScanSweep per frame with the frame's pose
+  // at mid-sweep, cars moving between frames; scene "street".
+  Motion motion = Motion::kTwoAxes;
   // drive: the pod moves during each sweep (false: a frozen pod per sweep, as stop-and-go; isolates
   // de-skewing in experiments)
   bool sweep_motion = true;
@@ -23,9 +32,7 @@ struct SimulationOptions {
   double image_scale = 1.0;
   // One camera: rig.json without "right", no images/right/ (a monocular dataset).
   bool mono = false;
-  // dataset (docs/dataset_format.md) | kitti (KITTI raw's layout and calibration files, with a
-  // rectified right camera; bridge/simulation/kitti_layout.h)
-  std::string layout = "dataset";
+  DatasetLayout layout = DatasetLayout::kDataset;
   // LiDAR rays per station
   size_t lidar_points = 1600000;
   double range_noise_m = 0.01;

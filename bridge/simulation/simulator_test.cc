@@ -302,7 +302,7 @@ double FiringFraction(const Eigen::Vector3d& point_in_lidar) {
 TEST(SimulatorTest, DriveSweepsAgreeWithTheImagesAtTheirFiringInstant) {
   testing::ScopedTempDir dir;
   sim::SimulationOptions options = NoiseFreeOptions("street", dir.File("d"));
-  options.motion = "drive";
+  options.motion = sim::Motion::kDrive;
   options.num_stations = 4;
   options.lidar_points = 60000;
   options.image_scale = 0.5;
