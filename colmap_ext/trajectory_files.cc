@@ -100,28 +100,11 @@ TrajectoryFileFormat DetectTrajectoryFileFormat(const std::string& path) {
 }
 
 TrajectoryFileFormat TrajectoryFileFormatFromName(const std::string& name) {
-  for (const TrajectoryFileFormat format : {TrajectoryFileFormat::kNamedWorldFromSensor,
-                                            TrajectoryFileFormat::kNamedSensorFromWorld,
-                                            TrajectoryFileFormat::kKitti,
-                                            TrajectoryFileFormat::kTum}) {
-    if (TrajectoryFileFormatName(format) == name) return format;
-  }
-  throw std::invalid_argument("unknown trajectory format '" + name +
-                              "' (named_world_from_sensor, named_sensor_from_world, kitti, tum)");
+  return ChoiceFromName(kTrajectoryFileFormatNames, name, "trajectory format");
 }
 
 std::string TrajectoryFileFormatName(TrajectoryFileFormat format) {
-  switch (format) {
-    case TrajectoryFileFormat::kNamedWorldFromSensor:
-      return "named_world_from_sensor";
-    case TrajectoryFileFormat::kNamedSensorFromWorld:
-      return "named_sensor_from_world";
-    case TrajectoryFileFormat::kKitti:
-      return "kitti";
-    case TrajectoryFileFormat::kTum:
-      return "tum";
-  }
-  return "";
+  return ChoiceName(kTrajectoryFileFormatNames, format);
 }
 
 Trajectory ReadTrajectoryFile(const std::string& path, TrajectoryFileFormat format) {

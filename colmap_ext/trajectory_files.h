@@ -8,6 +8,8 @@
 // Every reader throws std::runtime_error naming the file and line of a bad value.
 #pragma once
 
+#include "lidar/util/named_choice.h"
+
 #include "colmap/geometry/rigid3.h"
 
 #include <string>
@@ -36,7 +38,12 @@ enum class TrajectoryFileFormat {
 // numbers a named file, whose direction follows the file name ("..._from_world.txt":
 // sensor_from_world, otherwise world_from_sensor). Throws naming the file when none fits.
 TrajectoryFileFormat DetectTrajectoryFileFormat(const std::string& path);
-// "named_world_from_sensor", "named_sensor_from_world", "kitti", "tum"; throws on another name.
+inline constexpr NamedChoices<TrajectoryFileFormat, 4> kTrajectoryFileFormatNames = {
+    {{"named_world_from_sensor", TrajectoryFileFormat::kNamedWorldFromSensor},
+     {"named_sensor_from_world", TrajectoryFileFormat::kNamedSensorFromWorld},
+     {"kitti", TrajectoryFileFormat::kKitti},
+     {"tum", TrajectoryFileFormat::kTum}}};
+// Throws std::invalid_argument on a name not in kTrajectoryFileFormatNames.
 TrajectoryFileFormat TrajectoryFileFormatFromName(const std::string& name);
 std::string TrajectoryFileFormatName(TrajectoryFileFormat format);
 
