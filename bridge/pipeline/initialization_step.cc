@@ -108,9 +108,9 @@ CaptureProfile ProfileOf(const StationDataset& dataset, const PoseInitialization
 
 }  // namespace
 
-void RunPoseInitializerStep(const StationDataset& dataset,
-                            const PoseInitializerPaths& paths,
-                            const PoseInitializerOptions& options) {
+CaptureProfile RunPoseInitializerStep(const StationDataset& dataset,
+                                      const PoseInitializerPaths& paths,
+                                      const PoseInitializerOptions& options) {
   THROW_CHECK(options.Check());
   const auto start = std::chrono::steady_clock::now();
   PartialOutputFolder partial(paths.output_path);
@@ -151,10 +151,12 @@ void RunPoseInitializerStep(const StationDataset& dataset,
                 "initial cam_from_lidar (" + init.extrinsic_source + "); qw qx qy qz tx ty tz",
                 init.cam_from_lidar);
   WriteInitializationReport(partial.File("initialization.json"), init, paths.input_path, scales);
-  WriteCaptureProfile(partial.File(kCaptureProfileFile), ProfileOf(dataset, init));
+  const CaptureProfile profile = ProfileOf(dataset, init);
+  WriteCaptureProfile(partial.File(kCaptureProfileFile), profile);
   partial.Commit();
   std::cout << "Wrote the initial model to " << paths.output_path << " (" << std::fixed
             << std::setprecision(1) << SecondsSince(start) << " s)" << std::endl;
+  return profile;
 }
 
 }  // namespace colmap_lidar

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "bridge/initialization/pose_initializer.h"
+#include "bridge/pipeline/capture_profile.h"
 #include "colmap_ext/station_dataset.h"
 
 #include <string>
@@ -20,8 +21,9 @@ struct PoseInitializerPaths {
   std::string output_path;
   std::string depth_path;  // stereo_depth's output; empty: no stereo-LiDAR alignment
 };
-void RunPoseInitializerStep(const StationDataset& dataset,
-                            const PoseInitializerPaths& paths,
-                            const PoseInitializerOptions& options);
+// Returns the capture profile it decided (also recorded as OUTPUT/capture_profile.json).
+CaptureProfile RunPoseInitializerStep(const StationDataset& dataset,
+                                      const PoseInitializerPaths& paths,
+                                      const PoseInitializerOptions& options);
 
 }  // namespace colmap_lidar

@@ -196,7 +196,8 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   }
   const auto start = std::chrono::steady_clock::now();
   colmap::Reconstruction reconstruction = ReadInputModel(paths.input_path);
-  const CaptureProfile profile = InputCaptureProfile(dataset, paths.input_path);
+  const CaptureProfile profile =
+      options.profile ? *options.profile : InputCaptureProfile(dataset, paths.input_path);
   const bool vertical_alignment =
       DecideFromMotion(dataset, profile, reconstruction, &options.adjuster);
   colmap::Rigid3d cam_from_lidar =

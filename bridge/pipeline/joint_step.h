@@ -8,8 +8,10 @@
 
 #include "bridge/joint/joint_adjuster.h"
 #include "bridge/joint/joint_problem_data.h"
+#include "bridge/pipeline/capture_profile.h"
 #include "colmap_ext/station_dataset.h"
 
+#include <optional>
 #include <string>
 
 namespace colmap_lidar {
@@ -24,6 +26,10 @@ struct JointAdjusterStepOptions {
   bool estimate_time_offset = true;
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
   bool write_text = false;
+  // The capture profile the pose initialiser decided, given in memory by the pipeline that ran it;
+  // empty: the one recorded beside the input model (INPUT/capture_profile.json), else decided from
+  // the dataset and the model.
+  std::optional<CaptureProfile> profile;
 
   bool Check() const;
 };

@@ -13,6 +13,8 @@
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -114,13 +116,48 @@ std::vector<PipelineStep> EvaluationSteps(const StationDataset& dataset,
   return steps;
 }
 
+// pose_initializer, joint_adjuster and densifier on the camera steps' dataset (`camera_dataset`) with
+// the registrator's clouds; the initialiser's edges from `registration`. The capture profile passes
+// from the pose initialiser to the joint step in memory; a rerun that skips the initialiser reads
+// the one it recorded.
+std::vector<PipelineStep> BackEndSteps(const WorkspacePaths& paths,
+                                       const std::function<StationDataset()>& camera_dataset,
+                                       const std::string& registration,
+                                       bool stereo_rig,
+                                       const PipelineOptions& options) {
+  const std::function<StationDataset()> clouds = [=] {
+    return WithRegistratorClouds(camera_dataset(), paths.lidar);
+  };
+  const std::string stereo = stereo_rig ? paths.stereo : "";
+  const auto profile = std::make_shared<std::optional<CaptureProfile>>();
+  return {
+      {"pose_initializer",
+       [=] {
+         *profile =
+             RunPoseInitializerStep(clouds(),
+                                    {paths.database, registration, "", paths.initial, stereo},
+                                    options.initializer);
+       }},
+      {"joint_adjuster",
+       [=] {
+         JointAdjusterStepOptions joint_options = options.joint;
+         joint_options.profile = *profile;
+         RunJointAdjusterStep(
+             clouds(), {paths.database, paths.initial, "", paths.joint}, joint_options);
+       }},
+      {"densifier",
+       [=] {
+         RunDensifierStep(clouds(), {paths.joint, "", stereo, paths.dense}, options.densifier);
+       }},
+  };
+}
+
 // The steps in order, on the workspace layout (WorkspacePaths); the evaluation steps only when the
 // dataset has ground truth.
 std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
                                         const PipelineOptions& options) {
   const WorkspacePaths paths(options.workspace_path);
-  const std::string &database = paths.database, &stereo = paths.stereo, &lidar = paths.lidar,
-                    &initial = paths.initial, &joint = paths.joint, &dense = paths.dense;
+  const std::string &database = paths.database, &stereo = paths.stereo, &lidar = paths.lidar;
   // A monocular rig has no stereo steps and no stereo depth for the densifier.
   const bool stereo_rig = dataset.rig.IsStereo();
   // With frame selection the camera steps see the selected frames and their registration folder
@@ -153,26 +190,8 @@ std::vector<PipelineStep> PipelineSteps(const StationDataset& dataset,
                      [=] { RunDepthPriorStep(database, stereo, options.depth_prior); }});
   }
   if (!lidar_first) steps.push_back(registrator);
-  std::vector<PipelineStep> back_end = {
-      {"pose_initializer",
-       [=] {
-         RunPoseInitializerStep(WithRegistratorClouds(camera_dataset(), lidar),
-                                {database, registration, "", initial, stereo_rig ? stereo : ""},
-                                options.initializer);
-       }},
-      {"joint_adjuster",
-       [=] {
-         RunJointAdjusterStep(WithRegistratorClouds(camera_dataset(), lidar),
-                              {database, initial, "", joint},
-                              options.joint);
-       }},
-      {"densifier",
-       [=] {
-         RunDensifierStep(WithRegistratorClouds(camera_dataset(), lidar),
-                          {joint, "", stereo_rig ? stereo : "", dense},
-                          options.densifier);
-       }},
-  };
+  const std::vector<PipelineStep> back_end =
+      BackEndSteps(paths, camera_dataset, registration, stereo_rig, options);
   steps.insert(steps.end(), back_end.begin(), back_end.end());
   const std::vector<PipelineStep> evaluation_steps = EvaluationSteps(dataset, options);
   steps.insert(steps.end(), evaluation_steps.begin(), evaluation_steps.end());
