@@ -18,8 +18,8 @@ void AddMatcherOption(const std::string& name,
                       ImageMatcher* matcher,
                       bool* choose_matcher) {
   const std::string help =
-      "exhaustive | sequential (frames of a moving platform, by name) | spatial (stations near in "
-      "--lidar_registration_path)";
+      "sequential: frames of a moving platform, by name; spatial: stations near in "
+      "--lidar_registration_path";
   if (choose_matcher == nullptr) {
     manager->AddChoiceOption(name, matcher, kImageMatcherNames, help);
     return;
@@ -31,7 +31,8 @@ void AddMatcherOption(const std::string& name,
         *choose_matcher = text == "auto";
         if (!*choose_matcher) *matcher = ChoiceFromName(kImageMatcherNames, text, "--" + name);
       },
-      help + " | auto (exhaustive up to Import.max_exhaustive_stations, spatial beyond)");
+      "auto, exhaustive, sequential or spatial (" + help +
+          "; auto: exhaustive up to Import.max_exhaustive_stations, spatial beyond)");
 }
 
 }  // namespace
