@@ -380,10 +380,6 @@ std::string DatasetImportOptions::ImageName(const StationDataset& dataset, size_
   return name;
 }
 
-ImageMatcher ImageMatcherFromName(const std::string& name) {
-  return ChoiceFromName(kImageMatcherNames, name, "matcher");
-}
-
 const char* ImageMatcherName(ImageMatcher matcher) {
   return ChoiceName(kImageMatcherNames, matcher);
 }

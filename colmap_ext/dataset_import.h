@@ -35,8 +35,6 @@ inline constexpr NamedChoices<ImageMatcher, 3> kImageMatcherNames = {
     {{"exhaustive", ImageMatcher::kExhaustive},
      {"sequential", ImageMatcher::kSequential},
      {"spatial", ImageMatcher::kSpatial}}};
-// "exhaustive" | "sequential" | "spatial"; throws std::invalid_argument naming any other.
-ImageMatcher ImageMatcherFromName(const std::string& name);
 const char* ImageMatcherName(ImageMatcher matcher);
 
 struct DatasetImportOptions {
