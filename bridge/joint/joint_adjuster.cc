@@ -9,6 +9,7 @@
 #include "bridge/joint/lidar_point_to_plane_cost.h"
 #include "bridge/joint/start_departure.h"
 #include "bridge/joint/subspace_manifold.h"
+#include "bridge/joint/undetermined_parameters.h"
 #include "colmap_ext/depth_prior_cost.h"
 #include "colmap_ext/elapsed.h"
 #include "colmap_ext/logging.h"
@@ -466,7 +467,59 @@ std::unique_ptr<JointProblem> BuildProblem(const RunState& state,
   return joint;
 }
 
-SolveStats Solve(JointProblem* joint) {
+// Names of the joint problem's parameter blocks, for messages about them.
+std::map<const double*, std::string> ParameterNames(const RunState& state) {
+  std::map<const double*, std::string> names;
+  for (const auto& [image_id, image] : state.reconstruction->Images()) {
+    const colmap::Rigid3d& pose = image.CamFromWorld();
+    names[pose.rotation.coeffs().data()] = "image '" + image.Name() + "' rotation";
+    names[pose.translation.data()] = "image '" + image.Name() + "' translation";
+  }
+  for (const auto& [point3D_id, point3D] : state.reconstruction->Points3D()) {
+    names[point3D.xyz.data()] = "landmark " + std::to_string(point3D_id) + " (seen in " +
+                                std::to_string(point3D.track.Length()) + " images)";
+  }
+  names[state.ExtrinsicRotation()] = "cam_from_lidar rotation";
+  names[state.ExtrinsicTranslation()] = "cam_from_lidar translation";
+  names[state.time_offset.get()] = "the LiDAR clock offset";
+  names[state.lidar_free_angle.get()] = "E_l's free angle about the driving direction";
+  return names;
+}
+
+// Ceres marks a step invalid when its linear solver fails (a normal matrix that is not positive
+// definite) or the step cannot be evaluated; LM then retries with more damping. A failed step on a
+// problem that leaves parameters undetermined is an error naming them: the damping would only
+// move them by an amount nothing in the data decides.
+void StopIfUndetermined(const RunState& state, ceres::Problem* problem, int invalid_steps) {
+  const std::vector<std::string> undetermined =
+      UndeterminedParameters(problem, ParameterNames(state));
+  if (undetermined.empty()) {
+    std::cout << "WARNING: " << invalid_steps
+              << " steps of the solve failed (linear solver or evaluation); the problem's normal "
+                 "matrix is positive definite at its end"
+              << std::endl;
+    return;
+  }
+  std::ostringstream message;
+  message << "the joint problem's normal matrix is not positive definite (" << invalid_steps
+          << " failed steps): the data do not determine";
+  for (size_t k = 0; k < undetermined.size() && k < 10; ++k)
+    message << (k ? "; " : " ") << undetermined[k];
+  if (undetermined.size() > 10) message << "; and " << undetermined.size() - 10 << " more";
+  message << ". Hold what the data cannot see (--hold_rotation, --hold_translation) or give "
+             "rig.json's cam_from_lidar_guess a sigma";
+  throw std::runtime_error(message.str());
+}
+
+int NumInvalidSteps(const ceres::Solver::Summary& summary) {
+  int invalid = 0;
+  for (const ceres::IterationSummary& iteration : summary.iterations) {
+    if (!iteration.step_is_valid && iteration.iteration > 0) ++invalid;
+  }
+  return invalid;
+}
+
+SolveStats Solve(const RunState& state, JointProblem* joint) {
   ceres::Problem* problem = joint->problem.get();
   SolveStats stats;
   stats.reprojection.num_observations = joint->reprojection_ids.size();
@@ -490,6 +543,8 @@ SolveStats Solve(JointProblem* joint) {
   stats.residual_blocks = static_cast<size_t>(summary.num_residual_blocks);
   stats.residuals = static_cast<size_t>(summary.num_residuals);
   stats.termination = ceres::TerminationTypeToString(summary.termination_type);
+  stats.invalid_steps = NumInvalidSteps(summary);
+  if (stats.invalid_steps > 0) StopIfUndetermined(state, problem, stats.invalid_steps);
   return stats;
 }
 
@@ -723,7 +778,7 @@ void SolveWithOutliers(int round,
   for (int iteration = 0; iteration < state->options.max_outlier_iterations; ++iteration) {
     const auto start = std::chrono::steady_clock::now();
     std::unique_ptr<JointProblem> joint = BuildProblem(*state, *associations);
-    SolveStats stats = Solve(joint.get());
+    SolveStats stats = Solve(*state, joint.get());
     joint.reset();  // before the reconstruction changes under it
     stats.round = round + 1;
     stats.outlier_iteration = iteration + 1;

@@ -232,6 +232,9 @@ struct SolveStats {
   double seconds = 0;
   double seconds_per_iteration = 0;
   std::string termination;
+  // Steps Ceres rejected as invalid (a failed linear solve or evaluation); a solve with any on a
+  // problem that leaves parameters undetermined stops with an error naming them.
+  int invalid_steps = 0;
 };
 
 struct PerturbationCurve {

@@ -78,6 +78,7 @@ nlohmann::json SolvesJson(const std::vector<SolveStats>& stats) {
                         {"restored", solve.depth_outliers.restored}}},
                       {"iterations", solve.num_iterations},
                       {"termination", solve.termination},
+                      {"invalid_steps", solve.invalid_steps},
                       {"seconds", solve.seconds}});
   }
   return solves;
