@@ -2,6 +2,7 @@
 # Writes the coverage page of the reported cam_from_lidar uncertainty (Markdown, to stdout) from
 # benchmark_uncertainty.sh's results:
 #   uncertainty_table.py RESULTS_TSV VARIANT JOINT_OPTIONS
+# (environment START=truth: the runs started at the true cam_from_lidar)
 # A results line: scene, seed, the errors (rx ry rz [deg], tx ty tz [mm]), the sigmas and the z
 # (scripts/extrinsic_error.py); 'nan' z: the axis is undetermined (held at the start, no sigma).
 import datetime, math, os, sys
@@ -41,8 +42,11 @@ def print_header():
     print('Written by `scripts/benchmark_uncertainty.sh` on %s (%d cores), estimator variant `%s`%s.'
           % (datetime.date.today().isoformat(), os.cpu_count(), variant,
              ' (`%s`)' % joint_options.strip() if joint_options.strip() else ''))
+    start = ('the true cam_from_lidar (`START=truth`)' if os.environ.get('START') == 'truth'
+             else 'the pose initialiser\'s cam_from_lidar')
     print('Per family and seed the front end is made once; the joint adjuster then runs alone on '
-          'it with its default options.\n')
+          'it, %s, from %s.\n' % ('with the options above' if joint_options.strip()
+                                  else 'with its default options', start))
     for scene in sorted({r[0] for r in rows}):
         if scene in FAMILIES:
             print('- `%s`: %s.' % (scene, FAMILIES[scene][1]))
