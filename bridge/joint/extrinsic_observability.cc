@@ -1,5 +1,6 @@
 #include "bridge/joint/extrinsic_observability.h"
 
+#include "bridge/joint/problem_columns.h"
 #include "bridge/joint/subspace_manifold.h"
 #include "colmap_ext/logging.h"
 
@@ -297,15 +298,7 @@ JacobianRows EvaluateRows(
   problem->Evaluate(evaluate_options, &cost, &rows.residuals, nullptr, &crs);
   THROW_CHECK_EQ(static_cast<size_t>(crs.num_rows), rows.cluster.size());
   THROW_CHECK_EQ(crs.num_cols, layout.num_other + static_cast<int>(layout.directions.cols()));
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(crs.values.size());
-  for (int row = 0; row < crs.num_rows; ++row) {
-    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) {
-      triplets.emplace_back(row, crs.cols[k], crs.values[k]);
-    }
-  }
-  rows.jacobian.resize(crs.num_rows, crs.num_cols);
-  rows.jacobian.setFromTriplets(triplets.begin(), triplets.end());
+  rows.jacobian = SparseJacobian(crs);
   return rows;
 }
 

@@ -1,9 +1,9 @@
 #include "bridge/joint/undetermined_parameters.h"
 
+#include "bridge/joint/problem_columns.h"
+
 #include <Eigen/SparseCholesky>
 #include <ceres/crs_matrix.h>
-
-#include <sstream>
 
 namespace colmap_lidar {
 
@@ -34,24 +34,14 @@ std::vector<int> DependentColumns(const Eigen::SparseMatrix<double>& normal_matr
 
 namespace {
 
-// JᵀJ of `problem` over `blocks` (their tangent coordinates, in that order).
-Eigen::SparseMatrix<double> NormalMatrix(ceres::Problem* problem,
-                                         const std::vector<double*>& blocks) {
+// JᵀJ of `problem` over the tangent coordinates of `columns`.
+Eigen::SparseMatrix<double> NormalMatrix(ceres::Problem* problem, const ProblemColumns& columns) {
   ceres::Problem::EvaluateOptions options;
-  options.parameter_blocks = blocks;
-  options.apply_loss_function = true;
+  options.parameter_blocks = columns.blocks;
   double cost = 0;
   ceres::CRSMatrix crs;
   problem->Evaluate(options, &cost, nullptr, nullptr, &crs);
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(crs.values.size());
-  for (int row = 0; row < crs.num_rows; ++row) {
-    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) {
-      triplets.emplace_back(row, crs.cols[k], crs.values[k]);
-    }
-  }
-  Eigen::SparseMatrix<double> jacobian(crs.num_rows, crs.num_cols);
-  jacobian.setFromTriplets(triplets.begin(), triplets.end());
+  const Eigen::SparseMatrix<double> jacobian = SparseJacobian(crs);
   return (jacobian.transpose() * jacobian).pruned();
 }
 
@@ -66,29 +56,21 @@ std::string BlockName(const std::map<const double*, std::string>& names,
 
 std::vector<std::string> UndeterminedParameters(ceres::Problem* problem,
                                                 const std::map<const double*, std::string>& names) {
-  std::vector<double*> all_blocks;
-  problem->GetParameterBlocks(&all_blocks);
-  std::vector<double*> blocks;
-  std::vector<int> first_column;
-  int num_columns = 0;
-  for (double* block : all_blocks) {
-    if (problem->IsParameterBlockConstant(block)) continue;
-    blocks.push_back(block);
-    first_column.push_back(num_columns);
-    num_columns += problem->ParameterBlockTangentSize(block);
+  const ProblemColumns columns = FreeColumns(problem);
+  if (columns.blocks.empty()) return {};
+  const std::vector<int> dependent = DependentColumns(NormalMatrix(problem, columns));
+  // Per block, its dependent tangent coordinates (`dependent` is ascending).
+  std::map<int, std::string> coordinates;
+  for (const int column : dependent) {
+    const int block = columns.block_of_column[column];
+    std::string& list = coordinates[block];
+    list += (list.empty() ? "" : ", ") + std::to_string(column - columns.first_column[block]);
   }
-  const std::vector<int> dependent = DependentColumns(NormalMatrix(problem, blocks));
   std::vector<std::string> undetermined;
-  size_t next = 0;
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    const int size = problem->ParameterBlockTangentSize(blocks[b]);
-    std::ostringstream coordinates;
-    for (; next < dependent.size() && dependent[next] < first_column[b] + size; ++next) {
-      coordinates << (coordinates.tellp() > 0 ? ", " : "") << dependent[next] - first_column[b];
-    }
-    if (coordinates.tellp() == 0) continue;
-    undetermined.push_back(BlockName(names, blocks[b], b) + " (tangent coordinates " +
-                           coordinates.str() + " of " + std::to_string(size) + ")");
+  for (const auto& [block, list] : coordinates) {
+    undetermined.push_back(BlockName(names, columns.blocks[block], block) +
+                           " (tangent coordinates " + list + " of " +
+                           std::to_string(columns.size[block]) + ")");
   }
   return undetermined;
 }

@@ -1,5 +1,7 @@
 #include "bridge/joint/variance_components.h"
 
+#include "bridge/joint/problem_columns.h"
+
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <ceres/cost_function.h>
@@ -10,31 +12,6 @@
 namespace colmap_lidar {
 namespace {
 
-// The free parameter blocks of the problem and, per Jacobian column, its block.
-struct Columns {
-  std::vector<double*> blocks;
-  std::vector<int> block_of_column;
-  std::vector<int> first_column;  // per block
-  std::vector<int> size;          // per block (tangent size)
-};
-
-Columns FreeColumns(ceres::Problem* problem) {
-  Columns columns;
-  std::vector<double*> blocks;
-  problem->GetParameterBlocks(&blocks);
-  for (double* block : blocks) {
-    if (problem->IsParameterBlockConstant(block)) continue;
-    const int size = problem->ParameterBlockTangentSize(block);
-    if (size == 0) continue;
-    columns.first_column.push_back(static_cast<int>(columns.block_of_column.size()));
-    columns.size.push_back(size);
-    columns.block_of_column.insert(
-        columns.block_of_column.end(), size, static_cast<int>(columns.blocks.size()));
-    columns.blocks.push_back(block);
-  }
-  return columns;
-}
-
 // Per parameter block and group (the last index: the fixed blocks), the diagonal block of J_g^T J_g.
 using BlockInformation = std::vector<std::vector<Eigen::MatrixXd>>;
 
@@ -42,7 +19,7 @@ using BlockInformation = std::vector<std::vector<Eigen::MatrixXd>>;
 void AddRow(const ceres::CRSMatrix& jacobian,
             int row,
             int group,
-            const Columns& columns,
+            const ProblemColumns& columns,
             BlockInformation* information) {
   const int begin = jacobian.rows[row], end = jacobian.rows[row + 1];
   for (int a = begin; a < end; ++a) {
@@ -91,7 +68,7 @@ std::vector<VarianceComponent> EstimateVarianceComponents(
     ceres::Problem* problem,
     const std::vector<VarianceGroup>& groups,
     const std::vector<ceres::ResidualBlockId>& fixed) {
-  const Columns columns = FreeColumns(problem);
+  const ProblemColumns columns = FreeColumns(problem);
   std::vector<ceres::ResidualBlockId> blocks;
   std::vector<int> row_group;
   const auto add = [&](const std::vector<ceres::ResidualBlockId>& ids, int group) {
