@@ -35,7 +35,10 @@ colmap::Rigid3d CamFromWorld(const Eigen::Matrix3d& world_from_cam, const Eigen:
 
 }  // namespace
 
-bool IsDrive(Motion motion) { return motion == Motion::kDrive || motion == Motion::kDriveReturn; }
+bool IsDrive(Motion motion) {
+  return motion == Motion::kDrive || motion == Motion::kDriveReturn ||
+         motion == Motion::kStraightDrive;
+}
 
 namespace {
 
@@ -177,11 +180,12 @@ std::vector<colmap::Rigid3d> ReturnDriveStations(int num_stations, std::mt19937_
   return stations;
 }
 
-// 0.5-1 m per frame; a lane change (1.6 m over ~25 m) and a swerve, heading along the path.
-std::vector<colmap::Rigid3d> DriveStations(int num_stations, std::mt19937_64* rng) {
+// 0.5-1 m per frame, heading along the path y = lateral(x); with `turns` a lane change (1.6 m over
+// ~25 m) and a swerve, without them the right lane's centre.
+std::vector<colmap::Rigid3d> DriveStations(int num_stations, bool turns, std::mt19937_64* rng) {
   std::uniform_real_distribution<double> unit(0, 1);
-  auto lateral = [](double x) {
-    return 1.6 / (1 + std::exp(-(x - 20) / 4)) - 1.8 + 0.4 * std::sin(x / 9);
+  auto lateral = [turns](double x) {
+    return turns ? 1.6 / (1 + std::exp(-(x - 20) / 4)) - 1.8 + 0.4 * std::sin(x / 9) : -1.8;
   };
   std::vector<colmap::Rigid3d> stations;
   double x = 0;
@@ -229,7 +233,10 @@ std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
   std::vector<colmap::Rigid3d> stations;
 
   if (motion == Motion::kDriveReturn) return ReturnDriveStations(num_stations, &rng);
-  if (motion == Motion::kDrive) return DriveStations(num_stations, &rng);
+  if (motion == Motion::kDrive) return DriveStations(num_stations, /*turns=*/true, &rng);
+  if (motion == Motion::kStraightDrive) {
+    return DriveStations(num_stations, /*turns=*/false, &rng);
+  }
   if (motion == Motion::kFixedRotation) {
     return FixedRotationStations(scene, num_stations, ring_pitch, &rng);
   }

@@ -24,13 +24,17 @@ enum class Motion {
   // a car driving along world x in the right lane, 1-1.5 m per frame, slowing for a U-turn at the
   // far end and returning in the other lane: it passes every place of its way out again (revisits)
   kDriveReturn,
+  // a car driving along world x in one lane without turning, 0.5-1 m per frame: the relative
+  // rotations are zero, so a hand-eye calibration has nothing to work with
+  kStraightDrive,
 };
-inline constexpr NamedChoices<Motion, 5> kMotionNames = {
+inline constexpr NamedChoices<Motion, 6> kMotionNames = {
     {{"two_axes", Motion::kTwoAxes},
      {"one_axis", Motion::kOneAxis},
      {"fixed_rotation", Motion::kFixedRotation},
      {"drive", Motion::kDrive},
-     {"drive_return", Motion::kDriveReturn}}};
+     {"drive_return", Motion::kDriveReturn},
+     {"straight_drive", Motion::kStraightDrive}}};
 // The motions of a car (frames of one sweep each, in the street).
 bool IsDrive(Motion motion);
 
@@ -57,7 +61,7 @@ colmap::Rigid3d CamLookingAt(const Eigen::Vector3d& eye,
                              double roll_deg);
 
 // cam_from_world of the left camera of each station, 2-3 m from the structure and looking at it; for
-// kDrive and kDriveReturn, of the forward camera at 1.65 m above the street at each frame's
+// the drives (IsDrive), of the forward camera at 1.65 m above the street at each frame's
 // mid-sweep time.
 std::vector<colmap::Rigid3d> MakeStations(const Scene& scene,
                                           int num_stations,

@@ -355,5 +355,31 @@ TEST(SimulatorTest, DriveSweepsAgreeWithTheImagesAtTheirFiringInstant) {
   EXPECT_GT(max_displacement, 0.2 * travel);
 }
 
+// A straight drive never turns: every frame has the same orientation, the camera centres advance
+// along world x by 0.5-1 m at one height and lateral offset. The drive with turns is the control.
+TEST(SimulatorTest, StraightDriveHasNoRelativeRotation) {
+  const sim::Scene scene = sim::Scene::Create("street");
+  const auto max_turn_deg = [&](sim::Motion motion) {
+    const std::vector<colmap::Rigid3d> frames = sim::MakeStations(scene, 40, motion, 7);
+    double turn = 0;
+    for (const colmap::Rigid3d& frame : frames) {
+      turn = std::max(turn, frame.rotation.angularDistance(frames.front().rotation) * 180 / M_PI);
+    }
+    return turn;
+  };
+  EXPECT_LT(max_turn_deg(sim::Motion::kStraightDrive), 1e-9);
+  EXPECT_GT(max_turn_deg(sim::Motion::kDrive), 1.0);
+  const std::vector<colmap::Rigid3d> frames =
+      sim::MakeStations(scene, 40, sim::Motion::kStraightDrive, 7);
+  for (size_t i = 1; i < frames.size(); ++i) {
+    const Eigen::Vector3d step =
+        colmap::Inverse(frames[i]).translation - colmap::Inverse(frames[i - 1]).translation;
+    EXPECT_NEAR(step.y(), 0, 1e-9);
+    EXPECT_NEAR(step.z(), 0, 1e-9);
+    EXPECT_GE(step.x(), 0.5);
+    EXPECT_LE(step.x(), 1.0);
+  }
+}
+
 }  // namespace
 }  // namespace colmap_lidar
