@@ -993,11 +993,26 @@ std::array<double, 2> ExtrinsicChange(const colmap::Rigid3d& before, const colma
           1000 * (before.translation - after.translation).norm()};
 }
 
-// Whether the last round still moved T_e (so that another round at the final gate is due).
-// The state's free LiDAR rotation, variance factors and clock offset into `summary`, printed.
+// E_m's final associations by the camera axis their surface faces into `summary`, printed.
+void RecordLandmarkFacing(const RunState& state,
+                          const Associations& associations,
+                          JointAdjustmentSummary* summary) {
+  if (!state.use_landmark_lidar) return;
+  summary->landmark_lidar_facing =
+      SummariseByFacingAxis(associations.landmarks, *state.reconstruction, *state.cam_from_lidar);
+  const auto& facing = summary->landmark_lidar_facing;
+  std::cout << "E_m observations by the camera axis their surface faces: x "
+            << facing[0].num_observations << ", y " << facing[1].num_observations << ", z "
+            << facing[2].num_observations << std::endl;
+}
+
+// The state's free LiDAR rotation, variance factors, clock offset and E_m's surfaces into `summary`,
+// printed.
 void RecordFinalState(const RunState& state,
                       const JointProblemData& data,
+                      const Associations& associations,
                       JointAdjustmentSummary* summary) {
+  RecordLandmarkFacing(state, associations, summary);
   if (state.LidarHasFreeAxis()) {
     summary->lidar_free_axis_in_cam = state.lidar_free_axis;
     summary->lidar_free_angle_deg = *state.lidar_free_angle * 180 / M_PI;
@@ -1012,6 +1027,7 @@ void RecordFinalState(const RunState& state,
   }
 }
 
+// Whether the last round still moved T_e (so that another round at the final gate is due).
 bool RoundMovedExtrinsic(const JointAdjusterOptions& options,
                          const JointAdjustmentSummary& summary) {
   if (summary.extrinsic_change_per_round.empty()) return false;
@@ -1134,7 +1150,7 @@ JointAdjustmentSummary JointAdjuster::RunOnce(const JointProblemData& data,
   // state: the last solve's problem may hold residuals of observations (even landmarks) removed after
   // it.
   summary.motion = AnalyseMotion(*reconstruction, options_.observability);
-  RecordFinalState(state, data, &summary);
+  RecordFinalState(state, data, associations, &summary);
   const std::unique_ptr<JointProblem> final_problem = BuildProblem(state, associations);
   summary.final_reprojection_residuals = final_problem->reprojection_ids.size();
   summary.final_depth_residuals = final_problem->depth_ids.size();

@@ -30,6 +30,7 @@
 #pragma once
 
 #include "bridge/joint/extrinsic_observability.h"
+#include "bridge/joint/landmark_lidar_term.h"
 #include "bridge/joint/variance_components.h"
 #include "colmap_ext/extension_database.h"
 #include "lidar/point_to_plane_association.h"
@@ -275,6 +276,8 @@ struct JointAdjustmentSummary {
   // With estimate_time_offset: the LiDAR clock's offset from the cameras' [s, or frames without
   // image times].
   std::optional<double> time_offset;
+  // E_m's final associations by the camera axis their surface faces (x, y, z).
+  std::array<LandmarkPlaneFacing, 3> landmark_lidar_facing;
   std::vector<VarianceComponent> variance_components;
 };
 

@@ -61,4 +61,29 @@ double LandmarkPlaneDistance(const LandmarkPlaneObservation& observation,
   return observation.normal_in_lidar.dot(landmark_in_lidar - observation.point_in_lidar);
 }
 
+std::array<LandmarkPlaneFacing, 3> SummariseByFacingAxis(
+    const std::vector<LandmarkPlaneObservation>& observations,
+    const colmap::Reconstruction& reconstruction,
+    const colmap::Rigid3d& cam_from_lidar) {
+  std::array<LandmarkPlaneFacing, 3> facing;
+  std::array<double, 3> sum = {0, 0, 0}, squares = {0, 0, 0};
+  for (const LandmarkPlaneObservation& observation : observations) {
+    if (observation.outlier) continue;
+    const double residual = LandmarkPlaneDistance(observation, reconstruction, cam_from_lidar);
+    if (!std::isfinite(residual)) continue;
+    int axis = 0;
+    (cam_from_lidar.rotation * observation.normal_in_lidar).cwiseAbs().maxCoeff(&axis);
+    ++facing[axis].num_observations;
+    sum[axis] += residual;
+    squares[axis] += residual * residual;
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    const double n = static_cast<double>(facing[axis].num_observations);
+    if (n == 0) continue;
+    facing[axis].mean_residual_m = sum[axis] / n;
+    facing[axis].rms_residual_m = std::sqrt(squares[axis] / n);
+  }
+  return facing;
+}
+
 }  // namespace colmap_lidar

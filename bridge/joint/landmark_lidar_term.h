@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <map>
 #include <vector>
 
@@ -39,5 +40,19 @@ std::vector<LandmarkPlaneObservation> AssociateLandmarksWithLidar(
 double LandmarkPlaneDistance(const LandmarkPlaneObservation& observation,
                              const colmap::Reconstruction& reconstruction,
                              const colmap::Rigid3d& cam_from_lidar);
+
+// E_m's associations in force by the camera axis their surface faces (the largest component of the
+// normal in the camera frame): a translation of cam_from_lidar along a camera axis changes only the
+// residuals of surfaces facing that axis, so on a drive the vertical translation rests on the ground
+// (axis y). Signed residuals are positive in front of the LiDAR surface (normals face the sensor).
+struct LandmarkPlaneFacing {
+  size_t num_observations = 0;
+  double mean_residual_m = 0;
+  double rms_residual_m = 0;
+};
+std::array<LandmarkPlaneFacing, 3> SummariseByFacingAxis(
+    const std::vector<LandmarkPlaneObservation>& observations,
+    const colmap::Reconstruction& reconstruction,
+    const colmap::Rigid3d& cam_from_lidar);
 
 }  // namespace colmap_lidar

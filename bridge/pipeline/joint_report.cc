@@ -189,6 +189,18 @@ nlohmann::json VarianceComponentsJson(const JointAdjusterOptions& options,
   return json;
 }
 
+// E_m's associations per camera axis their surface faces, in mm.
+nlohmann::json LandmarkFacingJson(const std::array<LandmarkPlaneFacing, 3>& facing) {
+  nlohmann::json json;
+  const char* const axes[3] = {"x", "y", "z"};
+  for (int axis = 0; axis < 3; ++axis) {
+    json[axes[axis]] = {{"observations", facing[axis].num_observations},
+                        {"mean_residual_mm", 1000 * facing[axis].mean_residual_m},
+                        {"rms_residual_mm", 1000 * facing[axis].rms_residual_m}};
+  }
+  return json;
+}
+
 nlohmann::json MotionJson(const MotionAnalysis& motion) {
   return {{"stations", motion.num_stations},
           {"rotating_pairs", motion.num_rotating_pairs},
@@ -267,6 +279,9 @@ void WriteJointReport(const std::string& directory,
                              {"lidar_residuals", summary.final_lidar_residuals},
                              {"landmark_lidar_residuals", summary.final_landmark_lidar_residuals}};
   report["landmark_lidar_weight"] = options.landmark_lidar_weight;
+  if (options.landmark_lidar_weight > 0) {
+    report["landmark_lidar_facing"] = LandmarkFacingJson(summary.landmark_lidar_facing);
+  }
   report["variance_components"] = VarianceComponentsJson(options, summary);
   if (summary.time_offset) {
     report["time_offset"] = {{"lidar_minus_camera", *summary.time_offset},
