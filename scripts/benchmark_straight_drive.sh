@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# A drive that never turns (simulate_dataset --motion straight_drive): whether the pipeline
+# initialises cam_from_lidar without a guess, and whether from a guess GUESS_DEG (default 2) /
+# GUESS_M (default 0.05) off it ends no farther from the truth than the guess on every axis, with its
+# errors within 3 reported sigmas on the axes it determines. Mono and stereo, SEEDS seeds each
+# (default 3), DRIVE_FRAMES frames (default 40) of 120000 rays. Per run and camera axis: the start's
+# error, the result's error, its sigma and z; "undet." = held at the start and reported without a
+# sigma. Writes docs/benchmarks/straight_drive.md (DOC to write another page).
+#   WORK_DIR  keep the runs there (datasets and workspaces already there are not made again)
+#   BUILD_DIR (default build); CLI: another colmap-lidar executable instead of building one
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh >/dev/null
+source scripts/configure.sh
+readonly kBuild="${BUILD_DIR:-build}"
+if [ -z "${CLI:-}" ]; then build_cli "$kBuild"; fi
+cli="${CLI:-$PWD/$kBuild/bin/colmap-lidar}"
+use_work_dir
+results="$work/results.tsv"
+: > "$results"
+
+# run RIG SEED GUESS (0|1): simulation and the pipeline into $work/RIG-SEED-guessGUESS; appends the
+# start's and the result's errors to the results.
+run() {
+  local rig=$1 seed=$2 guess=$3
+  local dir="$work/$rig-$seed-guess$guess" mono=1
+  [ "$rig" = stereo ] && mono=0
+  echo "[$rig $seed, guess $guess] simulation and pipeline ..."
+  [ -d "$dir/dataset" ] || "$cli" simulate_dataset --scene street --motion straight_drive \
+    --mono "$mono" --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 \
+    --write_guess "$guess" --guess_rotation_deg "${GUESS_DEG:-2}" \
+    --guess_translation_m "${GUESS_M:-0.05}" --output_path "$dir/dataset" > "$dir.log" 2>&1
+  if [ ! -f "$dir/ws/sparse/joint/cam_from_lidar.txt" ] &&
+      ! "$cli" pipeline --dataset_path "$dir/dataset" --workspace_path "$dir/ws" \
+        --Import.matcher sequential >> "$dir.log" 2>&1; then
+    printf '%s\t%s\t%s\tFAILED\t%s\n' "$rig" "$seed" "$guess" \
+      "$(grep -m1 -i 'error' "$dir.log" | tr '\t' ' ')" >> "$results"
+    tail -1 "$results"
+    return 0
+  fi
+  local truth="$dir/dataset/ground_truth/cam_from_lidar.txt" start="$dir/ws/sparse/initial/cam_from_lidar.txt"
+  [ "$guess" = 1 ] && start="$dir/dataset/rig.json"
+  {
+    printf '%s\t%s\t%s\tstart\t' "$rig" "$seed" "$guess"
+    python3 scripts/extrinsic_error.py "$truth" "$start" ''
+    printf '%s\t%s\t%s\tresult\t' "$rig" "$seed" "$guess"
+    python3 scripts/extrinsic_error.py "$truth" "$dir/ws/sparse/joint/cam_from_lidar.txt" \
+      "$dir/ws/sparse/joint/report.json"
+  } >> "$results"
+  tail -1 "$results"
+}
+
+for rig in mono stereo; do
+  for seed in $(seq 1 "${SEEDS:-3}"); do
+    for guess in 0 1; do
+      mkdir -p "$work"
+      run "$rig" "$seed" "$guess"
+    done
+  done
+done
+mkdir -p docs/benchmarks
+readonly kDoc="${DOC:-docs/benchmarks/straight_drive.md}"
+python3 scripts/straight_drive_table.py "$results" "${GUESS_DEG:-2}" "${GUESS_M:-0.05}" > "$kDoc"
+cat "$kDoc"
