@@ -30,9 +30,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
 source scripts/configure.sh
-readonly kBuild="${BUILD_DIR:-build}"
-if [ -z "${CLI:-}" ]; then build_cli "$kBuild"; fi
-cli="${CLI:-$PWD/$kBuild/bin/colmap-lidar}"
+use_cli
 readonly kSample="$PWD/../shared/data/kitti_odometry_04_sample"
 readonly kVariant="${VARIANT:-default}"
 use_work_dir

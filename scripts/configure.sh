@@ -15,6 +15,13 @@ build_cli() {
   configure_build "$1"
   cmake --build "$1" --target colmap_lidar_cli >/dev/null
 }
+# Sets `cli` to $CLI (another colmap-lidar executable, e.g. a variant built elsewhere) or else to
+# the executable built in $BUILD_DIR (default build).
+use_cli() {
+  local build="${BUILD_DIR:-build}"
+  if [ -z "${CLI:-}" ]; then build_cli "$build"; fi
+  cli="${CLI:-$PWD/$build/bin/colmap-lidar}"
+}
 # Sets `work` to $WORK_DIR (created, kept) or else to a temporary folder removed on exit.
 use_work_dir() {
   if [ -n "${WORK_DIR:-}" ]; then
