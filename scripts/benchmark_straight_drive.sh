@@ -51,7 +51,6 @@ run() {
 for rig in mono stereo; do
   for seed in $(seq 1 "${SEEDS:-3}"); do
     for guess in 0 1; do
-      mkdir -p "$work"
       run "$rig" "$seed" "$guess"
     done
   done
