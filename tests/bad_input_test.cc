@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <sqlite3.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -18,6 +19,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -365,11 +367,28 @@ TEST(WorkspaceLockTest, ASecondPipelineOnTheWorkspaceIsRefused) {
 
 // True while another connection holds the write lock on `database` (sqlite3 without a busy timeout
 // fails at once to begin a write transaction then).
-bool WriteLocked(const std::string& database) {
-  return RunCommand("sqlite3 " + database + " 'BEGIN IMMEDIATE; ROLLBACK;'").exit_code != 0;
-}
+// An exclusive transaction held by this test process on its own SQLite connection: the command
+// under test runs as another process and meets the lock as it would meet another program's.
+class ExclusiveTransaction {
+ public:
+  explicit ExclusiveTransaction(const std::string& database) {
+    if (sqlite3_open_v2(database.c_str(), &connection_, SQLITE_OPEN_READWRITE, nullptr) ==
+        SQLITE_OK) {
+      held_ = sqlite3_exec(connection_, "BEGIN EXCLUSIVE;", nullptr, nullptr, nullptr) == SQLITE_OK;
+    }
+  }
+  ~ExclusiveTransaction() {
+    if (held_) sqlite3_exec(connection_, "ROLLBACK;", nullptr, nullptr, nullptr);
+    sqlite3_close(connection_);
+  }
+  bool held() const { return held_; }
 
-// A database that another program is writing to (sqlite3 holding an exclusive transaction open):
+ private:
+  sqlite3* connection_ = nullptr;
+  bool held_ = false;
+};
+
+// A database that another program is writing to (an exclusive transaction held open):
 // import_dataset waits 5 s for the lock, then gives one error naming the database; the database
 // keeps its bytes and no partial copy is left beside it.
 TEST(LockedDatabaseTest, ImportIntoADatabaseAnotherProgramWritesIsRefused) {
@@ -381,14 +400,8 @@ TEST(LockedDatabaseTest, ImportIntoADatabaseAnotherProgramWritesIsRefused) {
   const testing::CommandResult first = RunCommand(import);
   ASSERT_EQ(first.exit_code, 0) << first.output;
   const std::string before = ReadBytes(database);
-  ASSERT_EQ(std::system(("(echo 'BEGIN EXCLUSIVE;'; sleep 15) | sqlite3 " + database +
-                         " > /dev/null 2>&1 &")
-                            .c_str()),
-            0);
-  for (int i = 0; i < 100 && !WriteLocked(database); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  ASSERT_TRUE(WriteLocked(database)) << "sqlite3 did not take the lock";
+  auto lock = std::make_unique<ExclusiveTransaction>(database);
+  ASSERT_TRUE(lock->held()) << "could not begin an exclusive transaction on " << database;
   const testing::CommandResult result = RunCommand(import);
   EXPECT_NE(result.exit_code, -1) << "killed by a signal:\n" << result.output;
   EXPECT_NE(result.exit_code, 0) << result.output;
@@ -396,9 +409,7 @@ TEST(LockedDatabaseTest, ImportIntoADatabaseAnotherProgramWritesIsRefused) {
   ASSERT_EQ(errors.size(), 1u) << result.output;
   EXPECT_NE(errors[0].find(database), std::string::npos) << errors[0];
   EXPECT_NE(errors[0].find("locked"), std::string::npos) << errors[0];
-  for (int i = 0; i < 300 && WriteLocked(database); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  lock.reset();
   EXPECT_EQ(ReadBytes(database), before) << "the locked database changed";
   for (const auto& entry : fs::directory_iterator(dir.Path())) {
     EXPECT_EQ(entry.path().filename().string().find("partial"), std::string::npos)
