@@ -365,8 +365,6 @@ TEST(WorkspaceLockTest, ASecondPipelineOnTheWorkspaceIsRefused) {
   EXPECT_EQ(rerun.output.find("in use by another pipeline"), std::string::npos) << rerun.output;
 }
 
-// True while another connection holds the write lock on `database` (sqlite3 without a busy timeout
-// fails at once to begin a write transaction then).
 // An exclusive transaction held by this test process on its own SQLite connection: the command
 // under test runs as another process and meets the lock as it would meet another program's.
 class ExclusiveTransaction {
