@@ -34,6 +34,9 @@ int RunSimulateDataset(int argc, char** argv) {
   manager.AddDefaultOption("range_noise_m", &options.range_noise_m);
   manager.AddDefaultOption("pixel_noise", &options.pixel_noise, "grey levels");
   manager.AddDefaultOption("vignetting", &options.vignetting);
+  manager.AddDefaultOption("pixel_samples",
+                           &options.pixel_samples,
+                           "rays per pixel along each axis (N x N jittered over the pixel's area)");
   manager.AddDefaultOption("mixed_edge_points", &options.mixed_edge_points);
   manager.AddDefaultOption("guess_rotation_deg", &options.guess_rotation_deg);
   manager.AddDefaultOption("guess_translation_m", &options.guess_translation_m);

@@ -8,6 +8,22 @@
 namespace colmap_lidar {
 namespace sim {
 
+namespace {
+
+// Grey value of the scene along the ray through `image_point` (0 for the sky), and its hit distance.
+double RayRadiance(const Scene& scene,
+                   const colmap::Camera& camera,
+                   const colmap::Rigid3d& world_from_cam,
+                   const Eigen::Vector2d& image_point,
+                   RayHit* hit) {
+  const Eigen::Vector3d ray = camera.CamFromImg(image_point).homogeneous();
+  const Eigen::Vector3d direction = (world_from_cam.rotation * ray).normalized();
+  if (!scene.Intersect(world_from_cam.translation, direction, 1e3, hit)) return 0;
+  return scene.Shade(world_from_cam.translation + hit->t * direction, hit->normal, hit->primitive);
+}
+
+}  // namespace
+
 cv::Mat RenderImage(const Scene& scene,
                     const colmap::Camera& camera,
                     const colmap::Rigid3d& cam_from_world,
@@ -15,29 +31,35 @@ cv::Mat RenderImage(const Scene& scene,
                     cv::Mat* depth) {
   const int width = static_cast<int>(camera.width);
   const int height = static_cast<int>(camera.height);
+  const int n = options.samples_per_axis;
   cv::Mat image(height, width, CV_8UC1);
   if (depth) depth->create(height, width, CV_32F);
   const colmap::Rigid3d world_from_cam = colmap::Inverse(cam_from_world);
-  const Eigen::Matrix3d world_from_cam_rotation = world_from_cam.rotation.toRotationMatrix();
-  const Eigen::Vector3d& origin = world_from_cam.translation;
 #pragma omp parallel for schedule(dynamic, 8)
   for (int row = 0; row < height; ++row) {
     std::mt19937_64 rng(options.seed * 1000003ull + row);
     std::normal_distribution<double> noise(0, options.pixel_noise);
+    std::uniform_real_distribution<double> jitter(0, 1);
     for (int col = 0; col < width; ++col) {
-      const Eigen::Vector2d ray_in_cam = camera.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5));
-      const Eigen::Vector3d ray = ray_in_cam.homogeneous();
-      const Eigen::Vector3d direction = (world_from_cam_rotation * ray).normalized();
+      const Eigen::Vector2d centre(col + 0.5, row + 0.5);
       RayHit hit;
-      double value = 0;  // sky: black
-      float z = 0;
-      if (scene.Intersect(origin, direction, 1e3, &hit)) {
-        const Eigen::Vector3d point = origin + hit.t * direction;
-        value = scene.Shade(point, hit.normal, hit.primitive);
-        z = static_cast<float>(hit.t / ray.norm());  // z-depth along the optical axis
+      double value = RayRadiance(scene, camera, world_from_cam, centre, &hit);
+      const float z =
+          hit.primitive >= 0  // z-depth along the optical axis
+              ? static_cast<float>(hit.t / camera.CamFromImg(centre).homogeneous().norm())
+              : 0.f;
+      if (n > 1) {  // the pixel's area: n x n jittered strata, their mean
+        value = 0;
+        for (int k = 0; k < n * n; ++k) {
+          const Eigen::Vector2d offset((k % n + jitter(rng)) / n, (k / n + jitter(rng)) / n);
+          RayHit sample;
+          value += RayRadiance(
+                       scene, camera, world_from_cam, Eigen::Vector2d(col, row) + offset, &sample) /
+                   (n * n);
+        }
       }
       if (options.vignetting) {
-        value *= std::pow(1.0 / ray.norm(), 4);
+        value *= std::pow(1.0 / camera.CamFromImg(centre).homogeneous().norm(), 4);
       }
       if (options.pixel_noise > 0) value += noise(rng);
       image.at<uint8_t>(row, col) = static_cast<uint8_t>(std::clamp(std::lround(value), 0l, 255l));

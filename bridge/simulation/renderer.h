@@ -19,6 +19,11 @@ struct ImageOptions {
   double pixel_noise = 1.0;
   // cos^4 fall-off
   bool vignetting = false;
+  // A pixel integrates light over its area: the mean of samples_per_axis^2 rays jittered in as many
+  // strata of the pixel (1: one ray through its centre). One ray aliases texture finer than the
+  // pixel's footprint, which on a surface seen at a grazing angle (a road ahead) is several
+  // centimetres long; aliased texture moves unlike the surface, and keypoints on it are biased.
+  int samples_per_axis = 1;
   uint64_t seed = 0;
 };
 

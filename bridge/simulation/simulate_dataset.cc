@@ -76,6 +76,7 @@ bool SimulationOptions::Check() const {
   CHECK_OPTION_GE(lidar_points, 1000);
   CHECK_OPTION_GE(range_noise_m, 0);
   CHECK_OPTION_GE(pixel_noise, 0);
+  CHECK_OPTION_GE(pixel_samples, 1);
   CHECK_OPTION_GE(guess_rotation_deg, 0);
   CHECK_OPTION_GE(guess_translation_m, 0);
   CHECK_OPTION_GT(surface_spacing_m, 1e-4);
@@ -129,6 +130,7 @@ void RenderStationImages(const SimulationOptions& options,
   ImageOptions image_options;
   image_options.pixel_noise = options.pixel_noise;
   image_options.vignetting = options.vignetting;
+  image_options.samples_per_axis = options.pixel_samples;
   image_options.seed = options.seed * 1000 + 2 * i;
   cv::Mat depth;
   WriteImage((partial / "images/left" / (name + ".png")).string(),

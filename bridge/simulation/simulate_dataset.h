@@ -39,6 +39,8 @@ struct SimulationOptions {
   // grey levels
   double pixel_noise = 1.0;
   bool vignetting = false;
+  // rays per pixel along each image axis (ImageOptions::samples_per_axis)
+  int pixel_samples = 1;
   bool mixed_edge_points = false;
   // cam_from_lidar_guess = truth perturbed by this much
   double guess_rotation_deg = 3.0;
