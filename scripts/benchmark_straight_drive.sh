@@ -6,6 +6,8 @@
 # (default 3), DRIVE_FRAMES frames (default 40) of 120000 rays. Per run and camera axis: the start's
 # error, the result's error, its sigma and z; "undet." = held at the start and reported without a
 # sigma. Writes docs/benchmarks/straight_drive.md (DOC to write another page).
+#   PIXEL_SAMPLES  rays per pixel axis of the images (simulate_dataset --pixel_samples; default 4:
+#             one ray aliases the road ahead of the car)
 #   WORK_DIR  keep the runs there (datasets and workspaces already there are not made again)
 #   BUILD_DIR (default build); CLI: another colmap-lidar executable instead of building one
 set -euo pipefail
@@ -14,6 +16,7 @@ bash scripts/setup.sh >/dev/null
 source scripts/configure.sh
 use_cli
 use_work_dir
+readonly kPixelSamples="${PIXEL_SAMPLES:-4}"
 results="$work/results.tsv"
 : > "$results"
 
@@ -27,7 +30,8 @@ run() {
   [ -d "$dir/dataset" ] || "$cli" simulate_dataset --scene street --motion straight_drive \
     --mono "$mono" --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 \
     --write_guess "$guess" --guess_rotation_deg "${GUESS_DEG:-2}" \
-    --guess_translation_m "${GUESS_M:-0.05}" --output_path "$dir/dataset" > "$dir.log" 2>&1
+    --guess_translation_m "${GUESS_M:-0.05}" --pixel_samples "$kPixelSamples" \
+    --output_path "$dir/dataset" > "$dir.log" 2>&1
   if [ ! -f "$dir/ws/sparse/joint/cam_from_lidar.txt" ] &&
       ! "$cli" pipeline --dataset_path "$dir/dataset" --workspace_path "$dir/ws" \
         --Import.matcher sequential >> "$dir.log" 2>&1; then
@@ -57,5 +61,6 @@ for rig in mono stereo; do
 done
 mkdir -p docs/benchmarks
 readonly kDoc="${DOC:-docs/benchmarks/straight_drive.md}"
-python3 scripts/straight_drive_table.py "$results" "${GUESS_DEG:-2}" "${GUESS_M:-0.05}" > "$kDoc"
+python3 scripts/straight_drive_table.py "$results" "${GUESS_DEG:-2}" "${GUESS_M:-0.05}" \
+  "$kPixelSamples" > "$kDoc"
 cat "$kDoc"

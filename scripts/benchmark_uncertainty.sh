@@ -22,8 +22,10 @@
 #           truth: from the true one (the reference). Started at the truth, an estimator whose result
 #           does not depend on its start stays within its sigmas; how far it walks away shows what
 #           the associations and the model's errors add. Use with its own VARIANT.
+#   PIXEL_SAMPLES  rays per pixel axis of the simulated drives' images (simulate_dataset
+#           --pixel_samples; default 4: one ray aliases the road ahead of the car)
 #   WORK_DIR  keep the runs there (default: a temporary folder, removed); front ends and joint runs
-#           already there are not made again
+#           already there are not made again (whatever PIXEL_SAMPLES they were made with)
 #   BUILD_DIR (default build); CLI: another colmap-lidar executable instead of building one (a
 #           variant of the estimator built elsewhere)
 set -euo pipefail
@@ -33,6 +35,7 @@ source scripts/configure.sh
 use_cli
 readonly kSample="$PWD/../shared/data/kitti_odometry_04_sample"
 readonly kVariant="${VARIANT:-default}"
+readonly kPixelSamples="${PIXEL_SAMPLES:-4}"
 use_work_dir
 results="$work/results-$kVariant.tsv"
 : > "$results"
@@ -74,12 +77,13 @@ drive_front_end() {
   dataset="$run/dataset"
   step "$dataset" "$cli" simulate_dataset --scene street --motion drive --mono "$mono" \
     --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 --write_guess 0 \
-    --output_path "$dataset" && pipeline_front_end
+    --pixel_samples "$kPixelSamples" --output_path "$dataset" && pipeline_front_end
 }
 kitti_layout_front_end() {
   dataset="$run/dataset"
   step "$run/kitti" "$cli" simulate_dataset --scene street --motion drive --layout kitti --mono 1 \
-    --seed "$seed" --num_stations 20 --lidar_points 120000 --output_path "$run/kitti" &&
+    --seed "$seed" --num_stations 20 --lidar_points 120000 --pixel_samples "$kPixelSamples" \
+    --output_path "$run/kitti" &&
   step "$dataset" "$cli" import_kitti --kitti_path "$run/kitti/drive" \
     --calib_path "$run/kitti/calibration" --output_path "$dataset" --write_guess 1 \
     --guess_rotation_deg 1 --seed "$seed" && pipeline_front_end
@@ -132,6 +136,6 @@ for scene in ${SCENES:-t_specimen bridge_pier street_drive street_drive_stereo k
 done
 mkdir -p docs/benchmarks
 readonly kDoc="${DOC:-docs/benchmarks/uncertainty.md}"
-START="${START:-initial}" python3 scripts/uncertainty_table.py "$results" "$kVariant" \
+START="${START:-initial}" PIXEL_SAMPLES="$kPixelSamples" python3 scripts/uncertainty_table.py "$results" "$kVariant" \
   "${JOINT_OPTIONS:-}" > "$kDoc"
 cat "$kDoc"

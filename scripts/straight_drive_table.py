@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # The page of scripts/benchmark_straight_drive.sh from its results:
-#   straight_drive_table.py RESULTS_TSV GUESS_DEG GUESS_M
+#   straight_drive_table.py RESULTS_TSV GUESS_DEG GUESS_M [PIXEL_SAMPLES (default 1)]
 # RESULTS_TSV lines: rig, seed, guess (0|1), 'start' or 'result', then extrinsic_error.py's errors
 # (6), sigmas (6) and z (6); or rig, seed, guess, 'FAILED', the first error line.
 import datetime, math, subprocess, sys
@@ -45,17 +45,19 @@ def row(key, run):
 def main():
     runs, failed = read(sys.argv[1])
     guess_deg, guess_m = sys.argv[2], sys.argv[3]
+    pixel_samples = sys.argv[4] if len(sys.argv) > 4 else '1'
     commit = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], capture_output=True,
                             text=True).stdout.strip()
     print('# A drive that never turns\n')
     print('Written by `scripts/benchmark_straight_drive.sh` on %s, commit %s (2 cores).\n' %
           (datetime.date.today().isoformat(), commit))
     print('`simulate_dataset --scene street --motion straight_drive`: the street drive in one lane '
-          'without a turn, 0.5-1 m per frame, 120000 rays per sweep; the whole `pipeline` with '
+          'without a turn, 0.5-1 m per frame, 120000 rays per sweep, %s rays per pixel axis; '
+          'the whole `pipeline` with '
           'sequential matching. Each rig and seed runs twice: without a guess (the pose initialiser '
           'starts cam_from_lidar from the direction of travel and the structure both sensors see), '
           'and with rig.json\'s guess %s deg / %s m off the truth (no sigma).\n' %
-          (guess_deg, guess_m))
+          (pixel_samples, guess_deg, guess_m))
     print('Errors: the rotation vector of estimate * inverse(truth) about the camera axes [deg], '
           'the translation [mm]; z = error / reported sigma; "undet." = held at the start and '
           'reported without a sigma. "No farther" compares every axis of the result with the '

@@ -2,7 +2,8 @@
 # Writes the coverage page of the reported cam_from_lidar uncertainty (Markdown, to stdout) from
 # benchmark_uncertainty.sh's results:
 #   uncertainty_table.py RESULTS_TSV VARIANT JOINT_OPTIONS
-# (environment START=truth: the runs started at the true cam_from_lidar)
+# (environment START=truth: the runs started at the true cam_from_lidar; PIXEL_SAMPLES: the
+# simulated drives' rays per pixel axis)
 # A results line: scene, seed, the errors (rx ry rz [deg], tx ty tz [mm]), the sigmas and the z
 # (scripts/extrinsic_error.py); 'nan' z: the axis is undetermined (held at the start, no sigma).
 import datetime, math, os, sys
@@ -50,6 +51,9 @@ def print_header():
     for scene in sorted({r[0] for r in rows}):
         if scene in FAMILIES:
             print('- `%s`: %s.' % (scene, FAMILIES[scene][1]))
+    if any(FAMILIES.get(r[0], ('',))[0] == 'drive' and r[0] != 'kitti_odometry' for r in rows):
+        print('\nThe simulated drives\' images: %s rays per pixel axis (`simulate_dataset '
+              '--pixel_samples`).' % os.environ.get('PIXEL_SAMPLES', '1'))
     print('\nErrors: the rotation vector of estimate * inverse(truth) about the camera axes [deg], the '
           'translation [mm]; z = error / reported sigma (`report.json` `uncertainty`); "undet." = held '
           'at the start and reported without a sigma.\n')
