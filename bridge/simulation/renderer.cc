@@ -51,7 +51,9 @@ cv::Mat RenderImage(const Scene& scene,
       if (n > 1) {  // the pixel's area: n x n jittered strata, their mean
         value = 0;
         for (int k = 0; k < n * n; ++k) {
-          const Eigen::Vector2d offset((k % n + jitter(rng)) / n, (k / n + jitter(rng)) / n);
+          const double jitter_x = jitter(rng);  // drawn in a fixed order: the same image everywhere
+          const double jitter_y = jitter(rng);
+          const Eigen::Vector2d offset((k % n + jitter_x) / n, (k / n + jitter_y) / n);
           RayHit sample;
           value += RayRadiance(
                        scene, camera, world_from_cam, Eigen::Vector2d(col, row) + offset, &sample) /
