@@ -10,6 +10,17 @@
 // camera; comparing z with z keeps the residual unbiased off the optical axis, where range exceeds z by
 // up to 1/cos(24 deg) = 9 % at the image corner of a 48 deg lens. DepthType::kRange is there for priors
 // that really are ranges (e.g. time-of-flight sensors).
+//
+// Beyond the paper, d is corrected by the stereo rig's systematic disparity error, a field over the
+// left image in inverse depth (1/m; times b f it is disparity in pixels):
+//
+//   1/d_corrected = 1/d + c0 + c1 x + c2 y,   (x, y) the keypoint's normalised image coordinates.
+//
+// Residual rectification errors give these three terms: a relative yaw of the two cameras (or a
+// principal point offset) a constant disparity offset, a focal length mismatch one that grows with
+// x, a relative roll one that grows with y. An error common to every prior cannot show in their
+// scatter; where the LiDAR measures depth (E_m) the joint problem estimates c, elsewhere c is held
+// at zero.
 #pragma once
 
 #include "colmap/estimators/cost_functions.h"
@@ -28,66 +39,87 @@ T DepthOfPoint(const Eigen::Matrix<T, 3, 1>& point_in_cam, DepthType type) {
   return point_in_cam.norm();
 }
 
-// Pose and landmark are parameter blocks: cam_from_world rotation [4], translation [3], point [3].
+// One depth prior: the measured depth d, its sigma_d and the keypoint's normalised image coordinates.
+struct DepthPriorMeasurement {
+  double depth = 0;
+  double sigma = 1;
+  Eigen::Vector2d normalized_xy = Eigen::Vector2d::Zero();
+};
+
+// d_corrected of the header comment for the bias field c = bias[0..2].
+template <typename T>
+T CorrectedDepth(const DepthPriorMeasurement& measurement, const T* const bias) {
+  return T(1) / (T(1.0 / measurement.depth) + bias[0] + bias[1] * measurement.normalized_xy.x() +
+                 bias[2] * measurement.normalized_xy.y());
+}
+
+// Pose, landmark and bias field are parameter blocks: cam_from_world rotation [4], translation [3],
+// point [3], bias [3].
 class DepthPriorCostFunctor {
  public:
-  DepthPriorCostFunctor(double depth, double sigma, DepthType type)
-      : depth_(depth), inverse_sigma_(1.0 / sigma), type_(type) {}
+  DepthPriorCostFunctor(const DepthPriorMeasurement& measurement, DepthType type)
+      : measurement_(measurement), inverse_sigma_(1.0 / measurement.sigma), type_(type) {}
 
-  static ceres::CostFunction* Create(double depth, double sigma, DepthType type = DepthType::kZ) {
-    return new ceres::AutoDiffCostFunction<DepthPriorCostFunctor, 1, 4, 3, 3>(
-        new DepthPriorCostFunctor(depth, sigma, type));
+  static ceres::CostFunction* Create(const DepthPriorMeasurement& measurement,
+                                     DepthType type = DepthType::kZ) {
+    return new ceres::AutoDiffCostFunction<DepthPriorCostFunctor, 1, 4, 3, 3, 3>(
+        new DepthPriorCostFunctor(measurement, type));
   }
 
   template <typename T>
   bool operator()(const T* const cam_from_world_rotation,
                   const T* const cam_from_world_translation,
                   const T* const point_in_world,
+                  const T* const bias,
                   T* residual) const {
     const Eigen::Matrix<T, 3, 1> point_in_cam =
         colmap::EigenQuaternionMap<T>(cam_from_world_rotation) *
             colmap::EigenVector3Map<T>(point_in_world) +
         colmap::EigenVector3Map<T>(cam_from_world_translation);
-    residual[0] = (DepthOfPoint(point_in_cam, type_) - T(depth_)) * T(inverse_sigma_);
+    residual[0] = (DepthOfPoint(point_in_cam, type_) - CorrectedDepth(measurement_, bias)) *
+                  T(inverse_sigma_);
     return true;
   }
 
  private:
-  const double depth_;
+  const DepthPriorMeasurement measurement_;
   const double inverse_sigma_;
   const DepthType type_;
 };
 
 // The same residual for an image whose pose COLMAP holds constant (its pose is not a parameter block in
-// COLMAP's problem, as for ReprojErrorConstantPoseCostFunction): only the landmark [3] is a parameter.
+// COLMAP's problem, as for ReprojErrorConstantPoseCostFunction): the landmark [3] and the bias field
+// [3] are the parameters.
 class DepthPriorConstantPoseCostFunctor {
  public:
   DepthPriorConstantPoseCostFunctor(const colmap::Rigid3d& cam_from_world,
-                                    double depth,
-                                    double sigma,
+                                    const DepthPriorMeasurement& measurement,
                                     DepthType type)
-      : cam_from_world_(cam_from_world), depth_(depth), inverse_sigma_(1.0 / sigma), type_(type) {}
+      : cam_from_world_(cam_from_world),
+        measurement_(measurement),
+        inverse_sigma_(1.0 / measurement.sigma),
+        type_(type) {}
 
   static ceres::CostFunction* Create(const colmap::Rigid3d& cam_from_world,
-                                     double depth,
-                                     double sigma,
+                                     const DepthPriorMeasurement& measurement,
                                      DepthType type = DepthType::kZ) {
-    return new ceres::AutoDiffCostFunction<DepthPriorConstantPoseCostFunctor, 1, 3>(
-        new DepthPriorConstantPoseCostFunctor(cam_from_world, depth, sigma, type));
+    return new ceres::AutoDiffCostFunction<DepthPriorConstantPoseCostFunctor, 1, 3, 3>(
+        new DepthPriorConstantPoseCostFunctor(cam_from_world, measurement, type));
   }
 
   template <typename T>
-  bool operator()(const T* const point_in_world, T* residual) const {
+  bool operator()(const T* const point_in_world, const T* const bias, T* residual) const {
     const Eigen::Matrix<T, 3, 1> point_in_cam =
         cam_from_world_.rotation.cast<T>() * colmap::EigenVector3Map<T>(point_in_world) +
         cam_from_world_.translation.cast<T>();
-    residual[0] = (DepthOfPoint(point_in_cam, type_) - T(depth_)) * T(inverse_sigma_);
+    residual[0] = (DepthOfPoint(point_in_cam, type_) - CorrectedDepth(measurement_, bias)) *
+                  T(inverse_sigma_);
     return true;
   }
 
  private:
   const colmap::Rigid3d cam_from_world_;
-  const double depth_;
+  const DepthPriorMeasurement measurement_;
   const double inverse_sigma_;
   const DepthType type_;
 };

@@ -60,6 +60,10 @@ void AddJointAdjusterOptions(const std::string& prefix,
   add.Add("estimate_time_offset",
           &options->estimate_time_offset,
           "on a moving platform, estimate the LiDAR clock's offset from the cameras");
+  add.Add("estimate_depth_bias",
+          &adjuster.estimate_depth_bias,
+          "estimate the stereo depth's disparity bias field (offset, x and y slopes) against the "
+          "LiDAR (E_m)");
   add.Add("hold_rotation", &adjuster.hold_rotation, "hold cam_from_lidar's rotation at its start");
   std::array<bool, 3>* held = &adjuster.hold_translation;
   manager->AddParsedOption(

@@ -172,8 +172,15 @@ struct RunState {
   std::unique_ptr<double> lidar_free_angle = std::make_unique<double>(0.0);
   // JointAdjusterOptions::estimate_time_offset: dt, a parameter block that lives across rounds.
   std::unique_ptr<double> time_offset = std::make_unique<double>(0.0);
+  // The stereo depth's bias field (colmap_ext/depth_prior_cost.h), a parameter block that lives
+  // across rounds; estimated where E_m measures depth, else held at zero.
+  std::unique_ptr<std::array<double, 3>> depth_prior_bias =
+      std::make_unique<std::array<double, 3>>();
 
   bool UsesExtrinsic() const { return use_lidar || use_landmark_lidar; }
+  bool EstimatesDepthBias() const {
+    return options.estimate_depth_bias && use_landmark_lidar && options.depth_weight > 0;
+  }
 
   double* ExtrinsicRotation() const { return cam_from_lidar->rotation.coeffs().data(); }
   double* ExtrinsicTranslation() const { return cam_from_lidar->translation.data(); }
@@ -224,10 +231,23 @@ std::pair<double*, double*> PoseBlocks(const RunState& state,
   return {rotation, translation};
 }
 
+// The depth prior of a landmark observation as the cost takes it, its sigma scaled by `weight_scale`.
+DepthPriorMeasurement MeasurementOf(const RunState& state,
+                                    const colmap::TrackElement& element,
+                                    const DepthPrior& prior,
+                                    double weight_scale) {
+  const colmap::Image& image = state.reconstruction->Image(element.image_id);
+  const Eigen::Vector2d& xy = image.Point2D(element.point2D_idx).xy;
+  return {prior.depth,
+          prior.sigma * weight_scale,
+          state.reconstruction->Camera(image.CameraId()).CamFromImg(xy)};
+}
+
 // E_d, the paper's depth-prior residual, for every landmark observation with a prior in force.
 void AddDepthPriorBlocks(const RunState& state, JointProblem* joint) {
   if (state.options.depth_weight <= 0 || !state.depth_priors_in_force) return;
   ceres::Problem* problem = joint->problem.get();
+  double* bias = state.depth_prior_bias->data();
   const double weight_scale = std::sqrt(state.factors.depth / state.options.depth_weight);
   for (const auto& [point3D_id, point3D] : state.reconstruction->Points3D()) {
     double* xyz = state.reconstruction->Point3D(point3D_id).xyz.data();
@@ -236,25 +256,27 @@ void AddDepthPriorBlocks(const RunState& state, JointProblem* joint) {
       if (prior == nullptr || state.depth_outliers.count({element.image_id, element.point2D_idx})) {
         continue;
       }
-      const double sigma = prior->sigma * weight_scale;
+      const DepthPriorMeasurement measurement = MeasurementOf(state, element, *prior, weight_scale);
       joint->depth_images.push_back(element.image_id);
-      joint->depth_scale_derivatives.push_back(-prior->depth / sigma);
+      joint->depth_scale_derivatives.push_back(-prior->depth / measurement.sigma);
       if (state.config.HasConstantCamPose(element.image_id)) {
         joint->depth_ids.push_back(problem->AddResidualBlock(
             DepthPriorConstantPoseCostFunctor::Create(
-                state.reconstruction->Image(element.image_id).CamFromWorld(), prior->depth, sigma),
+                state.reconstruction->Image(element.image_id).CamFromWorld(), measurement),
             state.loss.get(),
-            xyz));
+            xyz,
+            bias));
       } else {
         const auto [rotation, translation] = PoseBlocks(state, problem, element.image_id);
         joint->depth_ids.push_back(
-            problem->AddResidualBlock(DepthPriorCostFunctor::Create(prior->depth, sigma),
+            problem->AddResidualBlock(DepthPriorCostFunctor::Create(measurement),
                                       state.loss.get(),
-                                      rotation,
-                                      translation,
-                                      xyz));
+                                      {rotation, translation, xyz, bias}));
       }
     }
+  }
+  if (problem->HasParameterBlock(bias) && !state.EstimatesDepthBias()) {
+    problem->SetParameterBlockConstant(bias);
   }
 }
 
@@ -482,6 +504,7 @@ std::map<const double*, std::string> ParameterNames(const RunState& state) {
   names[state.ExtrinsicRotation()] = "cam_from_lidar rotation";
   names[state.ExtrinsicTranslation()] = "cam_from_lidar translation";
   names[state.time_offset.get()] = "the LiDAR clock offset";
+  names[state.depth_prior_bias->data()] = "the stereo depth's bias field";
   names[state.lidar_free_angle.get()] = "E_l's free angle about the driving direction";
   return names;
 }
@@ -600,7 +623,9 @@ size_t UpdateDepthOutliers(RunState* state, DepthOutlierStats* stats) {
       const DepthPrior* prior = FindDepthPrior(state->data, element);
       if (prior == nullptr) continue;
       const colmap::Image& image = state->reconstruction->Image(element.image_id);
-      const double error = std::abs((image.CamFromWorld() * point3D.xyz).z() - prior->depth);
+      const double error = std::abs((image.CamFromWorld() * point3D.xyz).z() -
+                                    CorrectedDepth(MeasurementOf(*state, element, *prior, 1.0),
+                                                   state->depth_prior_bias->data()));
       checks.push_back({{element.image_id, element.point2D_idx}, error, prior->sigma});
       normalised.push_back(error / prior->sigma);
     }
@@ -1006,6 +1031,22 @@ void RecordLandmarkFacing(const RunState& state,
             << facing[2].num_observations << std::endl;
 }
 
+// The stereo depth's estimated bias field into `summary`, printed; or why it stayed at zero.
+void RecordDepthBias(const RunState& state, JointAdjustmentSummary* summary) {
+  if (state.options.estimate_depth_bias && !state.EstimatesDepthBias()) {
+    std::cout << "The stereo depth's bias field is held at zero: no landmark-to-LiDAR-plane term "
+                 "(E_m) measures depth against the LiDAR in this run"
+              << std::endl;
+  }
+  if (state.EstimatesDepthBias() && !state.data.depth_priors.empty()) {
+    const std::array<double, 3>& bias = *state.depth_prior_bias;
+    summary->depth_prior_bias = Eigen::Vector3d(bias[0], bias[1], bias[2]);
+    std::cout << "Stereo depth bias field (1/depth, 1/m): " << bias[0] << " + " << bias[1]
+              << " x + " << bias[2] << " y; a prior of 10 m on the optical axis is corrected by "
+              << 1000 * (1 / (0.1 + bias[0]) - 10) << " mm" << std::endl;
+  }
+}
+
 // The state's free LiDAR rotation, variance factors, clock offset and E_m's surfaces into `summary`,
 // printed.
 void RecordFinalState(const RunState& state,
@@ -1020,6 +1061,7 @@ void RecordFinalState(const RunState& state,
               << " deg from cam_from_lidar" << std::endl;
   }
   summary->variance_factors = state.factors;
+  RecordDepthBias(state, summary);
   if (state.options.estimate_time_offset) {
     summary->time_offset = *state.time_offset;
     std::cout << "LiDAR clock offset from the cameras (E_m): " << *state.time_offset

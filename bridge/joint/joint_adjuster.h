@@ -98,6 +98,11 @@ struct JointAdjusterOptions {
   // in the camera frame does not change (a straight drive at constant speed), dt and T_e's translation
   // along the travel are one direction, which the covariance then reports as undetermined.
   bool estimate_time_offset = false;
+  // Estimate the stereo depth's bias field (colmap_ext/depth_prior_cost.h) against E_m, which
+  // measures depth without it; off: the field is held at zero. Estimated, it also absorbs whatever
+  // else makes the cameras' depths disagree with the LiDAR's (sweeps not de-skewed, a clock
+  // offset), so it is for rigs whose LiDAR side is clean.
+  bool estimate_depth_bias = false;
   // sigma_m of E_m: the landmark's triangulation and the LiDAR surface together.
   double sigma_landmark_lidar_m = 0.02;
   // E_m outliers: beyond this distance or beyond max_landmark_plane_sigmas * sigma_m (absolute and in
@@ -276,6 +281,9 @@ struct JointAdjustmentSummary {
   // With estimate_time_offset: the LiDAR clock's offset from the cameras' [s, or frames without
   // image times].
   std::optional<double> time_offset;
+  // Where E_m measures depth: the stereo depth's bias field c (colmap_ext/depth_prior_cost.h) in
+  // inverse depth [1/m], per 1 and per normalised image x and y.
+  std::optional<Eigen::Vector3d> depth_prior_bias;
   // E_m's final associations by the camera axis their surface faces (x, y, z).
   std::array<LandmarkPlaneFacing, 3> landmark_lidar_facing;
   std::vector<VarianceComponent> variance_components;

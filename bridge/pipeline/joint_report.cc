@@ -250,6 +250,28 @@ std::string ObservabilityVerdict(const JointAdjusterOptions& options,
          ", though the motion alone is degenerate: " + summary.motion.verdict;
 }
 
+// The estimates besides cam_from_lidar that the run had as parameters: the LiDAR clock offset,
+// the stereo depth's bias field, E_l's own angle about the driving direction.
+void AddNuisanceParameters(const JointAdjustmentSummary& summary,
+                           const LoadedJointData& loaded,
+                           nlohmann::json* json) {
+  nlohmann::json& report = *json;
+  if (summary.time_offset) {
+    report["time_offset"] = {{"lidar_minus_camera", *summary.time_offset},
+                             {"unit", loaded.data.image_times.empty() ? "frames" : "s"}};
+  }
+  if (summary.depth_prior_bias) {
+    const Eigen::Vector3d& bias = *summary.depth_prior_bias;
+    report["depth_prior_bias"] = {{"inverse_depth_per_m", {bias.x(), bias.y(), bias.z()}},
+                                  {"terms", {"1", "x", "y"}}};
+  }
+  if (!summary.lidar_free_axis_in_cam.isZero()) {
+    const Eigen::Vector3d& axis = summary.lidar_free_axis_in_cam;
+    report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
+                                     {"lidar_term_angle_deg", summary.lidar_free_angle_deg}};
+  }
+}
+
 }  // namespace
 
 void WriteJointReport(const std::string& directory,
@@ -283,19 +305,11 @@ void WriteJointReport(const std::string& directory,
     report["landmark_lidar_facing"] = LandmarkFacingJson(summary.landmark_lidar_facing);
   }
   report["variance_components"] = VarianceComponentsJson(options, summary);
-  if (summary.time_offset) {
-    report["time_offset"] = {{"lidar_minus_camera", *summary.time_offset},
-                             {"unit", loaded.data.image_times.empty() ? "frames" : "s"}};
-  }
+  AddNuisanceParameters(summary, loaded, &report);
   report["extrinsic_measurements"] = MeasurementsJson(loaded.data.extrinsic_measurements, refined);
   report["start_departure"] =
       StartDepartureJson(CheckStartDeparture(initial, refined, loaded.data, summary));
   report["association"] = AssociationSettlingJson(CheckAssociationSettling(summary));
-  if (!summary.lidar_free_axis_in_cam.isZero()) {
-    const Eigen::Vector3d& axis = summary.lidar_free_axis_in_cam;
-    report["lidar_free_rotation"] = {{"axis_in_cam", {axis.x(), axis.y(), axis.z()}},
-                                     {"lidar_term_angle_deg", summary.lidar_free_angle_deg}};
-  }
   const ExtrinsicUncertainty& u = summary.uncertainty;
   report["uncertainty"] = UncertaintyJson(u, options.observability, caveat);
   report["uncertainty"]["prior_determined_axes"] =
