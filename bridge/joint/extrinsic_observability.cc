@@ -523,9 +523,9 @@ std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform
                                ? DescribeAxis(motion.common_axis_in_cam)
                                : std::string("no turn of 2 deg");
   return "not validated for a moving platform turning about one axis (" + axis +
-         "): on simulated 40-frame street drives the errors reached 3 of these sigmas with the "
-         "vertical alignment (the rotation about the driving direction), 5-8 without it; read "
-         "them as lower bounds";
+         "): the model leaves out errors common to the whole drive (the LiDAR's and the stereo "
+         "depth's systematic errors), which such a drive does not average out; read these sigmas "
+         "as lower bounds (docs/benchmarks/uncertainty.md gives the coverage measured on drives)";
 }
 
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInputs& inputs,

@@ -377,7 +377,8 @@ void WriteJointPlots(const std::string& directory,
 }
 
 void PrintJointUncertainty(const JointAdjustmentSummary& summary, const std::string& caveat) {
-  std::cout << "Motion: " << summary.motion.verdict << std::endl;
+  std::cout << "Motion alone (the rotations between stations, without the structure's terms): "
+            << summary.motion.verdict << std::endl;
   if (summary.uncertainty.computed) {
     const Eigen::VectorXd sigma = summary.uncertainty.covariance.diagonal().cwiseSqrt();
     std::ostringstream line;
