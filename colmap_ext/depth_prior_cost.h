@@ -19,8 +19,8 @@
 // Residual rectification errors give these three terms: a relative yaw of the two cameras (or a
 // principal point offset) a constant disparity offset, a focal length mismatch one that grows with
 // x, a relative roll one that grows with y. An error common to every prior cannot show in their
-// scatter; where the LiDAR measures depth (E_m) the joint problem estimates c, elsewhere c is held
-// at zero.
+// scatter. The joint adjuster estimates c against the LiDAR's depth (E_m) when asked to
+// (JointAdjusterOptions::estimate_depth_bias); otherwise c is held at zero.
 #pragma once
 
 #include "colmap/estimators/cost_functions.h"

@@ -173,7 +173,7 @@ struct RunState {
   // JointAdjusterOptions::estimate_time_offset: dt, a parameter block that lives across rounds.
   std::unique_ptr<double> time_offset = std::make_unique<double>(0.0);
   // The stereo depth's bias field (colmap_ext/depth_prior_cost.h), a parameter block that lives
-  // across rounds; estimated where E_m measures depth, else held at zero.
+  // across rounds; estimated with estimate_depth_bias where E_m measures depth, else held at zero.
   std::unique_ptr<std::array<double, 3>> depth_prior_bias =
       std::make_unique<std::array<double, 3>>();
 
