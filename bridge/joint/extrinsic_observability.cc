@@ -58,6 +58,7 @@ bool ObservabilityOptions::Check() const {
   CHECK_OPTION_GT(unobservable_rotation_deg, 0);
   CHECK_OPTION_GE(min_rotation_deg, 0);
   CHECK_OPTION_GE(stereo_scale_sigma, 0);
+  CHECK_OPTION_GE(disparity_bias_sigma_px, 0);
   CHECK_OPTION_GT(max_parallel_axes_deg, 0);
   return true;
 }
@@ -258,9 +259,10 @@ constexpr int kMeasurementRow = -2;
 struct JacobianRows {
   Eigen::SparseMatrix<double> jacobian;
   std::vector<double> residuals;
-  // Per row: its cluster (kRegularizerRow, kMeasurementRow or >= 0) and d(residual)/d(stereo scale).
+  // Per row: its cluster (kRegularizerRow, kMeasurementRow or >= 0) and d(residual)/d(the stereo
+  // depth's consider parameters).
   std::vector<int> cluster;
-  std::vector<double> scale_derivative;
+  std::vector<Eigen::Vector4d> consider_derivative;
   int num_data_rows = 0;
 };
 
@@ -270,18 +272,19 @@ JacobianRows EvaluateRows(
     const std::vector<std::vector<ceres::ResidualBlockId>>& clusters,
     const std::vector<ceres::ResidualBlockId>& regularizers,
     const std::vector<ceres::ResidualBlockId>& measurements,
-    const std::unordered_map<ceres::ResidualBlockId, double>& depth_scale_derivative) {
+    const std::unordered_map<ceres::ResidualBlockId, Eigen::Vector4d>& depth_consider_derivative) {
   JacobianRows rows;
   std::vector<ceres::ResidualBlockId> residual_blocks;
   const auto add = [&](ceres::ResidualBlockId id, int cluster) {
     residual_blocks.push_back(id);
     const int num_residuals = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
     rows.cluster.insert(rows.cluster.end(), num_residuals, cluster);
-    const auto derivative = depth_scale_derivative.find(id);
-    rows.scale_derivative.insert(
-        rows.scale_derivative.end(),
-        num_residuals,
-        derivative == depth_scale_derivative.end() ? 0.0 : derivative->second);
+    const auto derivative = depth_consider_derivative.find(id);
+    rows.consider_derivative.insert(rows.consider_derivative.end(),
+                                    num_residuals,
+                                    derivative == depth_consider_derivative.end()
+                                        ? Eigen::Vector4d::Zero()
+                                        : derivative->second);
   };
   for (size_t c = 0; c < clusters.size(); ++c) {
     for (const ceres::ResidualBlockId id : clusters[c]) add(id, static_cast<int>(c));
@@ -369,14 +372,14 @@ Eigen::MatrixXd GroupedSandwich(const std::vector<Eigen::VectorXd>& scores,
 }
 
 // Cluster-robust (sandwich) covariance of T_e's free tangent, X = H^-1 E (E selects T_e),
-// v_c = (J_c X)^T r_c over the data rows, and T_e's response to a common stereo scale error
-// dx = -H^-1 J^T dr/ds. H includes the regularisers (they keep it invertible); their rows add no score.
+// v_c = (J_c X)^T r_c over the data rows, and T_e's response to each of the stereo depth's
+// consider parameters s (its scale and disparity bias field), dx = -H^-1 J^T dr/ds. H includes the regularisers (they keep it invertible); their rows add no score.
 // With station groups (two-way clustering, Cameron, Gelbach & Miller 2011): V = V_A + V_B - V_AB, with A
 // the clusters merged by their first group key, B by their second, AB the clusters themselves, then
 // negative eigenvalues clipped; errors shared by every pair of one station are then covered.
 struct ClusterRobustCovariance {
-  Eigen::MatrixXd sandwich;           // in the parameters' own units
-  Eigen::VectorXd scale_sensitivity;  // dT_e / d(stereo scale)
+  Eigen::MatrixXd sandwich;              // in the parameters' own units
+  Eigen::MatrixXd consider_sensitivity;  // dT_e / d(consider parameters), one column each
 };
 
 std::optional<ClusterRobustCovariance> ClusterRobust(
@@ -387,7 +390,7 @@ std::optional<ClusterRobustCovariance> ClusterRobust(
     size_t num_clusters) {
   ClusterRobustCovariance robust;
   Eigen::MatrixXd* sandwich = &robust.sandwich;
-  Eigen::VectorXd* scale_sensitivity = &robust.scale_sensitivity;
+  Eigen::MatrixXd* consider_sensitivity = &robust.consider_sensitivity;
   const int num_cols = static_cast<int>(information.cols());
   const int num_extrinsic = num_cols - num_other;
   Eigen::SparseMatrix<double> regularised = information;
@@ -398,7 +401,7 @@ std::optional<ClusterRobustCovariance> ClusterRobust(
   for (int a = 0; a < num_extrinsic; ++a) selector(num_other + a, a) = 1;
   const Eigen::MatrixXd y = rows.jacobian * full.solve(selector);
   std::vector<Eigen::VectorXd> scores(num_clusters, Eigen::VectorXd::Zero(num_extrinsic));
-  *scale_sensitivity = Eigen::VectorXd::Zero(num_extrinsic);
+  *consider_sensitivity = Eigen::MatrixXd::Zero(num_extrinsic, 4);
   Eigen::MatrixXd known = Eigen::MatrixXd::Zero(num_extrinsic, num_extrinsic);
   for (int row = 0; row < rows.num_data_rows; ++row) {
     if (rows.cluster[row] == kMeasurementRow) {
@@ -406,7 +409,7 @@ std::optional<ClusterRobustCovariance> ClusterRobust(
       continue;
     }
     scores[rows.cluster[row]] += y.row(row).transpose() * rows.residuals[row];
-    *scale_sensitivity -= y.row(row).transpose() * rows.scale_derivative[row];
+    *consider_sensitivity -= y.row(row).transpose() * rows.consider_derivative[row].transpose();
   }
   *sandwich = GroupedSandwich(scores, {});
   if (!cluster_groups.empty()) {
@@ -465,9 +468,10 @@ void AddClusterRobustCovariance(const JacobianRows& rows,
       rows, information, layout.num_other, inputs.cluster_groups, inputs.clusters.size());
   if (!cluster_robust) return;
   const Eigen::MatrixXd& sandwich = cluster_robust->sandwich;
-  const Eigen::VectorXd& scale_sensitivity = cluster_robust->scale_sensitivity;
-  result->stereo_scale_sensitivity =
-      layout.directions * layout.scale.cwiseProduct(scale_sensitivity);
+  const Eigen::MatrixXd reported_sensitivity =
+      layout.directions * layout.scale.asDiagonal() * cluster_robust->consider_sensitivity;
+  result->stereo_scale_sensitivity = reported_sensitivity.col(0);
+  result->disparity_bias_sensitivity = reported_sensitivity.rightCols<3>();
   Matrix6 robust = ToReported(ScaleTangent(sandwich, layout, 1), layout);
   // Directions the data leaves undetermined keep the formal (capped) variance.
   Eigen::SelfAdjointEigenSolver<Matrix6> formal(result->formal_covariance);
@@ -477,9 +481,12 @@ void AddClusterRobustCovariance(const JacobianRows& rows,
                 formal.eigenvectors().col(k).transpose();
     }
   }
-  result->covariance = robust + options.stereo_scale_sigma * options.stereo_scale_sigma *
-                                    result->stereo_scale_sensitivity *
-                                    result->stereo_scale_sensitivity.transpose();
+  const Matrix6 scale =
+      result->stereo_scale_sensitivity * result->stereo_scale_sensitivity.transpose();
+  const Matrix6 field =
+      result->disparity_bias_sensitivity * result->disparity_bias_sensitivity.transpose();
+  result->covariance = robust + options.stereo_scale_sigma * options.stereo_scale_sigma * scale +
+                       options.disparity_bias_sigma_px * options.disparity_bias_sigma_px * field;
   result->cluster_robust = true;
   result->num_clusters = static_cast<int>(inputs.clusters.size());
 }
@@ -550,7 +557,7 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInput
                                          clusters,
                                          inputs.regularizers,
                                          inputs.measurements,
-                                         inputs.depth_scale_derivative);
+                                         inputs.depth_consider_derivative);
   const Eigen::SparseMatrix<double> data_jacobian = rows.jacobian.topRows(rows.num_data_rows);
   const Eigen::SparseMatrix<double> data_information =
       (data_jacobian.transpose() * data_jacobian).pruned();

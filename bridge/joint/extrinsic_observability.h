@@ -33,6 +33,13 @@ struct ObservabilityOptions {
   // a "consider" parameter: its effect on T_e, sigma^2 * s s^T with s = dT_e/dscale, is added to the
   // covariance (random residual scatter cannot reveal an error common to every depth prior).
   double stereo_scale_sigma = 0.001;
+  // Systematic disparity error of the stereo depth over the left image [px]: an offset and slopes
+  // per unit of normalised image x and y (a rectified pair's residual relative yaw or principal
+  // point offset, focal mismatch, relative roll; the matcher's sub-pixel bias). Consider
+  // parameters like the scale, each with this sigma (colmap_ext/depth_prior_cost.h's field c times
+  // b f). The scale and the field are the stereo depth's errors common to every prior, which the
+  // priors' scatter cannot reveal.
+  double disparity_bias_sigma_px = 0.02;
   // Two-way clustering of the LiDAR term: besides each directed pair, the pairs that share a target
   // station and those that share a source station form clusters (a station's cloud errors, e.g. its
   // normals near edges, enter every pair it is part of). Off by default: it lowered the coverage of
@@ -57,6 +64,9 @@ struct ExtrinsicUncertainty {
   // Rotation [deg] and translation [mm] of T_e per unit of relative stereo scale error (the consider
   // parameter); its contribution stereo_scale_sigma^2 s s^T is included in `covariance`.
   Eigen::Matrix<double, 6, 1> stereo_scale_sensitivity = Eigen::Matrix<double, 6, 1>::Zero();
+  // The same per pixel of the disparity bias field's offset, x slope and y slope (columns); its
+  // contribution disparity_bias_sigma_px^2 S S^T is included in `covariance`.
+  Eigen::Matrix<double, 6, 3> disparity_bias_sensitivity = Eigen::Matrix<double, 6, 3>::Zero();
   int num_clusters = 0;
   double variance_factor = 1;  // 2 cost / (residuals - parameters)
   Eigen::Matrix<double, 6, 1> eigenvalues =
@@ -133,8 +143,10 @@ struct ExtrinsicUncertaintyInputs {
   // Data residuals that compressed blocks stand for beyond their own rows (for the variance
   // factor's redundancy).
   size_t hidden_residuals = 0;
-  // d(residual)/d(stereo scale) of each depth-prior block (-d / sigma_d).
-  std::unordered_map<ceres::ResidualBlockId, double> depth_scale_derivative;
+  // Per depth-prior block, d(residual)/d(the stereo depth's consider parameters): the relative
+  // scale (-d / sigma_d) and the disparity bias field's offset, x and y slope [px]
+  // (d^2 (1, x, y) / (b f sigma_d)).
+  std::unordered_map<ceres::ResidualBlockId, Eigen::Vector4d> depth_consider_derivative;
 };
 
 // Marginal covariance of T_e in `inputs.problem`; `motion` turns unobservable directions into

@@ -109,9 +109,10 @@ struct JointProblem {
   colmap::BundleAdjustmentOptions ba_options;
   std::vector<ceres::ResidualBlockId> reprojection_ids;
   std::vector<ceres::ResidualBlockId> depth_ids;
-  // Parallel to depth_ids: the image, and d(residual)/d(stereo scale) = -d / sigma.
+  // Parallel to depth_ids: the image, and d(residual)/d(the stereo depth's consider parameters)
+  // (ConsiderDerivative).
   std::vector<colmap::image_t> depth_images;
-  std::vector<double> depth_scale_derivatives;
+  std::vector<Eigen::Vector4d> depth_consider_derivatives;
   std::vector<ceres::ResidualBlockId> lidar_ids;
   std::vector<ImagePair> lidar_pairs;  // parallel to lidar_ids
   size_t num_lidar_residuals = 0;
@@ -243,6 +244,22 @@ DepthPriorMeasurement MeasurementOf(const RunState& state,
           state.reconstruction->Camera(image.CameraId()).CamFromImg(xy)};
 }
 
+// d(E_d)/d(the stereo depth's consider parameters) at zero: a relative scale error s (d -> d (1 + s))
+// gives -d / sigma; a disparity error (1, x, y) . delta [px] moves 1/d by that over b f, so d by
+// -d^2 (1, x, y) . delta / (b f). b f = 0: no field (no stereo rig, or the field is estimated).
+Eigen::Vector4d ConsiderDerivative(const DepthPriorMeasurement& measurement,
+                                   double baseline_focal) {
+  const double d = measurement.depth;
+  Eigen::Vector4d derivative = Eigen::Vector4d::Zero();
+  derivative[0] = -d / measurement.sigma;
+  if (baseline_focal > 0) {
+    derivative.tail<3>() =
+        d * d / (baseline_focal * measurement.sigma) *
+        Eigen::Vector3d(1, measurement.normalized_xy.x(), measurement.normalized_xy.y());
+  }
+  return derivative;
+}
+
 // E_d, the paper's depth-prior residual, for every landmark observation with a prior in force.
 void AddDepthPriorBlocks(const RunState& state, JointProblem* joint) {
   if (state.options.depth_weight <= 0 || !state.depth_priors_in_force) return;
@@ -258,7 +275,9 @@ void AddDepthPriorBlocks(const RunState& state, JointProblem* joint) {
       }
       const DepthPriorMeasurement measurement = MeasurementOf(state, element, *prior, weight_scale);
       joint->depth_images.push_back(element.image_id);
-      joint->depth_scale_derivatives.push_back(-prior->depth / measurement.sigma);
+      // An estimated field is a parameter (marginalised), not a consider parameter.
+      joint->depth_consider_derivatives.push_back(ConsiderDerivative(
+          measurement, state.EstimatesDepthBias() ? 0.0 : state.data.stereo_baseline_focal));
       if (state.config.HasConstantCamPose(element.image_id)) {
         joint->depth_ids.push_back(problem->AddResidualBlock(
             DepthPriorConstantPoseCostFunctor::Create(
@@ -930,7 +949,7 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
   inputs.undetermined_rotation = state.held_rotation;
   inputs.undetermined_translation = state.held_translation;
   for (size_t k = 0; k < joint.depth_ids.size(); ++k) {
-    inputs.depth_scale_derivative[joint.depth_ids[k]] = joint.depth_scale_derivatives[k];
+    inputs.depth_consider_derivative[joint.depth_ids[k]] = joint.depth_consider_derivatives[k];
   }
   Clusters clusters = ResidualClusters(*state.reconstruction, joint);
   inputs.clusters = std::move(clusters.blocks);

@@ -192,6 +192,9 @@ struct JointProblemData {
   // Capture time of each image [s] (empty: the images are frames in image_id order, one unit apart);
   // for the camera velocities of estimate_time_offset.
   std::map<colmap::image_t, double> image_times;
+  // The stereo rig's baseline times its rectified focal length [m px] (0: no stereo rig): converts
+  // the depth priors' disparity bias field between pixels and inverse depth.
+  double stereo_baseline_focal = 0;
   // Each joins the cost as E_x (bridge/joint/extrinsic_deviation_cost.h) in joint mode.
   std::vector<ExtrinsicMeasurement> extrinsic_measurements;
 

@@ -144,6 +144,9 @@ nlohmann::json UncertaintyJson(const ExtrinsicUncertainty& u,
     uncertainty["stereo_scale_sigma"] = observability.stereo_scale_sigma;
     uncertainty["stereo_scale_sensitivity_deg_mm"] =
         MatrixJson(u.stereo_scale_sensitivity.transpose());
+    uncertainty["disparity_bias_sigma_px"] = observability.disparity_bias_sigma_px;
+    uncertainty["disparity_bias_sensitivity_deg_mm"] =
+        MatrixJson(u.disparity_bias_sensitivity.transpose());
     uncertainty["num_clusters"] = u.num_clusters;
     uncertainty["formal_covariance_deg_mm"] = MatrixJson(u.formal_covariance);
     const Eigen::VectorXd formal_sigma = u.formal_covariance.diagonal().cwiseSqrt();

@@ -1,7 +1,7 @@
 #include "bridge/survey/synthetic_joint_problem.h"
 
-#include "colmap_ext/depth_prior_extractor.h"
 #include "bridge/simulation/renderer.h"
+#include "colmap_ext/depth_prior_extractor.h"
 
 #include <random>
 
@@ -109,8 +109,17 @@ void AddImages(const std::vector<colmap::Rigid3d>& truth,
   }
 }
 
+// The z-depth of `point_in_cam` as a stereo rig with the disparity bias field
+// options.disparity_bias_px measures it: 1/d + (1, x, y) . delta / (b f).
+double BiasedDepth(const Eigen::Vector3d& point_in_cam, const SyntheticJointOptions& options) {
+  const Eigen::Vector3d basis(
+      1, point_in_cam.x() / point_in_cam.z(), point_in_cam.y() / point_in_cam.z());
+  const double baseline_focal = options.rig.BaselineMeters() * options.rig.left.params[0];
+  return 1 / (1 / point_in_cam.z() + options.disparity_bias_px.dot(basis) / baseline_focal);
+}
+
 // The landmarks (offset by noise) with their tracks, and a depth prior per observation for a stereo
-// rig (true z-depth, noise of its own sigma_d and the common scale error).
+// rig (true z-depth, noise of its own sigma_d, the common scale error and the disparity bias field).
 void AddLandmarks(const Observations& seen,
                   const SyntheticJointOptions& options,
                   Noise* noise,
@@ -128,7 +137,7 @@ void AddLandmarks(const Observations& seen,
           DepthSigma(depth, rig.BaselineMeters(), rig.left.params[0], options.depth_sigma_pixels);
       problem->data.depth_priors[image_id][index] = {
           static_cast<colmap::point2D_t>(index),
-          depth * (1 + options.depth_scale_error) +
+          BiasedDepth(truth[s] * seen.landmarks[k], options) * (1 + options.depth_scale_error) +
               options.depth_noise_sigmas * sigma * noise->Draw(),
           sigma};
     }
@@ -176,6 +185,7 @@ std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
       ObserveLandmarks(world, problem->true_cam_from_world, camera, options, &noise);
   AddImages(problem->true_cam_from_world, seen, options, &problem->reconstruction);
   AddLandmarks(seen, options, &noise, problem.get());
+  problem->data.stereo_baseline_focal = options.rig.BaselineMeters() * options.rig.left.params[0];
   AddLidarScans(world, options, problem.get());
   problem->cam_from_lidar = PerturbPose(problem->true_cam_from_lidar,
                                         options.extrinsic_rotation_deg,

@@ -7,12 +7,12 @@
 #pragma once
 
 #include "bridge/joint/joint_adjuster.h"
-#include "colmap_ext/station_dataset.h"
-#include "lidar/point_cloud.h"
-#include "lidar/station_cloud.h"
 #include "bridge/simulation/renderer.h"
 #include "bridge/simulation/scene.h"
 #include "bridge/simulation/sensor_pod.h"
+#include "colmap_ext/station_dataset.h"
+#include "lidar/point_cloud.h"
+#include "lidar/station_cloud.h"
 
 #include "colmap/scene/reconstruction.h"
 
@@ -42,6 +42,9 @@ struct SyntheticJointOptions {
   double depth_noise_sigmas = 0;
   // A relative scale error common to every depth prior (a stereo calibration error).
   double depth_scale_error = 0;
+  // A disparity bias field common to every depth prior [px]: offset, slope per normalised image x
+  // and y (colmap_ext/depth_prior_cost.h).
+  Eigen::Vector3d disparity_bias_px = Eigen::Vector3d::Zero();
   // sigma_p of sigma_d = d^2/(b f) sigma_p.
   double depth_sigma_pixels = 1.0;
   // Start: poses (all but the first), landmarks and cam_from_lidar perturbed.
