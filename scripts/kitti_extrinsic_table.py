@@ -56,4 +56,7 @@ for r in rows:
                             zs + z_ref) + ' |')
 print('\nEstimators: "default" = variance components estimated with the solve and, on this moving '
       'platform, the LiDAR clock offset as a parameter of E_m; "fixed weights, no clock offset" = '
-      'the nominal weights (1 px, sigma_d, 2 cm) and one cam_from_lidar for every station.')
+      'the nominal weights (1 px, sigma_d, 2 cm) and one cam_from_lidar for every station; '
+      '"nothing held" = the default with the hold thresholds lifted (`--hold_rotation_deg 1e9 '
+      '--hold_translation_mm 1e9`): every direction of cam_from_lidar is estimated, however weakly '
+      'the data determine it.')
