@@ -64,6 +64,9 @@ struct StationRig {
   bool IsStereo() const { return right.has_value(); }
   // 0 for a monocular rig.
   double BaselineMeters() const { return IsStereo() ? right_from_left.translation.norm() : 0.0; }
+  // b f [m px], disparity times depth (0 without a right camera); f is the left camera's first
+  // parameter, the rectified focal length.
+  double BaselineFocal() const { return BaselineMeters() * left.params[0]; }
 };
 
 // Throws std::runtime_error naming the file and the offending key (missing key, unknown camera model,

@@ -373,7 +373,8 @@ Eigen::MatrixXd GroupedSandwich(const std::vector<Eigen::VectorXd>& scores,
 
 // Cluster-robust (sandwich) covariance of T_e's free tangent, X = H^-1 E (E selects T_e),
 // v_c = (J_c X)^T r_c over the data rows, and T_e's response to each of the stereo depth's
-// consider parameters s (its scale and disparity bias field), dx = -H^-1 J^T dr/ds. H includes the regularisers (they keep it invertible); their rows add no score.
+// consider parameters s (its scale and disparity bias field), dx = -H^-1 J^T dr/ds. H includes the
+// regularisers (they keep it invertible); their rows add no score.
 // With station groups (two-way clustering, Cameron, Gelbach & Miller 2011): V = V_A + V_B - V_AB, with A
 // the clusters merged by their first group key, B by their second, AB the clusters themselves, then
 // negative eigenvalues clipped; errors shared by every pair of one station are then covered.

@@ -208,7 +208,7 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(const std::string& databas
     pairs = VerifiedImagePairs(database, station_of_image, options.min_image_pair_inliers);
   }
   ReadDepthPriors(database_path, image_ids, &loaded->data);
-  loaded->data.stereo_baseline_focal = dataset.rig.BaselineMeters() * dataset.rig.left.params[0];
+  loaded->data.stereo_baseline_focal = dataset.rig.BaselineFocal();
   loaded->num_image_pairs = pairs.size();
   if (load_clouds) {
     LoadClouds(dataset, image_ids, station_of_image, options.voxel_size_m, loaded.get());

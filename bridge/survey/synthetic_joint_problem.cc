@@ -114,7 +114,7 @@ void AddImages(const std::vector<colmap::Rigid3d>& truth,
 double BiasedDepth(const Eigen::Vector3d& point_in_cam, const SyntheticJointOptions& options) {
   const Eigen::Vector3d basis(
       1, point_in_cam.x() / point_in_cam.z(), point_in_cam.y() / point_in_cam.z());
-  const double baseline_focal = options.rig.BaselineMeters() * options.rig.left.params[0];
+  const double baseline_focal = options.rig.BaselineFocal();
   return 1 / (1 / point_in_cam.z() + options.disparity_bias_px.dot(basis) / baseline_focal);
 }
 
@@ -185,7 +185,7 @@ std::unique_ptr<SyntheticJointProblem> MakeSyntheticJointProblem(
       ObserveLandmarks(world, problem->true_cam_from_world, camera, options, &noise);
   AddImages(problem->true_cam_from_world, seen, options, &problem->reconstruction);
   AddLandmarks(seen, options, &noise, problem.get());
-  problem->data.stereo_baseline_focal = options.rig.BaselineMeters() * options.rig.left.params[0];
+  problem->data.stereo_baseline_focal = options.rig.BaselineFocal();
   AddLidarScans(world, options, problem.get());
   problem->cam_from_lidar = PerturbPose(problem->true_cam_from_lidar,
                                         options.extrinsic_rotation_deg,
