@@ -20,7 +20,8 @@
 // principal point offset) a constant disparity offset, a focal length mismatch one that grows with
 // x, a relative roll one that grows with y. An error common to every prior cannot show in their
 // scatter. The joint adjuster estimates c against the LiDAR's depth (E_m) when asked to
-// (JointAdjusterOptions::estimate_depth_bias); otherwise c is held at zero.
+// (JointAdjusterOptions::estimate_depth_bias); otherwise c is held at zero and the covariance of
+// cam_from_lidar considers it (ObservabilityOptions::disparity_bias_sigma_px).
 #pragma once
 
 #include "colmap/estimators/cost_functions.h"
