@@ -310,6 +310,31 @@ TEST(JointAdjusterExactTest, UnobservableDirectionIsNamedWhateverTheExtrinsicPri
   }
 }
 
+// Do no harm: a direction the data leave undetermined takes rig.json's guess along it, not the
+// start's value. One-axis motion leaves the translation along the axis (camera y) undetermined; the
+// start is 40 mm off along it, the guess 6 mm (and exact along x and z, which the data determine).
+TEST(JointAdjusterExactTest, UndeterminedDirectionIsHeldAtTheGuess) {
+  const sim::Scene scene = sim::Scene::Create("t_specimen");
+  testing::SyntheticJointOptions synthetic = SmallProblem();
+  synthetic.motion = sim::Motion::kOneAxis;
+  synthetic.pixel_noise = 0.3;
+  auto problem = testing::MakeSyntheticJointProblem(scene, synthetic);
+  problem->cam_from_lidar.translation.y() = problem->true_cam_from_lidar.translation.y() + 0.040;
+  colmap::Rigid3d guess = problem->true_cam_from_lidar;
+  guess.translation.y() += 0.006;
+  problem->data.cam_from_lidar_guess = guess;
+  JointAdjusterOptions options;
+  options.num_association_rounds = 2;
+  options.max_association_rounds = 2;
+  const JointAdjustmentSummary summary = RunOn(problem.get(), options);
+  ASSERT_EQ(summary.held_at_initial.size(), 1u);
+  EXPECT_TRUE(summary.held_at_guess);
+  const Eigen::Matrix<double, 6, 1> error =
+      testing::ExtrinsicError(problem->cam_from_lidar, problem->true_cam_from_lidar);
+  std::cout << "held at the guess (6 mm off along y): error " << error.transpose() << std::endl;
+  EXPECT_NEAR(error[4], 6.0, 1.5);
+}
+
 // Defect: nested option checks were called and their result dropped.
 TEST(JointAdjusterOptionsTest, NestedOptionChecksAreActedOn) {
   JointAdjusterOptions options;

@@ -1120,6 +1120,21 @@ HeldDirections UnobservableDirections(const ExtrinsicUncertainty& uncertainty,
   return held;
 }
 
+// The held pass's start: `start` with its components along the held directions taken from
+// `guess` (rotation vectors of guess * inverse(start) about the camera axes, projected).
+colmap::Rigid3d HeldAtGuess(const colmap::Rigid3d& start,
+                            const colmap::Rigid3d& guess,
+                            const HeldDirections& held) {
+  const Eigen::AngleAxisd difference(guess.rotation * start.rotation.inverse());
+  const Eigen::Vector3d rotation = held.rotation * (difference.angle() * difference.axis());
+  colmap::Rigid3d result = start;
+  result.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(rotation.norm(), rotation.normalized())) *
+                     start.rotation)
+                        .normalized();
+  result.translation += held.translation * (guess.translation - start.translation);
+  return result;
+}
+
 }  // namespace
 
 bool JointProblemData::HasExtrinsicPrior() const {
@@ -1245,15 +1260,17 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
   if (!may_hold || !summary.uncertainty.computed) return summary;
   const HeldDirections held = UnobservableDirections(summary.uncertainty, options_);
   if (held.names.empty()) return summary;
+  const bool at_guess = data.cam_from_lidar_guess.has_value();
   std::cout << "cam_from_lidar: " << held.names.size()
-            << " direction(s) unobservable; solving again from the start with them held at their "
-               "initial value"
-            << std::endl;
+            << " direction(s) unobservable; solving again from the start with them held at "
+            << (at_guess ? "rig.json's guess" : "their initial value") << std::endl;
   *reconstruction = initial_reconstruction;
-  *cam_from_lidar = initial_extrinsic;
+  *cam_from_lidar = at_guess ? HeldAtGuess(initial_extrinsic, *data.cam_from_lidar_guess, held)
+                             : initial_extrinsic;
   JointAdjustmentSummary held_summary =
       RunOnce(data, reconstruction, cam_from_lidar, held.rotation, held.translation);
   held_summary.held_at_initial = held.names;
+  held_summary.held_at_guess = at_guess;
   held_summary.solves.insert(
       held_summary.solves.begin(), summary.solves.begin(), summary.solves.end());
   return held_summary;

@@ -197,6 +197,10 @@ struct JointProblemData {
   double stereo_baseline_focal = 0;
   // Each joins the cost as E_x (bridge/joint/extrinsic_deviation_cost.h) in joint mode.
   std::vector<ExtrinsicMeasurement> extrinsic_measurements;
+  // rig.json's guess without a sigma: outside knowledge, though not a prior (empty: none). A
+  // direction the data leave undetermined is held at the guess's value along it, not at the
+  // start's: a start fitted to these data (the pose initialiser's) knows nothing along it either.
+  std::optional<colmap::Rigid3d> cam_from_lidar_guess;
 
   bool HasExtrinsicPrior() const;
 };
@@ -268,6 +272,9 @@ struct JointAdjustmentSummary {
   // Directions of T_e held at their initial value after a first solve found them unobservable (empty:
   // none); the solves of that first pass are in `solves` too, before those of the held pass.
   std::vector<std::string> held_at_initial;
+  // Whether those directions took the value of JointProblemData::cam_from_lidar_guess (else the
+  // start's).
+  bool held_at_guess = false;
   // With free_lidar_drive_roll: the axis in the camera frame (zero: E_l saw all of T_e) and E_l's own
   // angle about it at the end (how far the LiDAR motions alone would roll T_e) [deg].
   Eigen::Vector3d lidar_free_axis_in_cam = Eigen::Vector3d::Zero();

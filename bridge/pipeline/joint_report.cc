@@ -319,6 +319,7 @@ void WriteJointReport(const std::string& directory,
       PriorDeterminedAxes(u, loaded.data.extrinsic_measurements);
   report["unobservable"] = u.unobservable;
   report["held_at_initial"] = summary.held_at_initial;
+  report["held_value"] = summary.held_at_guess ? "rig.json guess" : "start";
   report["hold_thresholds"] = {{"enabled", options.hold_unobservable},
                                {"rotation_deg", options.hold_rotation_deg},
                                {"translation_mm", options.hold_translation_mm}};
@@ -401,7 +402,8 @@ void PrintJointUncertainty(const JointAdjustmentSummary& summary, const std::str
     std::cout << "UNOBSERVABLE: " << sentence << std::endl;
   }
   for (const std::string& direction : summary.held_at_initial) {
-    std::cout << "HELD at the initial value: " << direction << std::endl;
+    std::cout << "HELD at " << (summary.held_at_guess ? "rig.json's guess" : "the initial value")
+              << ": " << direction << std::endl;
   }
 }
 

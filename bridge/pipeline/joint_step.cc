@@ -215,6 +215,9 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   std::cout << "Loaded depth priors, clouds and the pose graph (" << SecondsSince(start) << " s)"
             << std::endl;
   DecideTimeOffset(dataset, profile, loaded.get(), &options);
+  if (options.use_guess && !dataset.rig.cam_from_lidar_guess_sigma) {
+    loaded->data.cam_from_lidar_guess = dataset.rig.cam_from_lidar_guess;
+  }
   const std::optional<VerticalAlignment> vertical = AddExtrinsicMeasurements(
       dataset, vertical_alignment, reconstruction, options, loaded.get(), &cam_from_lidar);
   const JointAdjustmentSummary summary =

@@ -24,6 +24,9 @@ struct JointAdjusterStepOptions {
   // On a moving platform (rig.json), estimate the LiDAR clock's offset from the cameras in E_m
   // (JointAdjusterOptions::estimate_time_offset).
   bool estimate_time_offset = true;
+  // rig.json's guess without a sigma gives the value of the directions the data leave undetermined
+  // (JointProblemData::cam_from_lidar_guess); the pipeline passes its pose initialiser's use_guess.
+  bool use_guess = true;
   // Also write the model as text (cameras.txt, images.txt, points3D.txt).
   bool write_text = false;
   // The capture profile the pose initialiser decided, given in memory by the pipeline that ran it;

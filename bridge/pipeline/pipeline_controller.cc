@@ -142,6 +142,7 @@ std::vector<PipelineStep> BackEndSteps(const WorkspacePaths& paths,
        [=] {
          JointAdjusterStepOptions joint_options = options.joint;
          joint_options.profile = *profile;
+         joint_options.use_guess = options.initializer.use_guess;
          RunJointAdjusterStep(
              clouds(), {paths.database, paths.initial, "", paths.joint}, joint_options);
        }},
