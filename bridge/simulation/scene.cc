@@ -57,12 +57,13 @@ Eigen::Matrix3d RotZ(double yaw) {
   return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
+// `R`: RotZ(box.yaw).
 bool IntersectBox(const Primitive& box,
+                  const Eigen::Matrix3d& R,
                   const Eigen::Vector3d& origin,
                   const Eigen::Vector3d& dir,
                   double* t_hit,
                   Eigen::Vector3d* normal) {
-  const Eigen::Matrix3d R = RotZ(box.yaw);
   const Eigen::Vector3d o = R.transpose() * (origin - box.center);
   const Eigen::Vector3d d = R.transpose() * dir;
   double t_min = -1e300, t_max = 1e300;
@@ -150,6 +151,27 @@ bool IntersectGround(const Primitive& ground,
   return true;
 }
 
+// Whether the ray origin + t dir can meet the box [lower, upper] at some t < max_t (slab test).
+bool MayHitBounds(const Eigen::Vector3d& lower,
+                  const Eigen::Vector3d& upper,
+                  const Eigen::Vector3d& origin,
+                  const Eigen::Vector3d& dir,
+                  double max_t) {
+  double t_min = -1e300, t_max = 1e300;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(dir[i]) < kEps) {
+      if (origin[i] < lower[i] || origin[i] > upper[i]) return false;
+      continue;
+    }
+    double t1 = (lower[i] - origin[i]) / dir[i];
+    double t2 = (upper[i] - origin[i]) / dir[i];
+    if (t1 > t2) std::swap(t1, t2);
+    t_min = std::max(t_min, t1);
+    t_max = std::min(t_max, t2);
+  }
+  return t_min <= t_max && t_max >= 0 && t_min < max_t;
+}
+
 }  // namespace
 
 std::vector<std::string> Scene::Names() {
@@ -204,7 +226,7 @@ void Scene::AddBox(const Eigen::Vector3d& min_corner,
   box.yaw = yaw;
   box.is_object = is_object;
   box.albedo = albedo;
-  primitives_.push_back(box);
+  AddPrimitive(box);
 }
 
 void Scene::AddCylinder(const Eigen::Vector3d& base_center,
@@ -218,7 +240,7 @@ void Scene::AddCylinder(const Eigen::Vector3d& base_center,
   cyl.half_size = Eigen::Vector3d(radius, radius, height / 2);
   cyl.is_object = is_object;
   cyl.albedo = albedo;
-  primitives_.push_back(cyl);
+  AddPrimitive(cyl);
 }
 
 void Scene::AddGround(double half_extent_m, double albedo) {
@@ -227,7 +249,24 @@ void Scene::AddGround(double half_extent_m, double albedo) {
   ground.half_size = Eigen::Vector3d(half_extent_m, half_extent_m, 0);
   ground.albedo = albedo;
   ground.texture_contrast = 0.5;
-  primitives_.push_back(ground);
+  AddPrimitive(ground);
+}
+
+Scene::Frame Scene::FrameOf(const Primitive& primitive) {
+  // Padded beyond rounding, so that every hit of the exact test lies inside.
+  constexpr double kPadding = 1e-6;
+  Frame frame;
+  if (primitive.type == Primitive::Type::kBox) frame.rotation = RotZ(primitive.yaw);
+  const Eigen::Vector3d half_extent =
+      frame.rotation.cwiseAbs() * primitive.half_size + Eigen::Vector3d::Constant(kPadding);
+  frame.lower = primitive.center - half_extent;
+  frame.upper = primitive.center + half_extent;
+  return frame;
+}
+
+void Scene::AddPrimitive(const Primitive& primitive) {
+  primitives_.push_back(primitive);
+  frames_.push_back(FrameOf(primitive));
 }
 
 void Scene::FinishObject() {
@@ -301,6 +340,7 @@ Scene Scene::MovedTo(double time_s) const {
   Scene moved = *this;
   for (const Mover& m : movers_) {
     moved.primitives_[m.primitive].center = m.center_at_zero + time_s * m.velocity;
+    moved.frames_[m.primitive] = FrameOf(moved.primitives_[m.primitive]);
   }
   return moved;
 }
@@ -313,12 +353,14 @@ bool Scene::Intersect(const Eigen::Vector3d& origin,
   hit->primitive = -1;
   for (size_t i = 0; i < primitives_.size(); ++i) {
     const Primitive& p = primitives_[i];
+    const Frame& frame = frames_[i];
+    if (!MayHitBounds(frame.lower, frame.upper, origin, unit_direction, hit->t)) continue;
     double t;
     Eigen::Vector3d normal;
     bool ok = false;
     switch (p.type) {
       case Primitive::Type::kBox:
-        ok = IntersectBox(p, origin, unit_direction, &t, &normal);
+        ok = IntersectBox(p, frame.rotation, origin, unit_direction, &t, &normal);
         break;
       case Primitive::Type::kCylinder:
         ok = IntersectCylinder(p, origin, unit_direction, &t, &normal);
@@ -441,6 +483,7 @@ PointCloud Scene::SampleObjectSurface(double spacing) const {
         if (j == i || !primitives_[j].is_object) continue;
         Scene single;
         single.primitives_ = {primitives_[j]};
+        single.frames_ = {frames_[j]};
         if (single.InsideObject(point, 1e-7)) return;
       }
       cloud.points.push_back(point);

@@ -84,6 +84,17 @@ class Scene {
   void AddStreet();
   void FinishObject();
 
+  // Per primitive, for Intersect: its rotation (RotZ(yaw)) and world-aligned bounds, so that a ray
+  // is tested against a primitive's exact shape only where it passes through its bounds.
+  struct Frame {
+    Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d lower = Eigen::Vector3d::Zero();
+    Eigen::Vector3d upper = Eigen::Vector3d::Zero();
+  };
+  static Frame FrameOf(const Primitive& primitive);
+  // Appends the primitive and its frame.
+  void AddPrimitive(const Primitive& primitive);
+
   struct Mover {
     size_t primitive = 0;
     Eigen::Vector3d center_at_zero = Eigen::Vector3d::Zero();
@@ -93,6 +104,7 @@ class Scene {
 
   std::string name_;
   std::vector<Primitive> primitives_;
+  std::vector<Frame> frames_;  // one per primitive
   Eigen::Vector3d object_center_ = Eigen::Vector3d::Zero();
   double object_radius_ = 1;
   double object_height_ = 1;
