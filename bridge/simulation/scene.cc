@@ -151,27 +151,6 @@ bool IntersectGround(const Primitive& ground,
   return true;
 }
 
-// Whether the ray origin + t dir can meet the box [lower, upper] at some t < max_t (slab test).
-bool MayHitBounds(const Eigen::Vector3d& lower,
-                  const Eigen::Vector3d& upper,
-                  const Eigen::Vector3d& origin,
-                  const Eigen::Vector3d& dir,
-                  double max_t) {
-  double t_min = -1e300, t_max = 1e300;
-  for (int i = 0; i < 3; ++i) {
-    if (std::abs(dir[i]) < kEps) {
-      if (origin[i] < lower[i] || origin[i] > upper[i]) return false;
-      continue;
-    }
-    double t1 = (lower[i] - origin[i]) / dir[i];
-    double t2 = (upper[i] - origin[i]) / dir[i];
-    if (t1 > t2) std::swap(t1, t2);
-    t_min = std::max(t_min, t1);
-    t_max = std::min(t_max, t2);
-  }
-  return t_min <= t_max && t_max >= 0 && t_min < max_t;
-}
-
 }  // namespace
 
 std::vector<std::string> Scene::Names() {
@@ -259,14 +238,29 @@ Scene::Frame Scene::FrameOf(const Primitive& primitive) {
   if (primitive.type == Primitive::Type::kBox) frame.rotation = RotZ(primitive.yaw);
   const Eigen::Vector3d half_extent =
       frame.rotation.cwiseAbs() * primitive.half_size + Eigen::Vector3d::Constant(kPadding);
-  frame.lower = primitive.center - half_extent;
-  frame.upper = primitive.center + half_extent;
+  frame.bounds = {primitive.center - half_extent, primitive.center + half_extent};
   return frame;
 }
 
 void Scene::AddPrimitive(const Primitive& primitive) {
   primitives_.push_back(primitive);
   frames_.push_back(FrameOf(primitive));
+  Index();
+}
+
+void Scene::Index() {
+  bounded_.clear();
+  unbounded_.clear();
+  std::vector<AxisAlignedBox> boxes;
+  for (size_t i = 0; i < primitives_.size(); ++i) {
+    if (primitives_[i].type == Primitive::Type::kGround) {
+      unbounded_.push_back(static_cast<int>(i));
+    } else {
+      bounded_.push_back(static_cast<int>(i));
+      boxes.push_back(frames_[i].bounds);
+    }
+  }
+  hierarchy_ = BoxHierarchy(boxes);
 }
 
 void Scene::FinishObject() {
@@ -342,6 +336,7 @@ Scene Scene::MovedTo(double time_s) const {
     moved.primitives_[m.primitive].center = m.center_at_zero + time_s * m.velocity;
     moved.frames_[m.primitive] = FrameOf(moved.primitives_[m.primitive]);
   }
+  moved.Index();
   return moved;
 }
 
@@ -351,16 +346,15 @@ bool Scene::Intersect(const Eigen::Vector3d& origin,
                       RayHit* hit) const {
   hit->t = max_t;
   hit->primitive = -1;
-  for (size_t i = 0; i < primitives_.size(); ++i) {
+  // The closest hit; of hits at the same distance, the first primitive's.
+  const auto test = [&](int i) {
     const Primitive& p = primitives_[i];
-    const Frame& frame = frames_[i];
-    if (!MayHitBounds(frame.lower, frame.upper, origin, unit_direction, hit->t)) continue;
     double t;
     Eigen::Vector3d normal;
     bool ok = false;
     switch (p.type) {
       case Primitive::Type::kBox:
-        ok = IntersectBox(p, frame.rotation, origin, unit_direction, &t, &normal);
+        ok = IntersectBox(p, frames_[i].rotation, origin, unit_direction, &t, &normal);
         break;
       case Primitive::Type::kCylinder:
         ok = IntersectCylinder(p, origin, unit_direction, &t, &normal);
@@ -369,12 +363,15 @@ bool Scene::Intersect(const Eigen::Vector3d& origin,
         ok = IntersectGround(p, origin, unit_direction, &t, &normal);
         break;
     }
-    if (ok && t < hit->t) {
+    if (ok && (t < hit->t || (t == hit->t && i < hit->primitive))) {
       hit->t = t;
       hit->normal = normal;
-      hit->primitive = static_cast<int>(i);
+      hit->primitive = i;
     }
-  }
+  };
+  for (const int i : unbounded_) test(i);
+  hierarchy_.Traverse(
+      origin, unit_direction, [&] { return hit->t; }, [&](int item) { test(bounded_[item]); });
   return hit->primitive >= 0;
 }
 

@@ -3,6 +3,7 @@
 // Surfaces carry a solid (3D) concrete-like texture, so every view of a point sees the same albedo.
 #pragma once
 
+#include "bridge/simulation/box_hierarchy.h"
 #include "lidar/point_cloud.h"
 
 #include <Eigen/Core>
@@ -84,16 +85,17 @@ class Scene {
   void AddStreet();
   void FinishObject();
 
-  // Per primitive, for Intersect: its rotation (RotZ(yaw)) and world-aligned bounds, so that a ray
-  // is tested against a primitive's exact shape only where it passes through its bounds.
+  // Per primitive, for Intersect: its rotation (RotZ(yaw)) and padded world-aligned bounds, so that
+  // a ray is tested against a primitive's exact shape only where it passes through its bounds.
   struct Frame {
     Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-    Eigen::Vector3d lower = Eigen::Vector3d::Zero();
-    Eigen::Vector3d upper = Eigen::Vector3d::Zero();
+    AxisAlignedBox bounds;
   };
   static Frame FrameOf(const Primitive& primitive);
-  // Appends the primitive and its frame.
+  // Appends the primitive and its frame, and indexes the scene again.
   void AddPrimitive(const Primitive& primitive);
+  // The hierarchy over the bounded primitives (all but the ground planes, tested by every ray).
+  void Index();
 
   struct Mover {
     size_t primitive = 0;
@@ -105,6 +107,9 @@ class Scene {
   std::string name_;
   std::vector<Primitive> primitives_;
   std::vector<Frame> frames_;  // one per primitive
+  BoxHierarchy hierarchy_;
+  std::vector<int> bounded_;    // the primitive of each item of hierarchy_
+  std::vector<int> unbounded_;  // the ground planes
   Eigen::Vector3d object_center_ = Eigen::Vector3d::Zero();
   double object_radius_ = 1;
   double object_height_ = 1;
