@@ -529,19 +529,41 @@ std::map<const double*, std::string> ParameterNames(const RunState& state) {
 }
 
 // Ceres marks a step invalid when its linear solver fails (a normal matrix that is not positive
-// definite) or the step cannot be evaluated; LM then retries with more damping. A failed step on a
-// problem that leaves parameters undetermined is an error naming them: the damping would only
-// move them by an amount nothing in the data decides.
-void StopIfUndetermined(const RunState& state, ceres::Problem* problem, int invalid_steps) {
-  const std::vector<std::string> undetermined =
-      UndeterminedParameters(problem, ParameterNames(state));
-  if (undetermined.empty()) {
-    std::cout << "WARNING: " << invalid_steps
-              << " steps of the solve failed (linear solver or evaluation); the problem's normal "
-                 "matrix is positive definite at its end"
-              << std::endl;
-    return;
+// definite) or the step cannot be evaluated; LM then retries with more damping. After a solve with
+// failed steps the problem's undetermined parameters are found: landmarks the data do not determine
+// (a track whose rays are nearly parallel) are returned, to leave the reconstruction as COLMAP
+// filters such points; any other undetermined parameter (a pose, cam_from_lidar, the clock offset)
+// is an error naming them: the damping would only move them by an amount nothing in the data
+// decides.
+std::vector<colmap::point3D_t> UndeterminedLandmarks(const RunState& state,
+                                                     ceres::Problem* problem,
+                                                     int invalid_steps) {
+  const std::vector<UndeterminedBlock> blocks = UndeterminedBlocks(problem);
+  std::map<const double*, colmap::point3D_t> landmark_of_block;
+  for (const auto& [point3D_id, point3D] : state.reconstruction->Points3D()) {
+    landmark_of_block[point3D.xyz.data()] = point3D_id;
   }
+  std::vector<colmap::point3D_t> landmarks;
+  std::vector<UndeterminedBlock> others;
+  for (const UndeterminedBlock& block : blocks) {
+    const auto landmark = landmark_of_block.find(block.block);
+    if (landmark != landmark_of_block.end()) {
+      landmarks.push_back(landmark->second);
+    } else {
+      others.push_back(block);
+    }
+  }
+  if (others.empty()) {
+    std::cout << "WARNING: " << invalid_steps
+              << " steps of the solve failed (linear solver or evaluation); "
+              << (landmarks.empty() ? "the problem's normal matrix is positive definite at its end"
+                                    : std::to_string(landmarks.size()) +
+                                          " landmark(s) the data do not determine leave the "
+                                          "reconstruction")
+              << std::endl;
+    return landmarks;
+  }
+  const std::vector<std::string> undetermined = DescribeUndetermined(others, ParameterNames(state));
   std::ostringstream message;
   message << "the joint problem's normal matrix is not positive definite (" << invalid_steps
           << " failed steps): the data do not determine";
@@ -561,7 +583,10 @@ int NumInvalidSteps(const ceres::Solver::Summary& summary) {
   return invalid;
 }
 
-SolveStats Solve(const RunState& state, JointProblem* joint) {
+// `undetermined_landmarks`: those to leave the reconstruction (UndeterminedLandmarks).
+SolveStats Solve(const RunState& state,
+                 JointProblem* joint,
+                 std::vector<colmap::point3D_t>* undetermined_landmarks) {
   ceres::Problem* problem = joint->problem.get();
   SolveStats stats;
   stats.reprojection.num_observations = joint->reprojection_ids.size();
@@ -586,7 +611,9 @@ SolveStats Solve(const RunState& state, JointProblem* joint) {
   stats.residuals = static_cast<size_t>(summary.num_residuals);
   stats.termination = ceres::TerminationTypeToString(summary.termination_type);
   stats.invalid_steps = NumInvalidSteps(summary);
-  if (stats.invalid_steps > 0) StopIfUndetermined(state, problem, stats.invalid_steps);
+  if (stats.invalid_steps > 0) {
+    *undetermined_landmarks = UndeterminedLandmarks(state, problem, stats.invalid_steps);
+  }
   return stats;
 }
 
@@ -822,11 +849,15 @@ void SolveWithOutliers(int round,
   for (int iteration = 0; iteration < state->options.max_outlier_iterations; ++iteration) {
     const auto start = std::chrono::steady_clock::now();
     std::unique_ptr<JointProblem> joint = BuildProblem(*state, *associations);
-    SolveStats stats = Solve(*state, joint.get());
+    std::vector<colmap::point3D_t> undetermined;
+    SolveStats stats = Solve(*state, joint.get(), &undetermined);
     joint.reset();  // before the reconstruction changes under it
+    for (const colmap::point3D_t point3D_id : undetermined) {
+      state->reconstruction->DeletePoint3D(point3D_id);
+    }
     stats.round = round + 1;
     stats.outlier_iteration = iteration + 1;
-    size_t changes = RemoveReprojectionOutliers(state);
+    size_t changes = undetermined.size() + RemoveReprojectionOutliers(state);
     changes += UpdateDepthOutliers(state, &stats.depth_outliers);
     changes += FlagLidarOutliers(state, &associations->lidar);
     changes += FlagLandmarkOutliers(state, &associations->landmarks);

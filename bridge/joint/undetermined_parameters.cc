@@ -54,25 +54,37 @@ std::string BlockName(const std::map<const double*, std::string>& names,
 
 }  // namespace
 
-std::vector<std::string> UndeterminedParameters(ceres::Problem* problem,
-                                                const std::map<const double*, std::string>& names) {
+std::vector<UndeterminedBlock> UndeterminedBlocks(ceres::Problem* problem) {
   const ProblemColumns columns = FreeColumns(problem);
   if (columns.blocks.empty()) return {};
-  const std::vector<int> dependent = DependentColumns(NormalMatrix(problem, columns));
-  // Per block, its dependent tangent coordinates (`dependent` is ascending).
-  std::map<int, std::string> coordinates;
-  for (const int column : dependent) {
+  std::vector<UndeterminedBlock> blocks;
+  for (const int column : DependentColumns(NormalMatrix(problem, columns))) {  // ascending
     const int block = columns.block_of_column[column];
-    std::string& list = coordinates[block];
-    list += (list.empty() ? "" : ", ") + std::to_string(column - columns.first_column[block]);
+    if (blocks.empty() || blocks.back().index != block) {
+      blocks.push_back({columns.blocks[block], block, columns.size[block], {}});
+    }
+    blocks.back().coordinates.push_back(column - columns.first_column[block]);
   }
+  return blocks;
+}
+
+std::vector<std::string> DescribeUndetermined(const std::vector<UndeterminedBlock>& blocks,
+                                              const std::map<const double*, std::string>& names) {
   std::vector<std::string> undetermined;
-  for (const auto& [block, list] : coordinates) {
-    undetermined.push_back(BlockName(names, columns.blocks[block], block) +
-                           " (tangent coordinates " + list + " of " +
-                           std::to_string(columns.size[block]) + ")");
+  for (const UndeterminedBlock& block : blocks) {
+    std::string list;
+    for (const int coordinate : block.coordinates) {
+      list += (list.empty() ? "" : ", ") + std::to_string(coordinate);
+    }
+    undetermined.push_back(BlockName(names, block.block, block.index) + " (tangent coordinates " +
+                           list + " of " + std::to_string(block.tangent_size) + ")");
   }
   return undetermined;
+}
+
+std::vector<std::string> UndeterminedParameters(ceres::Problem* problem,
+                                                const std::map<const double*, std::string>& names) {
+  return DescribeUndetermined(UndeterminedBlocks(problem), names);
 }
 
 }  // namespace colmap_lidar

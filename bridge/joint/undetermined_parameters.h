@@ -27,9 +27,24 @@ inline constexpr double kMaxRelativePivot = 1e-10;
 std::vector<int> DependentColumns(const Eigen::SparseMatrix<double>& normal_matrix,
                                   double max_relative_pivot = kMaxRelativePivot);
 
-// The undetermined coordinates of `problem`'s free parameter blocks at their current values, one
-// entry per block: "<name> (tangent coordinates 0, 2 of 3)". `names` names the blocks; a block
+// A free parameter block of a problem with undetermined tangent coordinates.
+struct UndeterminedBlock {
+  const double* block = nullptr;
+  int index = 0;  // among the problem's free blocks
+  int tangent_size = 0;
+  std::vector<int> coordinates;  // ascending
+};
+
+// The free parameter blocks of `problem` with undetermined coordinates at their current values, in
+// the order of the problem's free blocks.
+std::vector<UndeterminedBlock> UndeterminedBlocks(ceres::Problem* problem);
+
+// One entry per block: "<name> (tangent coordinates 0, 2 of 3)". `names` names the blocks; a block
 // without a name is "parameter block <index>".
+std::vector<std::string> DescribeUndetermined(const std::vector<UndeterminedBlock>& blocks,
+                                              const std::map<const double*, std::string>& names);
+
+// DescribeUndetermined(UndeterminedBlocks(problem), names).
 std::vector<std::string> UndeterminedParameters(ceres::Problem* problem,
                                                 const std::map<const double*, std::string>& names);
 

@@ -84,5 +84,21 @@ TEST(UndeterminedParameters, AnUnnamedBlockIsNamedByItsIndex) {
   EXPECT_EQ(named[0].rfind("parameter block ", 0), 0u) << named[0];
 }
 
+// The blocks come with their pointers (so that a caller can act on them, e.g. remove a landmark)
+// and the same description.
+TEST(UndeterminedParameters, BlocksCarryTheirPointerCoordinatesAndSize) {
+  double x[2] = {0, 0}, y[1] = {0};
+  ceres::Problem problem;
+  problem.AddResidualBlock(
+      new ceres::AutoDiffCostFunction<SumResidual, 2, 2, 1>(new SumResidual), nullptr, x, y);
+  const std::vector<UndeterminedBlock> blocks = UndeterminedBlocks(&problem);
+  ASSERT_EQ(blocks.size(), 1u);
+  EXPECT_TRUE(blocks[0].block == x || blocks[0].block == y);
+  EXPECT_EQ(blocks[0].coordinates, std::vector<int>{0});
+  EXPECT_EQ(blocks[0].tangent_size, blocks[0].block == x ? 2 : 1);
+  EXPECT_EQ(DescribeUndetermined(blocks, {{x, "x"}, {y, "y"}}),
+            UndeterminedParameters(&problem, {{x, "x"}, {y, "y"}}));
+}
+
 }  // namespace
 }  // namespace colmap_lidar
