@@ -152,7 +152,8 @@ struct JointAdjusterOptions {
   double extrinsic_prior_sigma_m = 1.0;
   // Never drift: when the solve finds directions of T_e unobservable (their standard deviation above
   // hold_rotation_deg / hold_translation_mm), the adjustment runs again from the initial state with
-  // those directions held at their initial value (bridge/joint/extrinsic_deviation_cost.h); the
+  // those directions held, at JointProblemData::cam_from_lidar_guess along them if there is one, else
+  // at their initial value (T_e's manifolds without them, bridge/joint/subspace_manifold.h); the
   // report names them.
   bool hold_unobservable = true;
   // Above the reporting thresholds of `observability` (5 mm / 0.2 deg: "not calibrated to that"): a
@@ -269,7 +270,7 @@ struct JointAdjustmentSummary {
   ExtrinsicUncertainty uncertainty;
   MotionAnalysis motion;
   std::vector<PerturbationCurve> perturbation;
-  // Directions of T_e held at their initial value after a first solve found them unobservable (empty:
+  // Directions of T_e held (hold_unobservable) after a first solve found them unobservable (empty:
   // none); the solves of that first pass are in `solves` too, before those of the held pass.
   std::vector<std::string> held_at_initial;
   // Whether those directions took the value of JointProblemData::cam_from_lidar_guess (else the
