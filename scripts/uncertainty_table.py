@@ -16,9 +16,8 @@ FAMILIES = {
                    'each, full-resolution images; hand-eye initialisation without a guess'),
     'bridge_pier': ('tripod', 'the bridge pier, as the T specimen'),
     'street_drive': ('drive', 'the simulated street drive, one camera, 40 frames, 120000 rays per '
-                     'sweep, no guess; the pipeline with sequential matching (de-skewed sweeps; '
-                     'the LiDAR points that neighbouring sweeps see through, on the two driving '
-                     'cars, left out; their image features are not)'),
+                     'sweep, no guess; the pipeline with sequential matching (de-skewed sweeps, '
+                     'moving cars left out)'),
     'street_drive_stereo': ('drive', 'the same drive with the second camera (stereo depth, depth '
                             'priors, the stereo-LiDAR alignment of the pose initialiser)'),
     'kitti_layout_drive': ('drive', '20 frames of the street drive in KITTI raw\'s layout (one '
