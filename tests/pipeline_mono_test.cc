@@ -170,7 +170,7 @@ TEST(PipelineMonoTest, KittiLayoutDriveHoldsWhatItCannotSee) {
 // weight 1, its variance factor estimated) observe the rest, and the association rounds continue while
 // cam_from_lidar still moves; the vertical alignment (walls and vertical image edges) measures the
 // roll about the driving direction and the pitch (docs/mono.md). Measured (seed 0, deterministic):
-// 0.029 deg, 9.1 mm; bounds about 3x. The spread over seeds is scripts/benchmark_uncertainty.sh's
+// 0.027 deg, 7.9 mm; bounds about 3x. The spread over seeds is scripts/benchmark_uncertainty.sh's
 // (SCENES=street_drive).
 TEST(PipelineMonoTest, FortyFrameDriveCalibratesWithoutAGuess) {
   testing::ScopedTempDir dir;
