@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 namespace colmap_lidar {
 namespace {
@@ -86,8 +87,11 @@ ExtrinsicMeasurement GuessPrior(const StationRig& rig) {
 // the landmarks on the LiDAR surfaces. Not for tripod stations: there the tool asks for tilted stations,
 // since E_m on unrotated stations ends far from the truth with a small reported sigma. Off (the
 // paper's cost) otherwise.
-// Its weight is 1: its variance factor is estimated with the others', and the errors its landmarks
-// share along a drive enter the covariance through its clusters (docs/joint_adjuster.md).
+// Its weight on such a moving platform is kMovingPlatformLandmarkWeight, 1 on tripods: along a
+// drive the landmarks' errors are shared (an E_m solve moved the roll by 0.12 deg through its
+// associations alone, and the roll's error kept its sign over runs), so E_m counts for less than its
+// number of residuals (docs/joint_adjuster.md).
+constexpr double kMovingPlatformLandmarkWeight = 0.25;
 
 // In joint mode: rig.json's guess with a sigma as a prior, and with `vertical_alignment` the vertical
 // alignment (which the start then takes when significant). Returns the vertical alignment if it ran.
@@ -132,10 +136,14 @@ bool DecideFromMotion(const StationDataset& dataset,
   const MotionAnalysis motion = AnalyseMotion(reconstruction, adjuster->observability);
   const bool degenerate_motion = profile.rotation == StationRotation::kOneAxis ||
                                  (!motion.unique && profile.platform == Platform::kMoving);
-  adjuster->landmark_lidar_weight = degenerate_motion || !dataset.rig.IsStereo() ? 1.0 : 0.0;
+  adjuster->landmark_lidar_weight =
+      degenerate_motion ? kMovingPlatformLandmarkWeight : (dataset.rig.IsStereo() ? 0.0 : 1.0);
   if (degenerate_motion) {
+    std::ostringstream weight;  // std::cout may hold a fixed precision of 1
+    weight << kMovingPlatformLandmarkWeight;
     std::cout << "A moving platform whose stations do not rotate about two axes (" << motion.verdict
-              << "): the landmark-to-LiDAR-plane term is on" << std::endl;
+              << "): the landmark-to-LiDAR-plane term is on (weight " << weight.str() << ")"
+              << std::endl;
   }
   return degenerate_motion;
 }
