@@ -19,13 +19,13 @@ function(colmap_lidar_add_library)
 endfunction()
 
 # colmap_lidar_add_test(NAME module/name SOURCES a_test.cc LINKS lib... [FILTER gtest_filter]
-#                       [LABEL unit|integration|slow] [COST seconds]
+#                       [LABEL unit|integration|slow] [COST seconds] [TIMEOUT seconds]
 #                       [FIXTURES_SETUP name] [FIXTURES_REQUIRED name])
 # builds one GoogleTest executable and registers its test cases (those matching FILTER, default all) in
 # ctest under the given name prefix, each case a ctest test; colmap_lidar_discover_tests registers
 # further cases of the same executable with other properties.
 function(colmap_lidar_add_test)
-  cmake_parse_arguments(ARG "" "NAME;COST;LABEL;FILTER;FIXTURES_SETUP;FIXTURES_REQUIRED"
+  cmake_parse_arguments(ARG "" "NAME;COST;LABEL;FILTER;TIMEOUT;FIXTURES_SETUP;FIXTURES_REQUIRED"
                         "SOURCES;LINKS" ${ARGN})
   if(ARG_LABEL STREQUAL "slow" AND COLMAP_LIDAR_SKIP_SLOW_TESTS)
     return()
@@ -43,16 +43,19 @@ function(colmap_lidar_add_test)
 endfunction()
 
 # colmap_lidar_discover_tests(TARGET exe NAME module/name [FILTER ...] [LABEL ...] [COST ...]
-#                             [FIXTURES_SETUP name] [FIXTURES_REQUIRED name])
+#                             [TIMEOUT seconds] [FIXTURES_SETUP name] [FIXTURES_REQUIRED name])
 # LABEL (default unit): `ctest -L unit` runs the tests beside the sources; `ctest -LE slow` the quick
 # set. COST: CTest starts costlier tests first under -j, so that a long test does not run alone at the
 # end (a clean checkout has no timing history to order by). FIXTURES_*: CTest fixtures, for tests that
 # read what another test built (it runs first, once).
 function(colmap_lidar_discover_tests)
-  cmake_parse_arguments(ARG "" "TARGET;NAME;COST;LABEL;FILTER;FIXTURES_SETUP;FIXTURES_REQUIRED"
+  cmake_parse_arguments(ARG "" "TARGET;NAME;COST;LABEL;FILTER;TIMEOUT;FIXTURES_SETUP;FIXTURES_REQUIRED"
                         "SOURCES;LINKS" ${ARGN})
   if(NOT ARG_COST)
     set(ARG_COST 0)
+  endif()
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 1200)
   endif()
   if(NOT ARG_LABEL)
     set(ARG_LABEL unit)
@@ -73,7 +76,7 @@ function(colmap_lidar_discover_tests)
   # Two tests share two cores under `ctest -j2`: OpenMP threads that wait sleep instead of spinning.
   gtest_discover_tests(${ARG_TARGET} TEST_PREFIX "${ARG_NAME}/" TEST_FILTER "${ARG_FILTER}"
                        DISCOVERY_TIMEOUT 60
-                       PROPERTIES TIMEOUT 1200 COST ${ARG_COST} LABELS ${ARG_LABEL}
+                       PROPERTIES TIMEOUT ${ARG_TIMEOUT} COST ${ARG_COST} LABELS ${ARG_LABEL}
                                   ENVIRONMENT OMP_WAIT_POLICY=PASSIVE ${fixtures})
 endfunction()
 
