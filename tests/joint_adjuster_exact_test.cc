@@ -327,7 +327,7 @@ TEST(JointAdjusterExactTest, UndeterminedDirectionIsHeldAtTheGuess) {
   options.num_association_rounds = 2;
   options.max_association_rounds = 2;
   const JointAdjustmentSummary summary = RunOn(problem.get(), options);
-  ASSERT_EQ(summary.held_at_initial.size(), 1u);
+  ASSERT_EQ(summary.held_directions.size(), 1u);
   EXPECT_TRUE(summary.held_at_guess);
   const Eigen::Matrix<double, 6, 1> error =
       testing::ExtrinsicError(problem->cam_from_lidar, problem->true_cam_from_lidar);

@@ -73,10 +73,12 @@ void AddJointAdjusterOptions(const std::string& prefix,
       "camera axes of cam_from_lidar's translation held at their start, e.g. y or x,z");
   add.Add("hold_rotation_deg",
           &adjuster.hold_rotation_deg,
-          "sigma above which a rotation direction is held at its start and named undetermined");
+          "sigma above which a rotation direction is held (at rig.json's guess, else at its start) "
+          "and named undetermined");
   add.Add("hold_translation_mm",
           &adjuster.hold_translation_mm,
-          "sigma above which a translation direction is held at its start and named undetermined");
+          "sigma above which a translation direction is held (at rig.json's guess, else at its "
+          "start) and named undetermined");
   add.Add("write_text", &options->write_text, "also write cameras.txt, images.txt, points3D.txt");
 }
 

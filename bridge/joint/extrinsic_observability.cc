@@ -505,7 +505,7 @@ void NameUndetermined(const ExtrinsicUncertaintyInputs& inputs,
     for (int k = 0; k < directions.cols(); ++k) {
       sentences.push_back((block == 0 ? "rotation about " : "translation along ") +
                           DescribeAxis(directions.col(k)) +
-                          " is unobservable (held at its start, no sigma): " + Advice(motion));
+                          " is unobservable (held, no sigma): " + Advice(motion));
     }
     for (int axis = 0; axis < 3; ++axis) {
       result->undetermined[3 * block + axis] = held(axis, axis) > 0.5;

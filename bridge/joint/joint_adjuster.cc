@@ -1300,7 +1300,7 @@ JointAdjustmentSummary JointAdjuster::Run(const JointProblemData& data,
                              : initial_extrinsic;
   JointAdjustmentSummary held_summary =
       RunOnce(data, reconstruction, cam_from_lidar, held.rotation, held.translation);
-  held_summary.held_at_initial = held.names;
+  held_summary.held_directions = held.names;
   held_summary.held_at_guess = at_guess;
   held_summary.solves.insert(
       held_summary.solves.begin(), summary.solves.begin(), summary.solves.end());

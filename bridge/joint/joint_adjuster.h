@@ -272,7 +272,7 @@ struct JointAdjustmentSummary {
   std::vector<PerturbationCurve> perturbation;
   // Directions of T_e held (hold_unobservable) after a first solve found them unobservable (empty:
   // none); the solves of that first pass are in `solves` too, before those of the held pass.
-  std::vector<std::string> held_at_initial;
+  std::vector<std::string> held_directions;
   // Whether those directions took the value of JointProblemData::cam_from_lidar_guess (else the
   // start's).
   bool held_at_guess = false;

@@ -318,7 +318,7 @@ void WriteJointReport(const std::string& directory,
   report["uncertainty"]["prior_determined_axes"] =
       PriorDeterminedAxes(u, loaded.data.extrinsic_measurements);
   report["unobservable"] = u.unobservable;
-  report["held_at_initial"] = summary.held_at_initial;
+  report["held_directions"] = summary.held_directions;
   report["held_value"] = summary.held_at_guess ? "rig.json guess" : "start";
   report["hold_thresholds"] = {{"enabled", options.hold_unobservable},
                                {"rotation_deg", options.hold_rotation_deg},
@@ -401,7 +401,7 @@ void PrintJointUncertainty(const JointAdjustmentSummary& summary, const std::str
   for (const std::string& sentence : summary.uncertainty.unobservable) {
     std::cout << "UNOBSERVABLE: " << sentence << std::endl;
   }
-  for (const std::string& direction : summary.held_at_initial) {
+  for (const std::string& direction : summary.held_directions) {
     std::cout << "HELD at " << (summary.held_at_guess ? "rig.json's guess" : "the initial value")
               << ": " << direction << std::endl;
   }
