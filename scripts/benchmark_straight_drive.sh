@@ -20,6 +20,17 @@ readonly kPixelSamples="${PIXEL_SAMPLES:-4}"
 results="$work/results.tsv"
 : > "$results"
 
+# simulate RIG SEED MONO: the drive of that seed with rig.json's guess into $work/RIG-SEED-dataset
+# (once; both runs of the seed copy it, the run without a guess dropping the guess from rig.json).
+simulate() {
+  local data="$work/$1-$2-dataset"
+  [ -d "$data" ] || "$cli" simulate_dataset --scene street --motion straight_drive \
+    --mono "$3" --seed "$2" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 \
+    --write_guess 1 --guess_rotation_deg "${GUESS_DEG:-2}" \
+    --guess_translation_m "${GUESS_M:-0.05}" --pixel_samples "$kPixelSamples" \
+    --output_path "$data" > "$data.log" 2>&1
+}
+
 # run RIG SEED GUESS (0|1): simulation and the pipeline into $work/RIG-SEED-guessGUESS; appends the
 # start's and the result's errors to the results.
 run() {
@@ -27,11 +38,13 @@ run() {
   local dir="$work/$rig-$seed-guess$guess" mono=1
   [ "$rig" = stereo ] && mono=0
   echo "[$rig $seed, guess $guess] simulation and pipeline ..."
-  [ -d "$dir/dataset" ] || "$cli" simulate_dataset --scene street --motion straight_drive \
-    --mono "$mono" --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 \
-    --write_guess "$guess" --guess_rotation_deg "${GUESS_DEG:-2}" \
-    --guess_translation_m "${GUESS_M:-0.05}" --pixel_samples "$kPixelSamples" \
-    --output_path "$dir/dataset" > "$dir.log" 2>&1
+  simulate "$rig" "$seed" "$mono"
+  if [ ! -d "$dir/dataset" ]; then
+    mkdir -p "$dir" && cp -r "$work/$rig-$seed-dataset" "$dir/dataset"
+    [ "$guess" = 1 ] || python3 -c 'import json, sys
+rig = json.load(open(sys.argv[1])); rig.pop("cam_from_lidar_guess")
+json.dump(rig, open(sys.argv[1], "w"), indent=2)' "$dir/dataset/rig.json"
+  fi
   if [ ! -f "$dir/ws/sparse/joint/cam_from_lidar.txt" ] &&
       ! "$cli" pipeline --dataset_path "$dir/dataset" --workspace_path "$dir/ws" \
         --Import.matcher sequential >> "$dir.log" 2>&1; then

@@ -181,6 +181,23 @@ TEST(JointAdjusterTest, DefaultSceneWithNoise) {
   EXPECT_LT(joint.evaluation.mean_position_error_mm, stereo_only.evaluation.mean_position_error_mm);
   EXPECT_TRUE(fs::exists(dir.File("joint/perturbation_rotation.png")));
   EXPECT_TRUE(fs::exists(dir.File("joint/cost.png")));
+  // The curves per term: the total less E_l, E_m and E_x is the rest, which does not depend on
+  // cam_from_lidar; E_l grows away from the optimum along every parameter.
+  for (const nlohmann::json& curve : joint.report["perturbation"]) {
+    const auto& costs = curve["costs"];
+    const auto rest = [&](size_t k) {
+      return costs[k].get<double>() - curve["lidar_costs"][k].get<double>() -
+             curve["landmark_lidar_costs"][k].get<double>() -
+             curve["extrinsic_costs"][k].get<double>();
+    };
+    const size_t middle = costs.size() / 2;
+    for (size_t k = 0; k < costs.size(); ++k) {
+      EXPECT_NEAR(rest(k), rest(0), 1e-6 * costs[k].get<double>()) << curve["parameter"];
+    }
+    EXPECT_GT(curve["lidar_costs"][0].get<double>(), curve["lidar_costs"][middle].get<double>());
+    EXPECT_GT(curve["lidar_costs"][costs.size() - 1].get<double>(),
+              curve["lidar_costs"][middle].get<double>());
+  }
 }
 
 // Results do not depend on the thread count: OpenMP's (associations) and Ceres' (the solves).

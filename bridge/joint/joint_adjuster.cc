@@ -1026,9 +1026,11 @@ std::vector<PerturbationCurve> PerturbationCurves(const RunState& state, JointPr
                                   optimum.rotation;
       }
       curve.offsets.push_back(offset);
-      curve.costs.push_back(rest + TermCost(problem, joint->lidar_ids) +
-                            TermCost(problem, joint->landmark_ids) +
-                            TermCost(problem, joint->measurement_ids));
+      curve.lidar_costs.push_back(TermCost(problem, joint->lidar_ids));
+      curve.landmark_lidar_costs.push_back(TermCost(problem, joint->landmark_ids));
+      curve.extrinsic_costs.push_back(TermCost(problem, joint->measurement_ids));
+      curve.costs.push_back(rest + curve.lidar_costs.back() + curve.landmark_lidar_costs.back() +
+                            curve.extrinsic_costs.back());
     }
     curves.push_back(curve);
   }

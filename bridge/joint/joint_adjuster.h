@@ -257,6 +257,9 @@ struct PerturbationCurve {
   std::vector<double> offsets;
   // Total cost, everything else at the optimum.
   std::vector<double> costs;
+  // The terms that depend on T_e, each on its own: E_l, E_m and E_x (the rest is constant). Their
+  // slopes at the optimum say which term pulls T_e which way along the parameter.
+  std::vector<double> lidar_costs, landmark_lidar_costs, extrinsic_costs;
 };
 
 struct JointAdjustmentSummary {

@@ -327,8 +327,12 @@ void WriteJointReport(const std::string& directory,
   report["observability_verdict"] = ObservabilityVerdict(options, summary);
   nlohmann::json curves = nlohmann::json::array();
   for (const PerturbationCurve& curve : summary.perturbation) {
-    curves.push_back(
-        {{"parameter", curve.parameter}, {"offsets", curve.offsets}, {"costs", curve.costs}});
+    curves.push_back({{"parameter", curve.parameter},
+                      {"offsets", curve.offsets},
+                      {"costs", curve.costs},
+                      {"lidar_costs", curve.lidar_costs},
+                      {"landmark_lidar_costs", curve.landmark_lidar_costs},
+                      {"extrinsic_costs", curve.extrinsic_costs}});
   }
   report["perturbation"] = curves;
   WriteFileAtomically(directory + "/report.json", report.dump(2) + "\n");
@@ -358,15 +362,17 @@ void WriteJointPlots(const std::string& directory,
 
   std::ostringstream csv;
   csv << "# total cost with one cam_from_lidar parameter perturbed around the "
-         "optimum (x y z in mm, roll pitch yaw in deg about the camera axes)\n"
-      << "parameter,offset,cost\n";
+         "optimum (x y z in mm, roll pitch yaw in deg about the camera axes), and the terms that "
+         "depend on it: LiDAR-to-LiDAR (E_l), landmark-to-LiDAR (E_m), extrinsic prior (E_x)\n"
+      << "parameter,offset,cost,lidar,landmark_lidar,extrinsic\n";
   std::vector<PlotSeries> translation, rotation;
   for (const PerturbationCurve& curve : summary.perturbation) {
     PlotSeries series{curve.parameter, curve.offsets, curve.costs};
     (curve.parameter.size() == 1 ? translation : rotation).push_back(series);
     for (size_t k = 0; k < curve.offsets.size(); ++k) {
       csv << curve.parameter << "," << curve.offsets[k] << "," << std::setprecision(10)
-          << curve.costs[k] << "\n";
+          << curve.costs[k] << "," << curve.lidar_costs[k] << "," << curve.landmark_lidar_costs[k]
+          << "," << curve.extrinsic_costs[k] << "\n";
     }
   }
   WriteFileAtomically(directory + "/perturbation.csv", csv.str());
