@@ -89,6 +89,31 @@ def main():
             print('| %s | %s | %d | %d | %d | %d |' % (rig, 'guess' if guess == '1' else 'none',
                                                       counts[0], num_failed, counts[1],
                                                       counts[2]))
+    start_dependence(runs)
+
+
+def start_dependence(runs):
+    """Both runs of a seed share the data; their results' difference per axis, over the mean of
+    their sigmas, says how far the result depends on where the adjustment starts."""
+    print('\n## Same data, two starts\n')
+    print('Both runs of a seed use the same simulated drive (rig.json differs only by the guess). '
+          'Per axis: the result with the guess minus the result without, over the mean of the two '
+          'reported sigmas. A result that depended only on the data would differ by far less than '
+          'one sigma.\n')
+    print('| rig | seed | ' + ' | '.join('diff ' + a for a in AXES) + ' | ' +
+          ' | '.join('diff/sigma ' + a for a in AXES) + ' |')
+    print('|' + '---|' * 14)
+    for rig, seed in sorted({(key[0], key[1]) for key in runs}):
+        pair = [runs.get((rig, seed, guess), {}).get('result') for guess in ('0', '1')]
+        if None in pair:
+            continue
+        diff = [b - a for a, b in zip(pair[0][:6], pair[1][:6])]
+        sigma = [(a + b) / 2 for a, b in zip(pair[0][6:12], pair[1][6:12])]
+        ratio = [d / s if s > 0 else float('nan') for d, s in zip(diff, sigma)]
+        digits = [4] * 3 + [1] * 3
+        print('| %s | %s | ' % (rig, seed) +
+              ' | '.join(number(v, d) for v, d in zip(diff, digits)) + ' | ' +
+              ' | '.join(number(v, 1) for v in ratio) + ' |')
 
 
 if __name__ == '__main__':
