@@ -196,9 +196,9 @@ TEST(PipelineMonoTest, FortyFrameDriveCalibratesWithoutAGuess) {
   EXPECT_TRUE(report["vertical_alignment"]["valid"].get<bool>()) << report["vertical_alignment"];
   EXPECT_GE(report["vertical_alignment"]["stations"].size(), 35u);
   // The densifier fills from the sweeps alone (their scan lines are decimetres apart: the LiDAR
-  // surface grows its neighbourhoods). Measured 4.75 M pixels over the 40 images (25 %); 12 k before
-  // the growth. This drive comes through the KITTI layout, which has no true depth maps; the
-  // simulator's own layout gives the error (evaluate_dense_depth; seed 1: median 6.1 mm).
+  // surface grows its neighbourhoods). Measured 4.75 M pixels over the 40 images (25 %). This drive
+  // comes through the KITTI layout, which has no true depth maps; the simulator's own layout gives
+  // the error (evaluate_dense_depth).
   const nlohmann::json densifier = ReadJson(dir.File("ws/dense/densifier.json"));
   size_t filled = 0;
   for (const nlohmann::json& station : densifier["stations"])
