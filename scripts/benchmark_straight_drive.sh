@@ -40,10 +40,13 @@ run() {
   echo "[$rig $seed, guess $guess] simulation and pipeline ..."
   simulate "$rig" "$seed" "$mono"
   if [ ! -d "$dir/dataset" ]; then
-    mkdir -p "$dir" && cp -r "$work/$rig-$seed-dataset" "$dir/dataset"
-    [ "$guess" = 1 ] || python3 -c 'import json, sys
+    # Hard links, not copies of the images and sweeps; rig.json is replaced, never written through
+    # its link.
+    mkdir -p "$dir" && cp -rl "$work/$rig-$seed-dataset" "$dir/dataset"
+    [ "$guess" = 1 ] || python3 -c 'import json, os, sys
 rig = json.load(open(sys.argv[1])); rig.pop("cam_from_lidar_guess")
-json.dump(rig, open(sys.argv[1], "w"), indent=2)' "$dir/dataset/rig.json"
+json.dump(rig, open(sys.argv[1] + ".new", "w"), indent=2); os.replace(sys.argv[1] + ".new", sys.argv[1])' \
+      "$dir/dataset/rig.json"
   fi
   if [ ! -f "$dir/ws/sparse/joint/cam_from_lidar.txt" ] &&
       ! "$cli" pipeline --dataset_path "$dir/dataset" --workspace_path "$dir/ws" \
