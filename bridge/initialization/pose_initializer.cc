@@ -4,15 +4,14 @@
 #include "bridge/initialization/lidar_registration_files.h"
 #include "bridge/initialization/model_completion.h"
 #include "bridge/initialization/pose_graph_checks.h"
+#include "bridge/initialization/track_triangulation.h"
 #include "colmap_ext/logging.h"
 #include "colmap_ext/rigid3_isometry.h"
 #include "lidar/pose_graph.h"
 #include "lidar/util/statistics.h"
 
-#include "colmap/controllers/incremental_mapper.h"
 #include "colmap/estimators/cost_functions.h"
 #include "colmap/scene/database.h"
-#include "colmap/scene/reconstruction_manager.h"
 
 #include <ceres/ceres.h>
 
@@ -598,63 +597,16 @@ PoseInitialization InitializeMonocular(const std::string& database_path,
 }
 
 void TriangulateInitialModel(const std::string& database_path,
-                             const std::string& image_path,
                              const PoseInitialization& initialization,
                              const std::string& output_path) {
-  auto reconstruction = std::make_shared<colmap::Reconstruction>();
-  std::vector<colmap::Image> without_correspondences;
-  {
-    const colmap::Database database(database_path);
-    for (const colmap::Camera& camera : database.ReadAllCameras()) {
-      const auto given = initialization.cameras.find(camera.camera_id);
-      reconstruction->AddCamera(given == initialization.cameras.end() ? camera : given->second);
-    }
-    // Images without any match would break COLMAP's observation manager: they join after triangulation.
-    std::set<colmap::image_t> matched;
-    std::vector<std::pair<colmap::image_t, colmap::image_t>> pairs;
-    std::vector<int> num_inliers;
-    database.ReadTwoViewGeometryNumInliers(&pairs, &num_inliers);
-    for (size_t k = 0; k < pairs.size(); ++k) {
-      if (num_inliers[k] > 0) {
-        matched.insert(pairs[k].first);
-        matched.insert(pairs[k].second);
-      }
-    }
-    for (const auto& [image_id, pose] : initialization.cam_from_world) {
-      colmap::Image image = database.ReadImage(image_id);
-      image.CamFromWorld() = pose;
-      // Built here, not by COLMAP's FeatureKeypointsToPointsVector: a vector of Eigen types allocated
-      // inside COLMAP's library and freed here may pair different allocators (ASan reports it).
-      std::vector<Eigen::Vector2d> points2D;
-      for (const colmap::FeatureKeypoint& keypoint : database.ReadKeypoints(image_id)) {
-        points2D.emplace_back(keypoint.x, keypoint.y);
-      }
-      image.SetPoints2D(points2D);
-      if (matched.count(image_id)) {
-        reconstruction->AddImage(image);
-        reconstruction->RegisterImage(image_id);
-      } else {
-        without_correspondences.push_back(image);
-      }
-    }
-  }
-  auto options = std::make_shared<colmap::IncrementalMapperOptions>();
-  options->fix_existing_images = true;
-  options->ba_refine_focal_length = false;
-  options->ba_refine_principal_point = false;
-  options->ba_refine_extra_params = false;
-  options->num_threads = -1;
-  if (reconstruction->NumRegImages() >= 2) {
-    colmap::IncrementalMapperController mapper(
-        options, image_path, database_path, std::make_shared<colmap::ReconstructionManager>());
-    mapper.TriangulateReconstruction(reconstruction);
-  }
-  for (const colmap::Image& image : without_correspondences) {
-    reconstruction->AddImage(image);
-    reconstruction->RegisterImage(image.ImageId());
+  std::map<colmap::camera_t, colmap::Camera> cameras;
+  for (const colmap::Camera& camera : colmap::Database(database_path).ReadAllCameras()) {
+    const auto given = initialization.cameras.find(camera.camera_id);
+    cameras[camera.camera_id] = given == initialization.cameras.end() ? camera : given->second;
   }
   fs::create_directories(output_path);
-  reconstruction->WriteBinary(output_path);
+  TriangulateAtPoses(database_path, cameras, initialization.cam_from_world)
+      ->WriteBinary(output_path);
 }
 
 }  // namespace colmap_lidar

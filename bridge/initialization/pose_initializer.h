@@ -169,10 +169,9 @@ PoseInitialization InitializeMonocular(const std::string& database_path,
                                        const PoseInitializerOptions& options);
 
 // Writes a COLMAP sparse model with the initial poses and landmarks triangulated by COLMAP's own
-// triangulator (IncrementalMapperController::TriangulateReconstruction with the poses held fixed); the
-// cameras are the database's, or `initialization.cameras` where given.
+// triangulator at those poses (TriangulateAtPoses); the cameras are the database's, or
+// `initialization.cameras` where given.
 void TriangulateInitialModel(const std::string& database_path,
-                             const std::string& image_path,
                              const PoseInitialization& initialization,
                              const std::string& output_path);
 

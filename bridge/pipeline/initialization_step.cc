@@ -10,15 +10,12 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <optional>
 #include <vector>
 
 namespace colmap_lidar {
-namespace fs = std::filesystem;
-
 namespace {
 
 std::vector<double> ToVector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
@@ -144,8 +141,7 @@ CaptureProfile RunPoseInitializerStep(const StationDataset& dataset,
               << init.num_image_edges << " model edges and " << init.num_lidar_edges
               << " LiDAR edges (A_l)" << std::endl;
   }
-  TriangulateInitialModel(
-      paths.database_path, (fs::path(dataset.root) / "images").string(), init, partial.Path());
+  TriangulateInitialModel(paths.database_path, init, partial.Path());
   PrintInitialization(init);
   WritePoseFile(partial.File("cam_from_lidar.txt"),
                 "initial cam_from_lidar (" + init.extrinsic_source + "); qw qx qy qz tx ty tz",

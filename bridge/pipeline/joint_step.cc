@@ -1,6 +1,7 @@
 #include "bridge/pipeline/joint_step.h"
 
 #include "bridge/evaluation/trajectory_evaluation.h"
+#include "bridge/initialization/track_triangulation.h"
 #include "bridge/joint/association_settling.h"
 #include "bridge/joint/start_departure.h"
 #include "bridge/pipeline/capture_profile.h"
@@ -180,6 +181,21 @@ void DecideTimeOffset(const StationDataset& dataset,
   }
 }
 
+// Rebuilds the tracks at the adjusted poses (RetriangulateTracks): those of the input model were built
+// at its poses, and on a weakly constrained drive the partition of the observations into tracks
+// moves cam_from_lidar by several sigma. True if any track changed, so that the joint runs again.
+bool RebuildTracks(const std::string& database_path, colmap::Reconstruction* reconstruction) {
+  const colmap::Reconstruction adjusted = *reconstruction;
+  RetriangulateTracks(database_path, reconstruction);
+  const double retracked = FractionOfObservationsRetracked(adjusted, *reconstruction);
+  std::ostringstream line;  // std::cout may hold a fixed precision of 1
+  line << "Tracks rebuilt at the adjusted poses: " << reconstruction->NumPoints3D()
+       << " landmarks; " << 100 * retracked << " % of the observations changed track"
+       << (retracked > 0 ? "; the joint adjuster runs again on them" : "");
+  std::cout << line.str() << std::endl;
+  return retracked > 0;
+}
+
 }  // namespace
 
 bool JointAdjusterStepOptions::Check() const { return adjuster.Check() && data.Check(); }
@@ -220,8 +236,11 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   }
   const std::optional<VerticalAlignment> vertical = AddExtrinsicMeasurements(
       dataset, vertical_alignment, reconstruction, options, loaded.get(), &cam_from_lidar);
-  const JointAdjustmentSummary summary =
-      JointAdjuster(options.adjuster).Run(loaded->data, &reconstruction, &cam_from_lidar);
+  const JointAdjuster adjuster(options.adjuster);
+  JointAdjustmentSummary summary = adjuster.Run(loaded->data, &reconstruction, &cam_from_lidar);
+  if (RebuildTracks(paths.database_path, &reconstruction)) {
+    summary = adjuster.Run(loaded->data, &reconstruction, &cam_from_lidar);
+  }
 
   PartialOutputFolder partial(paths.output_path);
   reconstruction.WriteBinary(partial.Path());
