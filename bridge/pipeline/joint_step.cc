@@ -196,6 +196,18 @@ bool RebuildTracks(const std::string& database_path, colmap::Reconstruction* rec
   return retracked > 0;
 }
 
+// The joint adjustment, then once more on the tracks rebuilt at its poses if any changed.
+JointAdjustmentSummary AdjustWithRebuiltTracks(const JointAdjusterOptions& options,
+                                               const JointProblemData& data,
+                                               const std::string& database_path,
+                                               colmap::Reconstruction* reconstruction,
+                                               colmap::Rigid3d* cam_from_lidar) {
+  const JointAdjuster adjuster(options);
+  const JointAdjustmentSummary summary = adjuster.Run(data, reconstruction, cam_from_lidar);
+  if (!RebuildTracks(database_path, reconstruction)) return summary;
+  return adjuster.Run(data, reconstruction, cam_from_lidar);
+}
+
 }  // namespace
 
 bool JointAdjusterStepOptions::Check() const { return adjuster.Check() && data.Check(); }
@@ -236,11 +248,8 @@ void RunJointAdjusterStep(const StationDataset& dataset,
   }
   const std::optional<VerticalAlignment> vertical = AddExtrinsicMeasurements(
       dataset, vertical_alignment, reconstruction, options, loaded.get(), &cam_from_lidar);
-  const JointAdjuster adjuster(options.adjuster);
-  JointAdjustmentSummary summary = adjuster.Run(loaded->data, &reconstruction, &cam_from_lidar);
-  if (RebuildTracks(paths.database_path, &reconstruction)) {
-    summary = adjuster.Run(loaded->data, &reconstruction, &cam_from_lidar);
-  }
+  const JointAdjustmentSummary summary = AdjustWithRebuiltTracks(
+      options.adjuster, loaded->data, paths.database_path, &reconstruction, &cam_from_lidar);
 
   PartialOutputFolder partial(paths.output_path);
   reconstruction.WriteBinary(partial.Path());
