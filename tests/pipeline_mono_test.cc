@@ -131,8 +131,8 @@ std::string RunDrive(const testing::ScopedTempDir& dir, int num_frames, bool gue
 // The guess is 1 deg / 5 cm off. What this test checks is the hold of the unobservable directions;
 // the convergence without any guess is the 40-frame test's. A direction the data know worse than the
 // hold thresholds (0.5 deg / 20 mm) is held at the guess, never left to drift; one known better is
-// observed and must then beat the guess. Measured: 0.016 deg, 5.8 mm (the guess: 50 mm), forward
-// (camera z) -4.8 mm; bounds: rotation 3x, forward 2x.
+// observed and must then beat the guess. Measured: 0.016 deg, 3.7 mm (the guess: 50 mm), forward
+// (camera z) -3.3 mm; bounds: rotation 3x, forward 3x.
 TEST(PipelineMonoTest, KittiLayoutDriveHoldsWhatItCannotSee) {
   testing::ScopedTempDir dir;
   RunDrive(dir, 20, true);
@@ -171,7 +171,7 @@ TEST(PipelineMonoTest, KittiLayoutDriveHoldsWhatItCannotSee) {
 // at the moving platform's weight 0.25) observe the rest, and the association rounds continue while
 // cam_from_lidar still moves; the vertical alignment (walls and vertical image edges) measures the
 // roll about the driving direction and the pitch (docs/mono.md). Measured (seed 0, deterministic):
-// 0.015 deg, 2.5 mm; bounds about 3x. The spread over seeds is scripts/benchmark_uncertainty.sh's
+// 0.013 deg, 2.5 mm; bounds about 3x. The spread over seeds is scripts/benchmark_uncertainty.sh's
 // (SCENES=street_drive).
 TEST(PipelineMonoTest, FortyFrameDriveCalibratesWithoutAGuess) {
   testing::ScopedTempDir dir;
