@@ -1,9 +1,15 @@
 #include "bridge/initialization/track_triangulation.h"
 
+#include "colmap_ext/sqlite_connection.h"
+
 #include "colmap/controllers/incremental_mapper.h"
 #include "colmap/scene/database.h"
 #include "colmap/scene/reconstruction_manager.h"
 
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
 #include <set>
 #include <utility>
 #include <vector>
@@ -12,6 +18,34 @@ namespace colmap_lidar {
 namespace {
 
 using Observation = std::pair<colmap::image_t, colmap::point2D_t>;
+
+// A private snapshot of the database, removed with this object. COLMAP's Database opens its file for
+// writing (it creates missing tables) and fails at once while another process holds a lock; the
+// snapshot (CopySqliteDatabase waits for writers) keeps both the input database untouched and the
+// triangulation free of other programs' locks.
+class DatabaseSnapshot {
+ public:
+  explicit DatabaseSnapshot(const std::string& database_path) {
+    static std::atomic<int> counter{0};
+    path_ = (std::filesystem::temp_directory_path() /
+             ("colmap_lidar_tracks_" + std::to_string(::getpid()) + "_" +
+              std::to_string(counter++) + ".db"))
+                .string();
+    CopySqliteDatabase(database_path, path_);
+  }
+  ~DatabaseSnapshot() {
+    std::error_code ignored;
+    for (const char* suffix : {"", "-wal", "-shm"})
+      std::filesystem::remove(path_ + suffix, ignored);
+  }
+  DatabaseSnapshot(const DatabaseSnapshot&) = delete;
+  DatabaseSnapshot& operator=(const DatabaseSnapshot&) = delete;
+
+  const std::string& Path() const { return path_; }
+
+ private:
+  std::string path_;
+};
 
 // The images with at least one verified match in the database.
 std::set<colmap::image_t> MatchedImages(const colmap::Database& database) {
@@ -93,11 +127,12 @@ std::shared_ptr<colmap::Reconstruction> TriangulateAtPoses(
     const std::string& database_path,
     const std::map<colmap::camera_t, colmap::Camera>& cameras,
     const std::map<colmap::image_t, colmap::Rigid3d>& cam_from_world) {
+  const DatabaseSnapshot snapshot(database_path);
   auto reconstruction = std::make_shared<colmap::Reconstruction>();
   // Images without any match would break COLMAP's observation manager: they join afterwards.
   std::vector<colmap::Image> without_correspondences;
   {
-    const colmap::Database database(database_path);
+    const colmap::Database database(snapshot.Path());
     for (const auto& [camera_id, camera] : cameras) reconstruction->AddCamera(camera);
     const std::set<colmap::image_t> matched = MatchedImages(database);
     for (const auto& [image_id, pose] : cam_from_world) {
@@ -110,7 +145,7 @@ std::shared_ptr<colmap::Reconstruction> TriangulateAtPoses(
       }
     }
   }
-  TriangulateRegistered(database_path, reconstruction);
+  TriangulateRegistered(snapshot.Path(), reconstruction);
   for (const colmap::Image& image : without_correspondences) {
     reconstruction->AddImage(image);
     reconstruction->RegisterImage(image.ImageId());
