@@ -87,9 +87,7 @@ void TriangulateRegistered(const std::string& database_path,
   options->ba_refine_focal_length = false;
   options->ba_refine_principal_point = false;
   options->ba_refine_extra_params = false;
-  // One thread: Ceres' threaded evaluation sums in the order threads finish, which would make the
-  // landmarks (and the joint adjustment on them) depend on the machine's core count.
-  options->num_threads = 1;
+  options->num_threads = -1;
   colmap::IncrementalMapperController mapper(
       options, "", database_path, std::make_shared<colmap::ReconstructionManager>());
   mapper.TriangulateReconstruction(reconstruction);
