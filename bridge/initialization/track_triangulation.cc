@@ -151,19 +151,14 @@ std::shared_ptr<colmap::Reconstruction> TriangulateAtPoses(
   return reconstruction;
 }
 
-double RetriangulateTracks(const std::string& database_path,
-                           colmap::Reconstruction* reconstruction) {
+void RetriangulateTracks(const std::string& database_path, colmap::Reconstruction* reconstruction) {
   std::map<colmap::image_t, colmap::Rigid3d> cam_from_world;
   for (const colmap::image_t image_id : reconstruction->RegImageIds()) {
     cam_from_world[image_id] = reconstruction->Image(image_id).CamFromWorld();
   }
   const std::map<colmap::camera_t, colmap::Camera> cameras(reconstruction->Cameras().begin(),
                                                            reconstruction->Cameras().end());
-  const std::shared_ptr<colmap::Reconstruction> rebuilt =
-      TriangulateAtPoses(database_path, cameras, cam_from_world);
-  const double retracked = FractionOfObservationsRetracked(*reconstruction, *rebuilt);
-  *reconstruction = std::move(*rebuilt);
-  return retracked;
+  *reconstruction = *TriangulateAtPoses(database_path, cameras, cam_from_world);
 }
 
 double FractionOfObservationsRetracked(const colmap::Reconstruction& before,

@@ -24,10 +24,8 @@ std::shared_ptr<colmap::Reconstruction> TriangulateAtPoses(
     const std::map<colmap::image_t, colmap::Rigid3d>& cam_from_world);
 
 // The same for the registered images of `reconstruction`, at its poses and with its cameras: its
-// landmarks are replaced by newly triangulated tracks. Returns the fraction of its former
-// observations whose track changed (FractionOfObservationsRetracked).
-double RetriangulateTracks(const std::string& database_path,
-                           colmap::Reconstruction* reconstruction);
+// landmarks are replaced by newly triangulated tracks.
+void RetriangulateTracks(const std::string& database_path, colmap::Reconstruction* reconstruction);
 
 // The fraction of `before`'s landmark observations whose track `after` does not hold as it is: an
 // observation counts when its track lost, gained or split observations or vanished (0: the same

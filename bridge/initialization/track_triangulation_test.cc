@@ -68,10 +68,7 @@ TEST(TrackTriangulation, RetriangulatingReplacesTheLandmarksAndKeepsThePoses) {
   }();
   model.MergePoints3D(ids[0], ids[1]);
   EXPECT_GT(FractionOfObservationsRetracked(scene.truth, model), 0.0);
-  const colmap::Reconstruction merged = model;
-  const double retracked = RetriangulateTracks(scene.database_path, &model);
-  EXPECT_GT(retracked, 0.0);
-  EXPECT_DOUBLE_EQ(retracked, FractionOfObservationsRetracked(merged, model));
+  RetriangulateTracks(scene.database_path, &model);
   EXPECT_EQ(FractionOfObservationsRetracked(scene.truth, model), 0.0);
   EXPECT_EQ(model.NumRegImages(), scene.truth.NumRegImages());
 }

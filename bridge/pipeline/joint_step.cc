@@ -185,7 +185,9 @@ void DecideTimeOffset(const StationDataset& dataset,
 // at its poses, and on a weakly constrained drive the partition of the observations into tracks
 // moves cam_from_lidar by several sigma. True if any track changed, so that the joint runs again.
 bool RebuildTracks(const std::string& database_path, colmap::Reconstruction* reconstruction) {
-  const double retracked = RetriangulateTracks(database_path, reconstruction);
+  const colmap::Reconstruction adjusted = *reconstruction;
+  RetriangulateTracks(database_path, reconstruction);
+  const double retracked = FractionOfObservationsRetracked(adjusted, *reconstruction);
   std::ostringstream line;  // std::cout may hold a fixed precision of 1
   line << "Tracks rebuilt at the adjusted poses: " << reconstruction->NumPoints3D()
        << " landmarks; " << 100 * retracked << " % of the observations changed track"
