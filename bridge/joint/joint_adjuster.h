@@ -295,8 +295,6 @@ struct JointAdjustmentSummary {
   // With estimate_time_offset: the LiDAR clock's offset from the cameras' [s, or frames without
   // image times].
   std::optional<double> time_offset;
-  // With E_m: its oblique-view offset delta [rad] (bridge/joint/landmark_lidar_plane_cost.h).
-  std::optional<double> oblique_offset_rad;
   // Where E_m measures depth: the stereo depth's bias field c (colmap_ext/depth_prior_cost.h) in
   // inverse depth [1/m], per 1 and per normalised image x and y.
   std::optional<Eigen::Vector3d> depth_prior_bias;

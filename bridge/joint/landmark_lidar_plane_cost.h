@@ -8,19 +8,8 @@
 // so it constrains T_e = cam_from_lidar too. It is evaluated in camera i's frame, where it has the same
 // value: E_m = (R_e n)^T (cam_i_from_world X - T_e q) / sigma_m.
 //
-// Keypoints on a surface seen obliquely (a road ahead) are displaced systematically: the texture is
-// foreshortened, and detection's blobs come out a fraction of a pixel off across the surface, so the
-// landmark triangulated from them sits off the surface by that angle times its distance, along the
-// surface normal by the share sin(ray, normal) of the ray's perpendicular. With the angle delta (a
-// parameter, radians; positive: towards the sensors) and X_c = cam_i_from_world X:
-//   E_m = ((R_e n)^T (X_c - T_e q) - delta |(R_e n) x X_c|) / sigma_m,
-// zero for a surface seen head on and delta times the distance at grazing view. A common offset of
-// every landmark would be the LiDAR's translation along the normal; one proportional to the distance
-// and to the obliqueness is not, so the data separate delta from T_e where distances vary.
-//
 // Parameter blocks (COLMAP's): cam_i_from_world rotation [4] (Eigen quaternion, xyzw) and translation
-// [3], the landmark's xyz [3] (world frame), cam_from_lidar rotation [4] and translation [3]; then
-// delta [1].
+// [3], the landmark's xyz [3] (world frame), cam_from_lidar rotation [4] and translation [3].
 #pragma once
 
 #include "colmap/estimators/cost_functions.h"
@@ -42,7 +31,7 @@ class LandmarkLidarPlaneCostFunctor {
   static ceres::CostFunction* Create(const Eigen::Vector3d& point_in_lidar_i,
                                      const Eigen::Vector3d& normal_in_lidar_i,
                                      double sigma) {
-    return new ceres::AutoDiffCostFunction<LandmarkLidarPlaneCostFunctor, 1, 4, 3, 3, 4, 3, 1>(
+    return new ceres::AutoDiffCostFunction<LandmarkLidarPlaneCostFunctor, 1, 4, 3, 3, 4, 3>(
         new LandmarkLidarPlaneCostFunctor(point_in_lidar_i, normal_in_lidar_i, sigma));
   }
 
@@ -52,15 +41,13 @@ class LandmarkLidarPlaneCostFunctor {
                   const T* const landmark_in_world,
                   const T* const cam_from_lidar_rotation,
                   const T* const cam_from_lidar_translation,
-                  const T* const oblique_offset,
                   T* residual) const {
     residual[0] =
         Residual(cam_i_from_world_rotation,
                  cam_i_from_world_translation,
                  landmark_in_world,
                  cam_from_lidar_rotation,
-                 Eigen::Matrix<T, 3, 1>(colmap::EigenVector3Map<T>(cam_from_lidar_translation)),
-                 oblique_offset[0]);
+                 Eigen::Matrix<T, 3, 1>(colmap::EigenVector3Map<T>(cam_from_lidar_translation)));
     return true;
   }
 
@@ -70,8 +57,7 @@ class LandmarkLidarPlaneCostFunctor {
              const T* const cam_i_from_world_translation,
              const T* const landmark_in_world,
              const T* const cam_from_lidar_rotation,
-             const Eigen::Matrix<T, 3, 1>& cam_from_lidar_translation_i,
-             const T& oblique_offset) const {
+             const Eigen::Matrix<T, 3, 1>& cam_from_lidar_translation_i) const {
     using Vector3 = Eigen::Matrix<T, 3, 1>;
     const auto cam_from_lidar_q = colmap::EigenQuaternionMap<T>(cam_from_lidar_rotation);
     const Vector3 landmark_in_cam_i = colmap::EigenQuaternionMap<T>(cam_i_from_world_rotation) *
@@ -80,11 +66,7 @@ class LandmarkLidarPlaneCostFunctor {
     const Vector3 target_in_cam_i =
         cam_from_lidar_q * point_in_lidar_i_.cast<T>() + cam_from_lidar_translation_i;
     const Vector3 normal_in_cam_i = cam_from_lidar_q * normal_in_lidar_i_.cast<T>();
-    using std::sqrt;
-    const T perpendicular_sq = normal_in_cam_i.cross(landmark_in_cam_i).squaredNorm();
-    const T offset = perpendicular_sq > T(1e-18) ? oblique_offset * sqrt(perpendicular_sq) : T(0);
-    return (normal_in_cam_i.dot(landmark_in_cam_i - target_in_cam_i) - offset) *
-           T(inverse_sigma_);
+    return normal_in_cam_i.dot(landmark_in_cam_i - target_in_cam_i) * T(inverse_sigma_);
   }
 
  private:
@@ -99,7 +81,7 @@ class LandmarkLidarPlaneCostFunctor {
 //   E_m = (R_e n)^T (cam_i_from_world X - R_e q - t_e - dt v_i) / sigma_m.
 // On a drive of constant velocity in the camera frame, dt and t_e along v are one direction (the
 // covariance says so); turns and speed changes separate them.
-// Parameter blocks: those of LandmarkLidarPlaneCostFunctor (delta last), then dt [1].
+// Parameter blocks: those of LandmarkLidarPlaneCostFunctor, then dt [1].
 class TimedLandmarkLidarPlaneCostFunctor {
  public:
   TimedLandmarkLidarPlaneCostFunctor(const Eigen::Vector3d& point_in_lidar_i,
@@ -112,7 +94,7 @@ class TimedLandmarkLidarPlaneCostFunctor {
                                      const Eigen::Vector3d& normal_in_lidar_i,
                                      const Eigen::Vector3d& velocity_in_cam_i,
                                      double sigma) {
-    return new ceres::AutoDiffCostFunction<TimedLandmarkLidarPlaneCostFunctor, 1, 4, 3, 3, 4, 3, 1, 1>(
+    return new ceres::AutoDiffCostFunction<TimedLandmarkLidarPlaneCostFunctor, 1, 4, 3, 3, 4, 3, 1>(
         new TimedLandmarkLidarPlaneCostFunctor(
             point_in_lidar_i, normal_in_lidar_i, velocity_in_cam_i, sigma));
   }
@@ -123,7 +105,6 @@ class TimedLandmarkLidarPlaneCostFunctor {
                   const T* const landmark_in_world,
                   const T* const cam_from_lidar_rotation,
                   const T* const cam_from_lidar_translation,
-                  const T* const oblique_offset,
                   const T* const time_offset,
                   T* residual) const {
     const Eigen::Matrix<T, 3, 1> translation_i =
@@ -133,35 +114,13 @@ class TimedLandmarkLidarPlaneCostFunctor {
                                   cam_i_from_world_translation,
                                   landmark_in_world,
                                   cam_from_lidar_rotation,
-                                  translation_i,
-                                  oblique_offset[0]);
+                                  translation_i);
     return true;
   }
 
  private:
   const LandmarkLidarPlaneCostFunctor plane_;
   const Eigen::Vector3d velocity_in_cam_i_;
-};
-
-// The prior on E_m's oblique-view offset delta: delta / sigma, with sigma from what is known of a
-// keypoint's systematic offset (a fraction of a pixel) over the focal length.
-class ObliqueOffsetPriorCostFunctor {
- public:
-  explicit ObliqueOffsetPriorCostFunctor(double sigma) : inverse_sigma_(1.0 / sigma) {}
-
-  static ceres::CostFunction* Create(double sigma) {
-    return new ceres::AutoDiffCostFunction<ObliqueOffsetPriorCostFunctor, 1, 1>(
-        new ObliqueOffsetPriorCostFunctor(sigma));
-  }
-
-  template <typename T>
-  bool operator()(const T* const oblique_offset, T* residual) const {
-    residual[0] = oblique_offset[0] * T(inverse_sigma_);
-    return true;
-  }
-
- private:
-  const double inverse_sigma_;
 };
 
 }  // namespace colmap_lidar
