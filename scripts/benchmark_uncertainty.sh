@@ -64,12 +64,11 @@ stations_front_end() {
     --use_guess 0 &&
   database="$run/ws/db.db" initial="$run/ws/initial"
 }
-# The pipeline on DATASET into RUN/ws (its own joint step included; the benchmark's runs from its
-# initial model).
+# The pipeline on DATASET into RUN/ws up to its initial model (the benchmark's runs start there).
 pipeline_front_end() {
   database="$run/ws/database.db" initial="$run/ws/sparse/initial" registration="$run/ws/lidar"
   step "$run/ws/steps/pose_initializer.done" "$cli" pipeline --dataset_path "$dataset" \
-    --workspace_path "$run/ws" --Import.matcher sequential
+    --workspace_path "$run/ws" --Import.matcher sequential --stop_after pose_initializer
 }
 drive_front_end() {
   local mono=1

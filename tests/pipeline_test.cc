@@ -1,6 +1,6 @@
 // The pipeline end to end through the CLI, without a cam_from_lidar guess: import, stereo depth, depth
 // priors, LiDAR registration, initialisation (hand-eye), joint adjustment, dense model, evaluation;
-// restartable; options reach the steps. The default scene's workspace is the fixture of the dense and
+// stopped after a step and continued; restartable; options reach the steps. The default scene's workspace is the fixture of the dense and
 // COLMAP-workflow tests (pipeline_dense_test.cc).
 #include "colmap_ext/station_dataset.h"
 #include "tests/testing/pipeline_fixture.h"
@@ -52,6 +52,12 @@ TEST(PipelineTest, DefaultSceneWithoutAGuessEndToEndAndRestartable) {
   // A step's option given to the pipeline reaches the step.
   const std::string command = kCli + " pipeline --dataset_path " + dataset + " --workspace_path " +
                               f.ws + " --JointAdjuster.write_text 1";
+  // Up to the initial model, then the rest on the same workspace.
+  const auto initial = RunCommand(command + " --stop_after pose_initializer");
+  ASSERT_EQ(initial.exit_code, 0) << initial.output;
+  EXPECT_NE(initial.output.find("stopped after pose_initializer"), std::string::npos);
+  EXPECT_TRUE(fs::is_regular_file(f.File("sparse/initial/images.bin")));
+  EXPECT_FALSE(fs::exists(f.File("sparse/joint")));
   const auto run = RunCommand(command);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::cout << run.output.substr(run.output.find("== Pipeline summary")) << std::endl;

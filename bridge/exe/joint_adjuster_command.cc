@@ -64,6 +64,10 @@ void AddJointAdjusterOptions(const std::string& prefix,
           &adjuster.estimate_depth_bias,
           "estimate the stereo depth's disparity bias field (offset, x and y slopes) against the "
           "LiDAR (E_m)");
+  add.Add("estimate_oblique_offset",
+          &adjuster.estimate_oblique_offset,
+          "estimate the landmarks' offset from surfaces seen at grazing angles (E_m), "
+          "experimental");
   add.Add("hold_rotation", &adjuster.hold_rotation, "hold cam_from_lidar's rotation at its start");
   std::array<bool, 3>* held = &adjuster.hold_translation;
   manager->AddParsedOption(

@@ -85,6 +85,8 @@ void AddPipelineOptions(CommandOptions* manager, PipelineOptions* options) {
   manager->AddRequiredOption("dataset_path", &options->dataset_path);
   manager->AddRequiredOption("workspace_path", &options->workspace_path);
   manager->AddDefaultOption("overwrite", &options->overwrite, "rerun finished steps");
+  manager->AddDefaultOption(
+      "stop_after", &options->stop_after, "the last step to run (e.g. pose_initializer)");
   manager->AddChoiceOption(
       "mode", &options->mode, kJointModeNames, "stereo_only also fuses unrefined stereo");
   // The pipeline's own defaults (PipelineOptions()) for COLMAP's sections too.

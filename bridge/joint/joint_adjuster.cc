@@ -121,6 +121,8 @@ struct JointProblem {
   std::vector<ceres::ResidualBlockId> landmark_ids;
   // E_x of the extrinsic measurement (data, known covariance), if any.
   std::vector<ceres::ResidualBlockId> measurement_ids;
+  // The prior on E_m's oblique-view offset (outside knowledge with its covariance), if E_m is in.
+  std::vector<ceres::ResidualBlockId> offset_prior_ids;
   std::vector<ceres::ResidualBlockId> prior_ids;
 };
 
@@ -173,6 +175,9 @@ struct RunState {
   std::unique_ptr<double> lidar_free_angle = std::make_unique<double>(0.0);
   // JointAdjusterOptions::estimate_time_offset: dt, a parameter block that lives across rounds.
   std::unique_ptr<double> time_offset = std::make_unique<double>(0.0);
+  // E_m's oblique-view offset delta [rad] (bridge/joint/landmark_lidar_plane_cost.h), a parameter
+  // block that lives across rounds.
+  std::unique_ptr<double> oblique_offset = std::make_unique<double>(0.0);
   // The stereo depth's bias field (colmap_ext/depth_prior_cost.h), a parameter block that lives
   // across rounds; estimated with estimate_depth_bias where E_m measures depth, else held at zero.
   std::unique_ptr<std::array<double, 3>> depth_prior_bias =
@@ -440,6 +445,18 @@ std::map<colmap::image_t, Eigen::Vector3d> CameraVelocities(
   return velocities;
 }
 
+// The prior sigma of E_m's oblique-view offset [rad]: a keypoint's systematic offset of at most
+// about kObliqueOffsetPriorPx over the registered cameras' mean focal length.
+double ObliqueOffsetPriorSigma(const colmap::Reconstruction& reconstruction) {
+  constexpr double kObliqueOffsetPriorPx = 1.0;
+  double focal_sum = 0;
+  const std::vector<colmap::image_t> image_ids = reconstruction.RegImageIds();
+  for (const colmap::image_t image_id : image_ids) {
+    focal_sum += reconstruction.Camera(reconstruction.Image(image_id).CameraId()).MeanFocalLength();
+  }
+  return kObliqueOffsetPriorPx * static_cast<double>(image_ids.size()) / focal_sum;
+}
+
 // E_m for every associated landmark observation in force (the landmark and image still there).
 void AddLandmarkLidarBlocks(const RunState& state,
                             const std::vector<LandmarkPlaneObservation>& observations,
@@ -468,6 +485,7 @@ void AddLandmarkLidarBlocks(const RunState& state,
            state.reconstruction->Point3D(observation.point3D_id).xyz.data(),
            state.ExtrinsicRotation(),
            state.ExtrinsicTranslation(),
+           state.oblique_offset.get(),
            state.time_offset.get()}));
       continue;
     }
@@ -479,7 +497,17 @@ void AddLandmarkLidarBlocks(const RunState& state,
          translation,
          state.reconstruction->Point3D(observation.point3D_id).xyz.data(),
          state.ExtrinsicRotation(),
-         state.ExtrinsicTranslation()}));
+         state.ExtrinsicTranslation(),
+         state.oblique_offset.get()}));
+  }
+  if (joint->landmark_ids.empty()) return;
+  if (!state.options.estimate_oblique_offset) {
+    problem->SetParameterBlockConstant(state.oblique_offset.get());  // delta = 0
+  } else {
+    joint->offset_prior_ids.push_back(problem->AddResidualBlock(
+        ObliqueOffsetPriorCostFunctor::Create(ObliqueOffsetPriorSigma(*state.reconstruction)),
+        nullptr,
+        state.oblique_offset.get()));
   }
 }
 
@@ -523,6 +551,7 @@ std::map<const double*, std::string> ParameterNames(const RunState& state) {
   names[state.ExtrinsicRotation()] = "cam_from_lidar rotation";
   names[state.ExtrinsicTranslation()] = "cam_from_lidar translation";
   names[state.time_offset.get()] = "the LiDAR clock offset";
+  names[state.oblique_offset.get()] = "E_m's oblique-view offset";
   names[state.depth_prior_bias->data()] = "the stereo depth's bias field";
   names[state.lidar_free_angle.get()] = "E_l's free angle about the driving direction";
   return names;
@@ -896,6 +925,7 @@ std::vector<VarianceComponent> UpdateVarianceFactors(RunState* state,
       {"landmark_lidar", joint->landmark_ids, joint->landmark_ids.size()}};
   std::vector<ceres::ResidualBlockId> fixed = joint->prior_ids;
   fixed.insert(fixed.end(), joint->measurement_ids.begin(), joint->measurement_ids.end());
+  fixed.insert(fixed.end(), joint->offset_prior_ids.begin(), joint->offset_prior_ids.end());
   const std::vector<VarianceComponent> components =
       EstimateVarianceComponents(problem, groups, fixed);
   double* factors[4] = {&state->factors.reprojection,
@@ -989,6 +1019,8 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
   }
   inputs.regularizers = joint.prior_ids;
   inputs.measurements = joint.measurement_ids;
+  inputs.measurements.insert(
+      inputs.measurements.end(), joint.offset_prior_ids.begin(), joint.offset_prior_ids.end());
   inputs.hidden_residuals = joint.num_hidden_residuals;
   ExtrinsicUncertainty uncertainty =
       ComputeExtrinsicUncertainty(inputs, motion, state.options.observability);
@@ -1114,6 +1146,13 @@ void RecordFinalState(const RunState& state,
   }
   summary->variance_factors = state.factors;
   RecordDepthBias(state, summary);
+  if (state.use_landmark_lidar && state.options.estimate_oblique_offset) {
+    summary->oblique_offset_rad = *state.oblique_offset;
+    std::cout << "E_m's oblique-view offset: delta " << 1000 * *state.oblique_offset
+              << " mrad (landmarks towards the sensors by delta d sin tan of the ray's angle to "
+                 "the surface normal)"
+              << std::endl;
+  }
   if (state.options.estimate_time_offset) {
     summary->time_offset = *state.time_offset;
     std::cout << "LiDAR clock offset from the cameras (E_m): " << *state.time_offset

@@ -103,6 +103,11 @@ struct JointAdjusterOptions {
   // else makes the cameras' depths disagree with the LiDAR's (sweeps not de-skewed, a clock
   // offset), so it is for rigs whose LiDAR side is clean.
   bool estimate_depth_bias = false;
+  // Estimate E_m's oblique-view offset delta (bridge/joint/landmark_lidar_plane_cost.h): the
+  // landmarks on surfaces seen at grazing angles sit off them, towards the camera
+  // (docs/benchmarks/landmark_offsets.md); off: delta is held at zero. Estimated, it has a prior of
+  // 1 px over the cameras' mean focal length and is marginalised in cam_from_lidar's covariance.
+  bool estimate_oblique_offset = false;
   // sigma_m of E_m: the landmark's triangulation and the LiDAR surface together.
   double sigma_landmark_lidar_m = 0.02;
   // E_m outliers: beyond this distance or beyond max_landmark_plane_sigmas * sigma_m (absolute and in
@@ -295,6 +300,9 @@ struct JointAdjustmentSummary {
   // With estimate_time_offset: the LiDAR clock's offset from the cameras' [s, or frames without
   // image times].
   std::optional<double> time_offset;
+  // With E_m and estimate_oblique_offset: the oblique-view offset delta [rad]
+  // (bridge/joint/landmark_lidar_plane_cost.h).
+  std::optional<double> oblique_offset_rad;
   // Where E_m measures depth: the stereo depth's bias field c (colmap_ext/depth_prior_cost.h) in
   // inverse depth [1/m], per 1 and per normalised image x and y.
   std::optional<Eigen::Vector3d> depth_prior_bias;

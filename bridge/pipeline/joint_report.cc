@@ -263,6 +263,9 @@ void AddNuisanceParameters(const JointAdjustmentSummary& summary,
     report["time_offset"] = {{"lidar_minus_camera", *summary.time_offset},
                              {"unit", loaded.data.image_times.empty() ? "frames" : "s"}};
   }
+  if (summary.oblique_offset_rad) {
+    report["landmark_oblique_offset"] = {{"angle_mrad", 1000 * *summary.oblique_offset_rad}};
+  }
   if (summary.depth_prior_bias) {
     const Eigen::Vector3d& bias = *summary.depth_prior_bias;
     report["depth_prior_bias"] = {{"inverse_depth_per_m", {bias.x(), bias.y(), bias.z()}},

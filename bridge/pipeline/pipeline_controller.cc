@@ -327,6 +327,23 @@ void DecideFromDataset(const StationDataset& dataset, PipelineOptions* pipeline)
   }
 }
 
+// The steps up to and including `stop_after` (all of them when it is empty); an unknown name is an
+// error listing the dataset's steps.
+std::vector<PipelineStep> StepsUpTo(std::vector<PipelineStep> steps,
+                                    const std::string& stop_after) {
+  if (stop_after.empty()) return steps;
+  std::string names;
+  for (size_t k = 0; k < steps.size(); ++k) {
+    if (steps[k].name == stop_after) {
+      steps.resize(k + 1);
+      return steps;
+    }
+    names += (names.empty() ? "" : ", ") + steps[k].name;
+  }
+  throw std::invalid_argument("--stop_after " + stop_after +
+                              ": not a step of this dataset's pipeline (" + names + ")");
+}
+
 }  // namespace
 
 PipelineOptions::PipelineOptions() {
@@ -346,11 +363,17 @@ void RunFullPipeline(PipelineOptions pipeline) {
   CheckStepOptions(&pipeline);
   const StationDataset dataset = ReadStationDataset(pipeline.dataset_path);
   DecideFromDataset(dataset, &pipeline);
+  const std::vector<PipelineStep> steps =
+      StepsUpTo(PipelineSteps(dataset, pipeline), pipeline.stop_after);
   const fs::path ws(pipeline.workspace_path);
   const WorkspaceLock lock(pipeline.workspace_path);
   fs::create_directories(ws / "steps");
   fs::create_directories(ws / "sparse");
-  RunSteps(PipelineSteps(dataset, pipeline), ws, pipeline.overwrite);
+  RunSteps(steps, ws, pipeline.overwrite);
+  if (!pipeline.stop_after.empty()) {
+    std::cout << "  stopped after " << pipeline.stop_after << " (--stop_after)" << std::endl;
+    return;
+  }
   std::cout << "  model: " << (ws / "sparse" / "joint").string()
             << " (cam_from_lidar.txt, report.json)\n"
             << "  dense: " << (ws / "dense").string()

@@ -26,6 +26,9 @@ struct PipelineOptions {
   std::string dataset_path;
   std::string workspace_path;
   bool overwrite = false;
+  // The name of the last step to run (empty: every step), e.g. pose_initializer for the initial
+  // model alone; the steps after it are left for a later run.
+  std::string stop_after;
   // The joint step's mode; stereo_only also fuses the unrefined stereo (no LiDAR in the densifier).
   JointMode mode = JointMode::kJoint;
   ImportStepOptions import;
