@@ -10,6 +10,8 @@
 #     street_drive             the simulated street drive, one camera (DRIVE_FRAMES, default 40;
 #                              120000 rays per sweep), no guess, the whole pipeline's front end
 #     street_drive_stereo      the same drive with the second camera
+#     straight_drive           the street drive in one lane without a turn (simulate_dataset
+#                              --motion straight_drive), one camera, no guess
 #     kitti_layout_drive       20 frames of the street drive written in KITTI raw's layout (one
 #                              camera), imported by import_kitti with its seeded 1 deg / 5 cm guess
 #     kitti_odometry           the real sample ../shared/data/kitti_odometry_04_sample, stereo and
@@ -71,10 +73,11 @@ pipeline_front_end() {
     --workspace_path "$run/ws" --Import.matcher sequential --stop_after pose_initializer
 }
 drive_front_end() {
-  local mono=1
+  local mono=1 motion=drive
   [ "$scene" = street_drive_stereo ] && mono=0
+  [ "$scene" = straight_drive ] && motion=straight_drive
   dataset="$run/dataset"
-  step "$dataset" "$cli" simulate_dataset --scene street --motion drive --mono "$mono" \
+  step "$dataset" "$cli" simulate_dataset --scene street --motion "$motion" --mono "$mono" \
     --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 --write_guess 0 \
     --pixel_samples "$kPixelSamples" --output_path "$dataset" && pipeline_front_end
 }
@@ -96,11 +99,11 @@ kitti_odometry_front_end() {  # seed: stereo | mono
   pipeline_front_end
 }
 
-for scene in ${SCENES:-t_specimen bridge_pier street_drive street_drive_stereo kitti_layout_drive kitti_odometry}; do
+for scene in ${SCENES:-t_specimen bridge_pier street_drive street_drive_stereo straight_drive kitti_layout_drive kitti_odometry}; do
   seeds=$(seq 1 "${SEEDS:-10}")
   case "$scene" in
     t_specimen | bridge_pier) front_end=stations_front_end ;;
-    street_drive | street_drive_stereo)
+    street_drive | street_drive_stereo | straight_drive)
       front_end=drive_front_end seeds=$(seq 1 "${DRIVE_SEEDS:-${SEEDS:-10}}") ;;
     kitti_layout_drive)
       front_end=kitti_layout_front_end seeds=$(seq 1 "${DRIVE_SEEDS:-${SEEDS:-10}}") ;;

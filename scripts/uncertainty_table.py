@@ -20,6 +20,9 @@ FAMILIES = {
                      'moving cars left out)'),
     'street_drive_stereo': ('drive', 'the same drive with the second camera (stereo depth, depth '
                             'priors, the stereo-LiDAR alignment of the pose initialiser)'),
+    'straight_drive': ('drive', 'the street drive in one lane without a turn, one camera, 40 '
+                       'frames, 120000 rays per sweep, no guess; the pipeline with sequential '
+                       'matching'),
     'kitti_layout_drive': ('drive', '20 frames of the street drive in KITTI raw\'s layout (one '
                            'camera), imported by `import_kitti` with its seeded 1 deg / 5 cm guess'),
     'kitti_odometry': ('drive', 'the real KITTI odometry 04 sample (20 frames of a straight drive), '
