@@ -1,0 +1,76 @@
+#!/usr/bin/env python3
+# Writes the page comparing two variants of the joint adjuster on the same front ends (Markdown, to
+# stdout) from two results files of benchmark_uncertainty.sh:
+#   variant_table.py BASE_TSV VARIANT_TSV VARIANT VARIANT_OPTIONS
+# Only the runs present in both files (same scene and seed) are compared. Per family and variant:
+# errors beyond 2 sigma per axis, rms z, the mean and rms error per axis; then every run's errors
+# and z with both variants.
+import datetime, math, os, sys
+
+base_path, variant_path, variant, options = sys.argv[1:]
+axes = ['rx', 'ry', 'rz', 'tx', 'ty', 'tz']
+
+
+def load(path):
+    runs = {}
+    for line in open(path):
+        fields = line.rstrip('\n').split('\t')
+        if len(fields) >= 20:
+            runs[(fields[0], fields[1])] = [float(v) for v in fields[2:20]]
+    return runs
+
+
+def seed_key(key):
+    return (key[0], int(key[1]) if key[1].isdigit() else 0, key[1])
+
+
+base, other = load(base_path), load(variant_path)
+keys = sorted(set(base) & set(other), key=seed_key)
+families = sorted({k[0] for k in keys})
+names = [('default', base), (variant, other)]
+
+
+def error_cell(k, value):
+    return '%+.4f' % value if k < 3 else '%+.1f' % value
+
+
+def summary_row(family, name, runs):
+    rows = [runs[k] for k in keys if k[0] == family]
+    misses, determined = [], []
+    for a in range(6):
+        z = [r[12 + a] for r in rows if not math.isnan(r[12 + a])]
+        misses.append(str(sum(abs(v) > 2 for v in z)))
+        determined += z
+    rms_z = math.sqrt(sum(v * v for v in determined) / len(determined)) if determined else math.nan
+    mean = [sum(r[a] for r in rows) / len(rows) for a in range(6)]
+    rms = [math.sqrt(sum(r[a] ** 2 for r in rows) / len(rows)) for a in range(6)]
+    return '| %s | %s | %d | %s | %.2f | %s | %s |' % (
+        family, name, len(rows), ' '.join(misses), rms_z,
+        ' '.join(error_cell(a, mean[a]) for a in range(6)),
+        ' '.join(error_cell(a, rms[a]).lstrip('+') for a in range(6)))
+
+
+print('# The joint adjuster with `%s` against its default, on the same front ends\n' % variant)
+print('Written by `scripts/benchmark_estimator_variant.sh` on %s (%d cores): `%s`. The front ends '
+      'and families are those of [uncertainty.md](uncertainty.md) (`scripts/benchmark_uncertainty.sh`);'
+      ' per family and seed the joint adjuster runs twice on the same initial model, with its '
+      'default options and with `%s`.\n' % (datetime.date.today().isoformat(), os.cpu_count(),
+                                             variant, options.strip()))
+print('Errors: the rotation vector of estimate * inverse(truth) about the camera axes [deg], the '
+      'translation [mm]; z = error / reported sigma; undetermined axes (no sigma) are left out of '
+      'the counts.\n')
+print('| family | variant | runs | beyond 2 sigma (rx ry rz tx ty tz) | rms z | mean error (rx ry rz '
+      '[deg], tx ty tz [mm]) | rms error |')
+print('|---|---|---|---|---|---|---|')
+for family in families:
+    for name, runs in names:
+        print(summary_row(family, name, runs))
+print('\n| family | seed | variant | ' + ' | '.join('err ' + a for a in axes) + ' | ' +
+      ' | '.join('z ' + a for a in axes) + ' |')
+print('|---|---|---|' + '---|' * 12)
+for key in keys:
+    for name, runs in names:
+        r = runs[key]
+        print('| %s | %s | %s | ' % (key[0], key[1], name) +
+              ' | '.join(error_cell(a, r[a]) for a in range(6)) + ' | ' +
+              ' | '.join('undet.' if math.isnan(v) else '%.2f' % v for v in r[12:18]) + ' |')
