@@ -13,7 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 : "${VARIANT:?name the variant (VARIANT=...)}"
-: "${JOINT_OPTIONS:?give the variant's joint_adjuster options (JOINT_OPTIONS=...)}"
+: "${JOINT_OPTIONS:?give the joint_adjuster options of the variant (JOINT_OPTIONS=...)}"
 source scripts/configure.sh
 use_work_dir
 readonly kRuns="${RUNS:-street_drive:10 street_drive_stereo:10 straight_drive:10 kitti_layout_drive:10 kitti_odometry:1}"

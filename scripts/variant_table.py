@@ -3,8 +3,8 @@
 # stdout) from two results files of benchmark_uncertainty.sh:
 #   variant_table.py BASE_TSV VARIANT_TSV VARIANT VARIANT_OPTIONS
 # Only the runs present in both files (same scene and seed) are compared. Per family and variant:
-# errors beyond 2 sigma per axis, rms z, the mean and rms error per axis; then every run's errors
-# and z with both variants.
+# errors beyond 2 sigma per axis, rms z, the mean and rms error per axis (determined axes only);
+# then every run's errors and z with both variants.
 import datetime, math, os, sys
 
 base_path, variant_path, variant, options = sys.argv[1:]
@@ -31,6 +31,8 @@ names = [('default', base), (variant, other)]
 
 
 def error_cell(k, value):
+    if math.isnan(value):
+        return 'undet.'
     return '%+.4f' % value if k < 3 else '%+.1f' % value
 
 
@@ -42,8 +44,11 @@ def summary_row(family, name, runs):
         misses.append(str(sum(abs(v) > 2 for v in z)))
         determined += z
     rms_z = math.sqrt(sum(v * v for v in determined) / len(determined)) if determined else math.nan
-    mean = [sum(r[a] for r in rows) / len(rows) for a in range(6)]
-    rms = [math.sqrt(sum(r[a] ** 2 for r in rows) / len(rows)) for a in range(6)]
+    mean, rms = [], []
+    for a in range(6):
+        errors = [r[a] for r in rows if not math.isnan(r[12 + a])]  # determined axes only
+        mean.append(sum(errors) / len(errors) if errors else math.nan)
+        rms.append(math.sqrt(sum(e * e for e in errors) / len(errors)) if errors else math.nan)
     return '| %s | %s | %d | %s | %.2f | %s | %s |' % (
         family, name, len(rows), ' '.join(misses), rms_z,
         ' '.join(error_cell(a, mean[a]) for a in range(6)),
@@ -51,7 +56,7 @@ def summary_row(family, name, runs):
 
 
 print('# The joint adjuster with `%s` against its default, on the same front ends\n' % variant)
-print('Written by `scripts/benchmark_estimator_variant.sh` on %s (%d cores): `%s`. The front ends '
+print('Written by `scripts/benchmark_estimator_variant.sh` on %s (%d cores), variant `%s`. The front ends '
       'and families are those of [uncertainty.md](uncertainty.md) (`scripts/benchmark_uncertainty.sh`);'
       ' per family and seed the joint adjuster runs twice on the same initial model, with its '
       'default options and with `%s`.\n' % (datetime.date.today().isoformat(), os.cpu_count(),
