@@ -1,7 +1,8 @@
-// The pipeline end to end through the CLI, without a cam_from_lidar guess: import, stereo depth, depth
-// priors, LiDAR registration, initialisation (hand-eye), joint adjustment, dense model, evaluation;
-// stopped after a step and continued; restartable; options reach the steps. The default scene's workspace is the fixture of the dense and
-// COLMAP-workflow tests (pipeline_dense_test.cc).
+// The pipeline end to end through the CLI, without a cam_from_lidar guess: import, stereo depth,
+// depth priors, LiDAR registration, initialisation (hand-eye), joint adjustment, dense model,
+// evaluation; stopped after a step and continued; restartable; options reach the steps. The
+// default scene's workspace is the fixture of the dense and COLMAP-workflow tests
+// (pipeline_dense_test.cc).
 #include "colmap_ext/station_dataset.h"
 #include "tests/testing/pipeline_fixture.h"
 #include "tests/testing/scoped_temp_dir.h"

@@ -8,21 +8,22 @@
 // so it constrains T_e = cam_from_lidar too. It is evaluated in camera i's frame, where it has the same
 // value: E_m = (R_e n)^T (cam_i_from_world X - T_e q) / sigma_m.
 //
-// Keypoints on a surface seen at a grazing angle (a road ahead) are displaced systematically: across
-// a keypoint's support the foreshortening changes, and the more so the more oblique the view, so the
-// landmark triangulated from several views sits off the surface along its normal
-// (docs/benchmarks/landmark_offsets.md measures it at the true poses: on the road, not on the walls).
-// With theta the angle between the ray and the normal, the offset is modelled as delta d sin(theta)
-// tan(theta) (d the distance; delta a parameter, positive: towards the sensors), with X_c =
-// cam_i_from_world X and m = R_e n:
-//   E_m = (m^T (X_c - T_e q) - delta |m x X_c|^2 / sqrt((m^T X_c)^2 + kGrazing^2 |X_c|^2)) / sigma_m,
+// Keypoints on a surface seen at a grazing angle (a road ahead) are displaced systematically:
+// across a keypoint's support the foreshortening changes, the more so the more oblique the view,
+// so the landmark triangulated from several views sits off the surface along its normal
+// (docs/benchmarks/landmark_offsets.md measures it at the true poses: on the road, not on the
+// walls). With theta the angle between the ray and the normal, the offset is modelled as
+// delta d sin(theta) tan(theta) (d the distance; delta a parameter, positive: towards the
+// sensors), with X_c = cam_i_from_world X and m = R_e n:
+//   E_m = (m^T (X_c - T_e q) - delta |m x X_c|^2 / sqrt((m^T X_c)^2 + kGrazing^2 |X_c|^2))
+//         / sigma_m,
 // zero head on; kGrazing caps tan(theta) at 1 / kGrazing for rays within 3 deg of the surface.
-// A translation of cam_from_lidar shifts every residual of a surface alike; delta shifts them with
-// distance and obliqueness, so landmarks at different distances and angles separate the two.
+// A translation of cam_from_lidar shifts every residual of a surface alike; delta shifts them
+// with distance and obliqueness, so landmarks at different distances and angles separate the two.
 //
-// Parameter blocks (COLMAP's): cam_i_from_world rotation [4] (Eigen quaternion, xyzw) and translation
-// [3], the landmark's xyz [3] (world frame), cam_from_lidar rotation [4] and translation [3]; then
-// delta [1].
+// Parameter blocks (COLMAP's): cam_i_from_world rotation [4] (Eigen quaternion, xyzw) and
+// translation [3], the landmark's xyz [3] (world frame), cam_from_lidar rotation [4] and
+// translation [3]; then delta [1].
 #pragma once
 
 #include "colmap/estimators/cost_functions.h"
