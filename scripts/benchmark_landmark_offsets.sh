@@ -14,6 +14,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
 source scripts/configure.sh
+source scripts/true_pose_model.sh
 use_cli
 use_work_dir
 readonly kSeeds="${SEEDS:-4}"
@@ -29,23 +30,9 @@ done
 arguments=()
 for seed in $(seq 1 "$kSeeds"); do
   run="$work/street_drive-$seed"
-  out="$run/true_pose_landmarks"
   echo "[street_drive $seed] triangulating at the true poses ..."
-  if [ ! -e "$out/triangulated/points3D.txt" ]; then
-    rm -rf "$out" && mkdir -p "$out/input" "$out/triangulated"
-    "$kColmap" model_converter --input_path "$run/ws/sparse/initial" --output_path "$out/input" \
-      --output_type TXT > "$out/log.txt" 2>&1
-    python3 scripts/landmark_offset_table.py true_model "$out/input" \
-      "$run/dataset/ground_truth/cam_from_world.txt" "$out/true_poses"
-    cp "$run/ws/database.db" "$out/database.db"  # the triangulator writes to its database
-    "$kColmap" point_triangulator --database_path "$out/database.db" \
-      --image_path "$run/dataset/images" --input_path "$out/true_poses" \
-      --output_path "$out/triangulated" --Mapper.ba_refine_focal_length 0 \
-      --Mapper.ba_refine_extra_params 0 >> "$out/log.txt" 2>&1
-    "$kColmap" model_converter --input_path "$out/triangulated" \
-      --output_path "$out/triangulated" --output_type TXT >> "$out/log.txt" 2>&1
-  fi
-  arguments+=("$seed:$out/triangulated:$run/dataset")
+  true_pose_landmarks "$kColmap" "$run"
+  arguments+=("$seed:$run/true_pose_landmarks/triangulated:$run/dataset")
 done
 mkdir -p docs/benchmarks
 readonly kDoc=docs/benchmarks/landmark_offsets.md
