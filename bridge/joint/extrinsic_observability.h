@@ -107,9 +107,10 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
 // Empty if the reported covariance of T_e has been validated by coverage for this kind of capture
 // (stations that rotate about two axes: tests/joint_adjuster_coverage_test.cc and the T specimen end
 // to end), else one sentence saying why it has not. A moving platform (sweeps, or a one-axis
-// hand-eye) whose stations turn about one axis is not: on simulated street drives the errors in the
-// height and the rotation about the driving direction exceed the reported sigmas, with a sign that
-// holds across runs of one drive (docs/benchmarks/drive_uncertainty.md).
+// hand-eye) whose stations turn about one axis, or not at all, is not: on the simulated drives errors
+// with a sign common to the runs exceed the reported sigmas (the height; where the drive does not
+// turn, the pitch, which follows the images' direction of travel), see
+// docs/benchmarks/uncertainty_drives.md and docs/benchmarks/travel_direction.md.
 std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform);
 
 // What the covariance of T_e is computed from: the joint problem and T_e's blocks in it (both
