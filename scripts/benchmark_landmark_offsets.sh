@@ -4,8 +4,9 @@
 # street_drive, made there unless WORK_DIR already has it), then COLMAP's point_triangulator on its
 # database at the true camera poses, then per landmark its signed offset along the true surface's
 # normal (scripts/landmark_offset_table.py), tabulated by the surface (road, walls) and by distance
-# and obliqueness. E_m pulls landmarks onto the LiDAR's surfaces; an offset common to a surface ends
-# in cam_from_lidar's translation along its normal. Writes docs/benchmarks/landmark_offsets.md.
+# and obliqueness, and the keypoints' image rows against the landmarks' projections by the distance
+# they are seen from. E_m pulls landmarks onto the LiDAR's surfaces; an offset common to a surface
+# ends in cam_from_lidar's translation along its normal. Writes docs/benchmarks/landmark_offsets.md.
 #   SEEDS     seeds 1..SEEDS (default 4)
 #   WORK_DIR  keep the runs there (default: a temporary folder, removed); shared with
 #             benchmark_uncertainty.sh
@@ -45,7 +46,11 @@ readonly kDoc=docs/benchmarks/landmark_offsets.md
   echo "front end's database at the true camera poses (the landmarks only are adjusted). Per"
   echo "landmark, from its observation in the nearest camera: the signed offset along the true"
   echo "surface's normal (positive: towards the camera), from the rendered depth; landmarks more than"
-  echo "5 cm off are left out as mismatches. sem: standard error of the mean."
+  echo "5 cm off are left out as mismatches. sem: standard error of the mean. The last table gives"
+  echo "every observation's keypoint row minus the landmark's projection, by the distance the"
+  echo "keypoint is seen from (positive: lower in the image): an offset that changes with that"
+  echo "distance is not absorbed by the landmark and moves the cameras (their direction of travel:"
+  echo "[travel_direction.md](travel_direction.md))."
   echo
   python3 scripts/landmark_offset_table.py table "${arguments[@]}"
 } > "$kDoc"

@@ -9,7 +9,9 @@
       keypoint's ray (the dataset's rendered z-depth, a plane fitted in inverse depth over the 4 x 4
       pixels around it; non-planar neighbourhoods are skipped), the surface normal, and the signed
       offset of the landmark along it (positive: towards the camera). Prints markdown tables by the
-      camera axis the surface faces and by distance, and by the cosine between ray and normal.
+      camera axis the surface faces and by distance, and by the cosine between ray and normal;
+      then, by surface and the distance each keypoint is seen from, the keypoints' image rows
+      against the landmark's projection.
 """
 import math
 import os
@@ -139,8 +141,23 @@ def norm(a):
     return math.sqrt(dot(a, a))
 
 
+def image_row_residuals(images, cameras, world, track):
+    """Per observation of a landmark (distance [m], keypoint row minus the landmark's projection
+    [px])."""
+    rows = []
+    for j in range(0, len(track), 2):
+        rot, trans, camera_id, _, keypoints = images[track[j]]
+        in_cam = tuple(dot(rot[r], world) + trans[r] for r in range(3))
+        camera = cameras[camera_id]
+        if in_cam[2] > 0:
+            row = camera[1] * in_cam[1] / in_cam[2] + camera[3]
+            rows.append((norm(in_cam), keypoints[track[j + 1]][1] - row))
+    return rows
+
+
 def landmark_offsets(model, dataset):
-    """Per landmark (facing axis, distance [m], cos(ray, normal), offset [m])."""
+    """Per landmark (facing axis, distance [m], cos(ray, normal), offset [m], its observations'
+    image_row_residuals)."""
     cameras = {int(f[0]): tuple(map(float, f[4:8])) for f in
                (line.split() for line in data_lines(os.path.join(model, "cameras.txt")))}
     images = read_images(model)
@@ -173,7 +190,8 @@ def landmark_offsets(model, dataset):
             normal = tuple(-x for x in normal)  # towards the camera
         facing = max(range(3), key=lambda k: abs(normal[k]))
         cosine = abs(dot(normal, surface)) / norm(surface)
-        rows.append((facing, norm(surface), cosine, dot(normal, sub(in_cam, surface))))
+        rows.append((facing, norm(surface), cosine, dot(normal, sub(in_cam, surface)),
+                     image_row_residuals(images, cameras, world, track)))
     return rows
 
 
@@ -206,6 +224,24 @@ def print_tables(rows):
                 n, median, mean, sem = summary(values)
                 print(f"| {kAxisNames[axis]} | {low:.1f}-{min(high, 1.0):.1f} | {n} | {median:+.3f} | "
                       f"{mean:+.3f} | {sem:.3f} |")
+    print()
+    print_row_residual_table(kept)
+
+
+def print_row_residual_table(kept):
+    """The observations' keypoint rows against the landmark's projection, by surface and distance:
+    an offset that changes with the distance a keypoint is seen from is not absorbed by the
+    landmark and moves the cameras."""
+    print("| surface faces | observed from [m] | observations | mean keypoint row minus projection "
+          "[px] | sem [px] |")
+    print("|---|---|---|---|---|")
+    for axis in (1, 0):
+        for low, high in kDistanceBins:
+            values = [r for landmark in kept if landmark[0] == axis
+                      for d, r in landmark[4] if low <= d < high]
+            if len(values) >= 10:
+                n, _, mean, sem = summary(values)
+                print(f"| {kAxisNames[axis]} | {low}-{high} | {n} | {mean:+.4f} | {sem:.4f} |")
 
 
 def main():
