@@ -12,6 +12,10 @@
       camera axis the surface faces and by distance, and by the cosine between ray and normal;
       then, by surface and the distance each keypoint is seen from, the keypoints' image rows
       against the landmark's projection.
+  landmark_offset_table.py road_rows HEIGHT_M NAME:MODEL_TXT ...
+      At each model's own poses (no truth needed): the keypoints' image rows against their
+      landmark's projection for the landmarks about HEIGHT_M below the observing camera (the road
+      under a car's camera), by the distance they are seen from.
 """
 import math
 import os
@@ -244,9 +248,48 @@ def print_row_residual_table(kept):
                 print(f"| {kAxisNames[axis]} | {low}-{high} | {n} | {mean:+.4f} | {sem:.4f} |")
 
 
+def road_row_residuals(model, height_m):
+    """Per observation of a landmark 0.35 m or less from height_m below its camera (camera y: the
+    road under a camera height_m over it) (distance [m], keypoint row minus projection [px])."""
+    cameras = {int(f[0]): tuple(map(float, f[4:8])) for f in
+               (line.split() for line in data_lines(os.path.join(model, "cameras.txt")))}
+    images = read_images(model)
+    rows = []
+    for line in data_lines(os.path.join(model, "points3D.txt")):
+        f = line.split()
+        world = tuple(map(float, f[1:4]))
+        track = list(map(int, f[8:]))
+        for j in range(0, len(track), 2):
+            rot, trans, _, _, _ = images[track[j]]
+            below = dot(rot[1], world) + trans[1]
+            if abs(below - height_m) <= 0.35:
+                rows += image_row_residuals(images, cameras, world, track[j:j + 2])
+    return rows
+
+
+def print_road_rows(height_m, arguments):
+    """The road's observations' keypoint rows against their landmark's projection, by distance, at
+    each model's own poses (no truth needed)."""
+    bins = ((0, 5), (5, 10), (10, 15), (15, 20), (20, 30), (30, math.inf))
+    print(f"| model | observed from [m] | observations {height_m:g} m below the camera | mean "
+          "keypoint row minus projection [px] | sem [px] |")
+    print("|---|---|---|---|---|")
+    for argument in arguments:
+        name, model = argument.split(":", 1)
+        rows = road_row_residuals(model, height_m)
+        for low, high in bins:
+            values = [r for d, r in rows if low <= d < high]
+            if len(values) >= 10:
+                n, _, mean, sem = summary(values)
+                print(f"| {name} | {low}-{high} | {n} | {mean:+.4f} | {sem:.4f} |")
+
+
 def main():
     if sys.argv[1] == "true_model":
         true_model(*sys.argv[2:5])
+        return
+    if sys.argv[1] == "road_rows":
+        print_road_rows(float(sys.argv[2]), sys.argv[3:])
         return
     rows = []
     seeds = []
