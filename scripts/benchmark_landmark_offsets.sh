@@ -66,9 +66,10 @@ readonly kDoc=docs/benchmarks/landmark_offsets.md
   if [ ${#adjusted[@]} -gt 0 ]; then
     echo
     echo "At the joint adjuster's poses (default options; the front ends of"
-    echo "\`scripts/benchmark_uncertainty.sh\`), no truth involved: the keypoint rows against their"
-    echo "landmark's projection for the landmarks 1.65 m (+- 0.35 m) under the observing camera, the"
-    echo "road, by the distance they are seen from. kitti_odometry: the real KITTI odometry sample."
+    echo "\`scripts/benchmark_uncertainty.sh\`), no truth involved: the keypoint rows against"
+    echo "their landmark's projection for the landmarks 1.65 m (+- 0.35 m) under the observing"
+    echo "camera, the road, by the distance they are seen from. kitti_odometry: the real KITTI"
+    echo "odometry sample."
     echo
     python3 scripts/landmark_offset_table.py road_rows 1.65 "${adjusted[@]}"
   fi
