@@ -5,7 +5,8 @@
 # cam_from_lidar_guess); REPORT_JSON may be '' (no sigmas). Prints one tab-separated line:
 # the labels, the errors (rotation vector of estimate * inverse(truth) about the camera axes [deg],
 # translation [mm]), the reported sigmas and z = error / sigma ('nan' for an axis reported without a
-# sigma: undetermined or held).
+# sigma: undetermined or held). A report whose uncertainty was not computed gives the labels,
+# 'FAILED' and the report's message instead, as a failed run does in the benchmarks' results.
 import json, math, sys
 
 
@@ -48,6 +49,11 @@ def sigmas(report_path):
 
 def main():
     truth, estimate, report = sys.argv[1:4]
+    uncertainty = json.load(open(report))['uncertainty'] if report else {}
+    if report and 'sigma_deg_mm' not in uncertainty and 'covariance_deg_mm' not in uncertainty:
+        message = 'no covariance: ' + uncertainty.get('message', '')
+        print('\t'.join(sys.argv[4:] + ['FAILED', message]))
+        return
     e, s = errors(truth, estimate), sigmas(report)
     z = [ek / sk if sk > 0 else float('nan') for ek, sk in zip(e, s)]  # nan > 0 is False
     print('\t'.join(sys.argv[4:] + ['%.4f' % v for v in e] + ['%.4f' % v for v in s] +

@@ -2,9 +2,9 @@
 # Writes the page comparing two variants of the joint adjuster on the same front ends (Markdown, to
 # stdout) from two results files of benchmark_uncertainty.sh:
 #   variant_table.py BASE_TSV VARIANT_TSV VARIANT VARIANT_OPTIONS
-# Only the runs present in both files (same scene and seed) are compared. Per family and variant:
-# errors beyond 2 sigma per axis, rms z, the mean and rms error per axis (determined axes only);
-# then every run's errors and z with both variants.
+# Only the runs present in both files (same scene and seed) are compared; failed runs are named.
+# Per family and variant: errors beyond 2 sigma per axis, rms z, the mean and rms error per axis
+# (determined axes only); then every run's errors and z with both variants.
 import datetime, math, os, sys
 
 base_path, variant_path, variant, options = sys.argv[1:]
@@ -12,19 +12,22 @@ axes = ['rx', 'ry', 'rz', 'tx', 'ty', 'tz']
 
 
 def load(path):
-    runs = {}
+    """The runs with results, and the failed ones' messages, by (scene, seed)."""
+    runs, failed = {}, {}
     for line in open(path):
         fields = line.rstrip('\n').split('\t')
         if len(fields) >= 20:
             runs[(fields[0], fields[1])] = [float(v) for v in fields[2:20]]
-    return runs
+        elif len(fields) >= 3 and fields[2] == 'FAILED':
+            failed[(fields[0], fields[1])] = ' '.join(fields[3:])
+    return runs, failed
 
 
 def seed_key(key):
     return (key[0], int(key[1]) if key[1].isdigit() else 0, key[1])
 
 
-base, other = load(base_path), load(variant_path)
+(base, base_failed), (other, other_failed) = load(base_path), load(variant_path)
 keys = sorted(set(base) & set(other), key=seed_key)
 families = sorted({k[0] for k in keys})
 names = [('default', base), (variant, other)]
@@ -70,6 +73,9 @@ print('|---|---|---|---|---|---|---|')
 for family in families:
     for name, runs in names:
         print(summary_row(family, name, runs))
+for name, failed in (('default', base_failed), (variant, other_failed)):
+    for key in sorted(failed, key=seed_key):
+        print('\nLeft out: %s seed %s failed with %s (%s).' % (key[0], key[1], name, failed[key]))
 print('\n| family | seed | variant | ' + ' | '.join('err ' + a for a in axes) + ' | ' +
       ' | '.join('z ' + a for a in axes) + ' |')
 print('|---|---|---|' + '---|' * 12)

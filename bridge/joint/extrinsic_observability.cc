@@ -532,10 +532,11 @@ std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform
                                : std::string("no turn of 2 deg");
   return "not validated for a moving platform turning about one axis (" + axis +
          "): the model leaves out errors common to the whole drive, which such a drive does not "
-         "average out: the images' systematic error of the direction of travel (which a drive "
-         "that does not turn passes on to cam_from_lidar's rotation), the LiDAR's and the stereo "
-         "depth's; read these sigmas as lower bounds (docs/benchmarks/uncertainty_drives.md and "
-         "travel_direction.md give the coverage measured on drives)";
+         "average out: the cameras' systematic error of the direction of travel (the road's "
+         "keypoint offsets; a drive that does not turn passes it on to cam_from_lidar's "
+         "rotation), the LiDAR's and the stereo depth's; read these sigmas as lower bounds "
+         "(docs/benchmarks/uncertainty_drives.md and travel_direction.md give the coverage "
+         "measured on drives)";
 }
 
 ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInputs& inputs,

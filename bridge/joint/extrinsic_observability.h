@@ -109,7 +109,7 @@ MotionAnalysis AnalyseMotion(const colmap::Reconstruction& reconstruction,
 // to end), else one sentence saying why it has not. A moving platform (sweeps, or a one-axis
 // hand-eye) whose stations turn about one axis, or not at all, is not: on the simulated drives errors
 // with a sign common to the runs exceed the reported sigmas (the height; where the drive does not
-// turn, the pitch, which follows the images' direction of travel), see
+// turn, the pitch, which follows the cameras' direction of travel), see
 // docs/benchmarks/uncertainty_drives.md and docs/benchmarks/travel_direction.md.
 std::string UncertaintyCaveat(const MotionAnalysis& motion, bool moving_platform);
 
