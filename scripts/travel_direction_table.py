@@ -120,8 +120,22 @@ def median(values):
     return (values[(len(values) - 1) // 2] + values[len(values) // 2]) / 2 if values else None
 
 
+kDriftedDeg = 1.0  # an images-only adjustment whose travel moved this far has drifted off
+
+
+def drifted(images):
+    return images is not None and max(abs(images[0]), abs(images[1])) > kDriftedDeg
+
+
 def images_only(rows, k):
-    return median([r[9][k] for r in rows if r[9]])
+    """Median over the runs whose images-only adjustment did not drift, and their number."""
+    kept = [r[9][k] for r in rows if r[9] and not drifted(r[9])]
+    return median(kept), len(kept)
+
+
+def images_cell(rows, k):
+    value, count = images_only(rows, k)
+    return f'{cell(value)} ({count} runs)' if count else ''
 
 
 def summary(rows):
@@ -134,8 +148,8 @@ def summary(rows):
         column = lambda k: [r[k] for r in own]
         print(f'| {label} | {len(own)} | {own[0][2]} | {cell(mean(column(3)))} | '
               f'{cell(mean(column(5)))} | {cell(correlation(column(3), column(5)), 2)} | '
-              f'{cell(images_only(own, 0))} | {cell(mean(column(6)))} | {cell(mean(column(8)))} | '
-              f'{cell(correlation(column(6), column(8)), 2)} | {cell(images_only(own, 1))} |')
+              f'{images_cell(own, 0)} | {cell(mean(column(6)))} | {cell(mean(column(8)))} | '
+              f'{cell(correlation(column(6), column(8)), 2)} | {images_cell(own, 1)} |')
 
 
 def main():
@@ -153,15 +167,16 @@ def main():
           'the step length, of the joint adjuster\'s cameras and of COLMAP\'s images-only bundle '
           'adjustment started at the true poses (the images\' own optimum: no LiDAR, no '
           'cam_from_lidar). corr.: correlation over the runs of the error of cam_from_lidar and '
-          'that of the joint\'s travel direction. The images-only columns give the median: '
-          'COLMAP\'s adjustment of a forward-moving single camera, whose scale is free, drifts off '
-          'in some runs.\n')
+          'that of the joint\'s travel direction. The images-only columns give the median over '
+          'the runs whose adjustment did not drift off (travel moved by less than 1 deg; COLMAP\'s '
+          'adjustment of a forward-moving single camera, whose scale is free, drifts in some '
+          'runs; empty cells).\n')
     summary(rows)
     print('\n| family | seed | err rx | z rx | travel pitch err | images only | err ry | z ry | '
           'travel yaw err | images only |')
     print('|---|---|---|---|---|---|---|---|---|---|')
     for r in rows:
-        images = r[9] or (None, None)
+        images = (None, None) if not r[9] or drifted(r[9]) else r[9]
         print(f'| {r[0]} | {r[1]} | {r[3]:+.4f} | {r[4]:+.2f} | {r[5]:+.4f} | {cell(images[0])} | '
               f'{r[6]:+.4f} | {r[7]:+.2f} | {r[8]:+.4f} | {cell(images[1])} |')
 
