@@ -15,50 +15,36 @@
 # errors are one direction.
 import datetime, math, os, sys
 
-
-def rotation(qw, qx, qy, qz):
-    return ((1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)),
-            (2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)),
-            (2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)))
+from landmark_offset_table import data_lines, read_images, rotation
 
 
 def transposed_times(r, v):
     return tuple(sum(r[i][j] * v[i] for i in range(3)) for j in range(3))
 
 
-def data_lines(path):
-    return [line.split() for line in open(path) if line.strip() and not line.startswith('#')]
+def world_from_cam(r, t):
+    """(world_from_cam rotation, camera centre) of a cam_from_world rotation r and translation t."""
+    return tuple(zip(*r)), tuple(-c for c in transposed_times(r, t))
 
 
 def truth_poses(path):
-    """(world_from_cam rotation, camera centre) per station, in the file's (station) order."""
-    poses = []
-    for f in sorted(data_lines(path), key=lambda f: f[0]):
-        r = rotation(*map(float, f[1:5]))
-        t = tuple(map(float, f[5:8]))
-        centre = tuple(-c for c in transposed_times(r, t))
-        poses.append((tuple(zip(*r)), centre))
-    return poses
+    """world_from_cam per station of a cam_from_world file, in station order."""
+    return [world_from_cam(rotation(*map(float, f[1:5])), tuple(map(float, f[5:8])))
+            for f in sorted((line.split() for line in data_lines(path)), key=lambda f: f[0])]
 
 
 def tum_poses(path):
     poses = []
-    for f in data_lines(path):
+    for f in (line.split() for line in data_lines(path)):
         qx, qy, qz, qw = map(float, f[4:8])
         poses.append((rotation(qw, qx, qy, qz), tuple(map(float, f[1:4]))))
     return poses
 
 
 def colmap_poses(model):
-    """(world_from_cam rotation, camera centre) per image of a TXT model, in name order."""
-    lines = [line.split() for line in open(os.path.join(model, 'images.txt'))
-             if not line.startswith('#')][0::2]
-    poses = []
-    for f in sorted((f for f in lines if len(f) >= 10), key=lambda f: f[9]):
-        r = rotation(*map(float, f[1:5]))
-        t = tuple(map(float, f[5:8]))
-        poses.append((tuple(zip(*r)), tuple(-c for c in transposed_times(r, t))))
-    return poses
+    """world_from_cam per image of a TXT model, in station order."""
+    return [world_from_cam(r, t) for r, t, _, _, _ in
+            sorted(read_images(model).values(), key=lambda image: image[3])]
 
 
 def travel_angles(poses):
