@@ -58,6 +58,12 @@ def true_model(model, truth_path, out):
                 f"{keypoints[j]} {keypoints[j + 1]} -1" for j in range(0, len(keypoints), 3)) + "\n")
 
 
+def read_cameras(model):
+    """Camera id -> (fx, fy, cx, cy) of a TXT model's pinhole cameras."""
+    return {int(f[0]): tuple(map(float, f[4:8])) for f in
+            (line.split() for line in data_lines(os.path.join(model, "cameras.txt")))}
+
+
 def read_images(model):
     images = {}
     lines = [line for line in open(os.path.join(model, "images.txt")) if not line.startswith("#")]
@@ -162,8 +168,7 @@ def image_row_residuals(images, cameras, world, track):
 def landmark_offsets(model, dataset):
     """Per landmark (facing axis, distance [m], cos(ray, normal), offset [m], its observations'
     image_row_residuals)."""
-    cameras = {int(f[0]): tuple(map(float, f[4:8])) for f in
-               (line.split() for line in data_lines(os.path.join(model, "cameras.txt")))}
+    cameras = read_cameras(model)
     images = read_images(model)
     depths = {}
     rows = []
@@ -251,8 +256,7 @@ def print_row_residual_table(kept):
 def road_row_residuals(model, height_m):
     """Per observation of a landmark 0.35 m or less from height_m below its camera (camera y: the
     road under a camera height_m over it) (distance [m], keypoint row minus projection [px])."""
-    cameras = {int(f[0]): tuple(map(float, f[4:8])) for f in
-               (line.split() for line in data_lines(os.path.join(model, "cameras.txt")))}
+    cameras = read_cameras(model)
     images = read_images(model)
     rows = []
     for line in data_lines(os.path.join(model, "points3D.txt")):
