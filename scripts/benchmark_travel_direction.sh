@@ -25,10 +25,7 @@ readonly kColmap="$kColmapPrefix/bin/colmap"
 arguments=()
 for entry in $kRuns; do
   scene="${entry%%:*}" seeds="${entry#*:}"
-  echo "== $scene, $seeds seeds: front ends and joint runs ($kVariant)"
-  WORK_DIR="$work" SCENES="$scene" SEEDS="$seeds" DRIVE_SEEDS="$seeds" \
-    DOC="$work/uncertainty-$kVariant.md" bash scripts/benchmark_uncertainty.sh > /dev/null
-  cp "$work/results-$kVariant.tsv" "$work/travel-$scene-$kVariant.tsv"
+  family_joint_runs "$scene" "$seeds" "$work/travel-$scene-$kVariant.tsv"
   for seed in $(seq 1 "$seeds"); do
     echo "[$scene $seed] COLMAP's images-only adjustment from the true poses ..."
     images_only_adjustment "$kColmap" "$work/$scene-$seed"

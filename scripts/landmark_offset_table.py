@@ -64,6 +64,12 @@ def read_cameras(model):
             (line.split() for line in data_lines(os.path.join(model, "cameras.txt")))}
 
 
+def image_names(model):
+    """Image id -> name of a TXT model's images."""
+    lines = [line for line in open(os.path.join(model, "images.txt")) if not line.startswith("#")]
+    return {int(lines[k].split()[0]): lines[k].split()[9] for k in range(0, len(lines) - 1, 2)}
+
+
 def read_images(model):
     images = {}
     lines = [line for line in open(os.path.join(model, "images.txt")) if not line.startswith("#")]

@@ -3,6 +3,9 @@
 #   true_pose_landmarks COLMAP RUN: COLMAP's point_triangulator on RUN/ws/database.db at the true
 #     camera poses of RUN/dataset (the landmarks only are adjusted), into
 #     RUN/true_pose_landmarks/triangulated (also as TXT); kept if already there.
+#   family_joint_runs SCENE SEEDS RESULTS: the front ends and joint runs of
+#     scripts/benchmark_uncertainty.sh for SCENE's seeds 1..SEEDS in $work (made there unless
+#     already there; VARIANT and JOINT_OPTIONS as there), their results copied to RESULTS.
 #   images_only_adjustment COLMAP RUN: then COLMAP's bundle_adjuster on that model (poses and
 #     landmarks, the intrinsics fixed: the images' own optimum near the truth), into
 #     RUN/true_pose_landmarks/adjusted (also as TXT); kept if already there.
@@ -34,4 +37,11 @@ images_only_adjustment() {
     --BundleAdjustment.refine_extra_params 0 >> "$out/log.txt" 2>&1
   "$colmap" model_converter --input_path "$out/adjusted" --output_path "$out/adjusted" \
     --output_type TXT >> "$out/log.txt" 2>&1
+}
+family_joint_runs() {
+  local scene=$1 seeds=$2
+  echo "== $scene, $seeds seeds: front ends and joint runs (${VARIANT:-default})"
+  WORK_DIR="$work" SCENES="$scene" SEEDS="$seeds" DRIVE_SEEDS="$seeds" \
+    DOC="$work/uncertainty-${VARIANT:-default}.md" bash scripts/benchmark_uncertainty.sh > /dev/null
+  cp "$work/results-${VARIANT:-default}.tsv" "$3"
 }
