@@ -9,7 +9,7 @@
 #                true depth maps), no noise: what is left is the LiDAR side and the estimator
 # Writes docs/benchmarks/error_sources.md (DOC to write another page).
 #   RUNS      families and their number of seeds, "SCENE:SEEDS ..." (default:
-#             kitti_layout_drive:6 straight_drive:6)
+#             kitti_layout_drive:6 street_drive_20:3 straight_drive:6)
 #   JOBS      joint runs at a time (default 2)
 #   WORK_DIR  keep the runs there (default: a temporary folder, removed); shared with
 #             benchmark_uncertainty.sh
@@ -21,7 +21,7 @@ source scripts/configure.sh
 source scripts/true_pose_model.sh
 use_work_dir
 use_cli
-readonly kRuns="${RUNS:-kitti_layout_drive:6 straight_drive:6}"
+readonly kRuns="${RUNS:-kitti_layout_drive:6 street_drive_20:3 straight_drive:6}"
 readonly kColmap="$kColmapPrefix/bin/colmap"
 
 # synthetic_run RUN KIND: the joint adjuster on RUN's front end with KIND's keypoints, into

@@ -10,6 +10,8 @@
 #     street_drive             the simulated street drive, one camera (DRIVE_FRAMES, default 40;
 #                              120000 rays per sweep), no guess, the whole pipeline's front end
 #     street_drive_stereo      the same drive with the second camera
+#     street_drive_20          its first 20 frames (those of kitti_layout_drive) in the simulator's
+#                              own layout, with true depth maps; not among the defaults
 #     straight_drive           the street drive in one lane without a turn (simulate_dataset
 #                              --motion straight_drive), one camera, no guess
 #     kitti_layout_drive       20 frames of the street drive written in KITTI raw's layout (one
@@ -73,12 +75,13 @@ pipeline_front_end() {
     --workspace_path "$run/ws" --Import.matcher sequential --stop_after pose_initializer
 }
 drive_front_end() {
-  local mono=1 motion=drive
+  local mono=1 motion=drive frames="${DRIVE_FRAMES:-40}"
   [ "$scene" = street_drive_stereo ] && mono=0
+  [ "$scene" = street_drive_20 ] && frames=20
   [ "$scene" = straight_drive ] && motion=straight_drive
   dataset="$run/dataset"
   step "$dataset" "$cli" simulate_dataset --scene street --motion "$motion" --mono "$mono" \
-    --seed "$seed" --num_stations "${DRIVE_FRAMES:-40}" --lidar_points 120000 --write_guess 0 \
+    --seed "$seed" --num_stations "$frames" --lidar_points 120000 --write_guess 0 \
     --pixel_samples "$kPixelSamples" --output_path "$dataset" && pipeline_front_end
 }
 kitti_layout_front_end() {
@@ -103,7 +106,7 @@ for scene in ${SCENES:-t_specimen bridge_pier street_drive street_drive_stereo s
   seeds=$(seq 1 "${SEEDS:-10}")
   case "$scene" in
     t_specimen | bridge_pier) front_end=stations_front_end ;;
-    street_drive | street_drive_stereo | straight_drive)
+    street_drive | street_drive_stereo | straight_drive | street_drive_20)
       front_end=drive_front_end seeds=$(seq 1 "${DRIVE_SEEDS:-${SEEDS:-10}}") ;;
     kitti_layout_drive)
       front_end=kitti_layout_front_end seeds=$(seq 1 "${DRIVE_SEEDS:-${SEEDS:-10}}") ;;

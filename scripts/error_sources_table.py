@@ -52,6 +52,10 @@ def main():
               datetime.date.today().isoformat(), os.cpu_count()))
     for kind in kKinds:
         print('- `%s`: %s.' % (kind, kKindText[kind]))
+    if 'street_drive_20' in results:
+        print('\n`street_drive_20` is the street drive\'s first 20 frames (those of '
+              '`kitti_layout_drive`) in the simulator\'s own layout, which has the true depth maps '
+              'that the KITTI layout lacks (`benchmark_uncertainty.sh` makes its front ends).')
     print('\nFrom one kind to the next one error source goes: SIFT\'s systematic keypoint errors '
           '(default to exact_noise), the keypoint noise (exact_noise to exact), the landmarks\' '
           'offsets from the surfaces that E_m sees (exact to surface). What `surface` keeps comes '

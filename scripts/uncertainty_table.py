@@ -20,6 +20,9 @@ FAMILIES = {
                      'moving cars left out)'),
     'street_drive_stereo': ('drive', 'the same drive with the second camera (stereo depth, depth '
                             'priors, the stereo-LiDAR alignment of the pose initialiser)'),
+    'street_drive_20': ('drive', 'the street drive\'s first 20 frames (those of '
+                        '`kitti_layout_drive`) in the simulator\'s own layout, with true depth '
+                        'maps, one camera, no guess'),
     'straight_drive': ('drive', 'the street drive in one lane without a turn, one camera, 40 '
                        'frames, 120000 rays per sweep, no guess; the pipeline with sequential '
                        'matching'),
