@@ -64,6 +64,11 @@ def read_cameras(model):
             (line.split() for line in data_lines(os.path.join(model, "cameras.txt")))}
 
 
+def to_camera(rot, trans, world):
+    """A world point in a camera (rotation rows, translation)."""
+    return tuple(dot(rot[r], world) + trans[r] for r in range(3))
+
+
 def image_names(model):
     """Image id -> name of a TXT model's images."""
     lines = [line for line in open(os.path.join(model, "images.txt")) if not line.startswith("#")]

@@ -7,6 +7,8 @@
 # (docs/benchmarks/error_sources.md).
 import struct, sys
 
+from landmark_offset_table import rotation
+
 
 def read_string(f):
     name = b""
@@ -21,15 +23,12 @@ def read_poses(path):
     with open(path, "rb") as f:
         for _ in range(struct.unpack("<Q", f.read(8))[0]):
             image_id = struct.unpack("<I", f.read(4))[0]
-            w, x, y, z = struct.unpack("<4d", f.read(32))
+            quaternion = struct.unpack("<4d", f.read(32))  # w first
             translation = struct.unpack("<3d", f.read(24))
             f.read(4)  # camera id
             read_string(f)
             f.seek(24 * struct.unpack("<Q", f.read(8))[0], 1)  # points2D
-            rows = ((1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
-                    (2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
-                    (2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)))
-            poses[image_id] = (rows, translation)
+            poses[image_id] = (rotation(*quaternion), translation)
     return poses
 
 

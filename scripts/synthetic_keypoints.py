@@ -19,11 +19,18 @@ import array, os, random, sqlite3, sys
 import landmark_offset_table as offsets
 
 
+def project(camera, in_cam):
+    """Pixel (x, y) of a point in a pinhole camera (fx, fy, cx, cy); (None, None) behind it."""
+    if in_cam[2] <= 0:
+        return None, None
+    fx, fy, cx, cy = camera
+    return fx * in_cam[0] / in_cam[2] + cx, fy * in_cam[1] / in_cam[2] + cy
+
+
 def surface_point(images, cameras, depths, dataset, world, track):
     """The true surface point on the ray of the landmark's nearest observation (world), or None."""
     def distance(j):
-        rot, trans = images[track[j]][0], images[track[j]][1]
-        return offsets.norm(tuple(offsets.dot(rot[r], world) + trans[r] for r in range(3)))
+        return offsets.norm(offsets.to_camera(images[track[j]][0], images[track[j]][1], world))
     nearest = min(range(0, len(track), 2), key=distance)
     rot, trans, camera_id, station, keypoints = images[track[nearest]]
     if station not in depths:
@@ -54,13 +61,10 @@ def synthetic_keypoints(kind, true_model, dataset, noise_px, seed):
                 world, moved = on_surface, moved + 1
         for j in range(0, len(track), 2):
             rot, trans, camera_id, _, _ = images[track[j]]
-            in_cam = tuple(offsets.dot(rot[r], world) + trans[r] for r in range(3))
-            if in_cam[2] <= 0:
-                continue
-            fx, fy, cx, cy = cameras[camera_id]
-            keypoints[(names[track[j]], track[j + 1])] = (
-                fx * in_cam[0] / in_cam[2] + cx + noise_px * rng.gauss(0, 1),
-                fy * in_cam[1] / in_cam[2] + cy + noise_px * rng.gauss(0, 1))
+            x, y = project(cameras[camera_id], offsets.to_camera(rot, trans, world))
+            if x is not None:
+                keypoints[(names[track[j]], track[j + 1])] = (
+                    x + noise_px * rng.gauss(0, 1), y + noise_px * rng.gauss(0, 1))
     return keypoints, moved
 
 
@@ -112,12 +116,11 @@ def residual_rms(true_model):
         track = list(map(int, f[8:]))
         for j in range(0, len(track), 2):
             rot, trans, camera_id, _, keypoints = images[track[j]]
-            in_cam = tuple(offsets.dot(rot[r], world) + trans[r] for r in range(3))
-            fx, fy, cx, cy = cameras[camera_id]
-            x, y = keypoints[track[j + 1]]
-            total += (x - fx * in_cam[0] / in_cam[2] - cx) ** 2
-            total += (y - fy * in_cam[1] / in_cam[2] - cy) ** 2
-            count += 2
+            x, y = project(cameras[camera_id], offsets.to_camera(rot, trans, world))
+            if x is not None:
+                u, v = keypoints[track[j + 1]]
+                total += (u - x) ** 2 + (v - y) ** 2
+                count += 2
     return (total / count) ** 0.5
 
 
