@@ -1,5 +1,6 @@
 #include "bridge/joint/joint_adjuster.h"
 
+#include "bridge/joint/camera_centre_observations.h"
 #include "bridge/joint/extrinsic_deviation_cost.h"
 #include "bridge/joint/extrinsic_prior_cost.h"
 #include "bridge/joint/free_axis_extrinsic_cost.h"
@@ -640,10 +641,26 @@ SolveStats Solve(const RunState& state,
   stats.residuals = static_cast<size_t>(summary.num_residuals);
   stats.termination = ceres::TerminationTypeToString(summary.termination_type);
   stats.invalid_steps = NumInvalidSteps(summary);
-  if (stats.invalid_steps > 0) {
+  // A landmark at a camera's centre makes that camera's pose look undetermined; its observation
+  // leaves first (RemoveObservationsAtCameraCentres) and the solve runs again.
+  if (stats.invalid_steps > 0 && ObservationsAtCameraCentres(*state.reconstruction).empty()) {
     *undetermined_landmarks = UndeterminedLandmarks(state, problem, stats.invalid_steps);
   }
   return stats;
+}
+
+// Deletes `observations` still in the reconstruction; returns how many. Deleting an observation
+// deletes the whole landmark when its track drops below two.
+size_t DeleteObservations(const std::vector<ImagePoint>& observations,
+                          colmap::Reconstruction* reconstruction) {
+  size_t deleted = 0;
+  for (const ImagePoint& observation : observations) {
+    if (reconstruction->Image(observation.first).Point2D(observation.second).HasPoint3D()) {
+      reconstruction->DeleteObservation(observation.first, observation.second);
+      ++deleted;
+    }
+  }
+  return deleted;
 }
 
 // Reprojection outliers (> max px) leave the reconstruction, as in COLMAP's filtering; returns how many.
@@ -664,15 +681,22 @@ size_t RemoveReprojectionOutliers(RunState* state) {
       }
     }
   }
-  size_t removed = 0;
-  for (const ImagePoint& observation : bad) {
-    // Deleting an observation deletes the whole landmark when its track drops below two.
-    if (reconstruction.Image(observation.first).Point2D(observation.second).HasPoint3D()) {
-      reconstruction.DeleteObservation(observation.first, observation.second);
-      ++removed;
-    }
-  }
+  const size_t removed = DeleteObservations(bad, &reconstruction);
   state->num_reprojection_outliers += removed;
+  return removed;
+}
+
+// Observations of landmarks at their camera's centre (ObservationsAtCameraCentres) leave the
+// reconstruction; returns how many.
+size_t RemoveObservationsAtCameraCentres(RunState* state) {
+  const size_t removed = DeleteObservations(ObservationsAtCameraCentres(*state->reconstruction),
+                                            state->reconstruction);
+  if (removed > 0) {
+    std::cout << "  " << removed
+              << " observation(s) of a landmark at the observing camera's centre leave the "
+                 "reconstruction"
+              << std::endl;
+  }
   return removed;
 }
 
@@ -886,7 +910,8 @@ void SolveWithOutliers(int round,
     }
     stats.round = round + 1;
     stats.outlier_iteration = iteration + 1;
-    size_t changes = undetermined.size() + RemoveReprojectionOutliers(state);
+    size_t changes = undetermined.size() + RemoveObservationsAtCameraCentres(state);
+    changes += RemoveReprojectionOutliers(state);
     changes += UpdateDepthOutliers(state, &stats.depth_outliers);
     changes += FlagLidarOutliers(state, &associations->lidar);
     changes += FlagLandmarkOutliers(state, &associations->landmarks);
