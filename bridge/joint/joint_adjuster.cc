@@ -910,7 +910,8 @@ void SolveWithOutliers(int round,
     }
     stats.round = round + 1;
     stats.outlier_iteration = iteration + 1;
-    size_t changes = undetermined.size() + RemoveObservationsAtCameraCentres(state);
+    stats.observations_at_camera_centres = RemoveObservationsAtCameraCentres(state);
+    size_t changes = undetermined.size() + stats.observations_at_camera_centres;
     changes += RemoveReprojectionOutliers(state);
     changes += UpdateDepthOutliers(state, &stats.depth_outliers);
     changes += FlagLidarOutliers(state, &associations->lidar);

@@ -254,6 +254,9 @@ struct SolveStats {
   // Steps Ceres rejected as invalid (a failed linear solve or evaluation); a solve with any on a
   // problem that leaves parameters undetermined stops with an error naming them.
   int invalid_steps = 0;
+  // Observations of landmarks at their camera's centre removed after the solve
+  // (bridge/joint/camera_centre_observations.h).
+  size_t observations_at_camera_centres = 0;
 };
 
 struct PerturbationCurve {

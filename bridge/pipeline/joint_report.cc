@@ -79,6 +79,7 @@ nlohmann::json SolvesJson(const std::vector<SolveStats>& stats) {
                       {"iterations", solve.num_iterations},
                       {"termination", solve.termination},
                       {"invalid_steps", solve.invalid_steps},
+                      {"observations_at_camera_centres", solve.observations_at_camera_centres},
                       {"seconds", solve.seconds}});
   }
   return solves;
