@@ -87,7 +87,10 @@ void TriangulateRegistered(const std::string& database_path,
   options->ba_refine_focal_length = false;
   options->ba_refine_principal_point = false;
   options->ba_refine_extra_params = false;
-  options->num_threads = -1;
+  // One thread: with more, Ceres sums the landmark-only adjustment's partial results in the order
+  // its threads finish, which makes the landmarks (and the joint adjustment on them) depend on the
+  // machine's core count in their last digits.
+  options->num_threads = 1;
   colmap::IncrementalMapperController mapper(
       options, "", database_path, std::make_shared<colmap::ReconstructionManager>());
   mapper.TriangulateReconstruction(reconstruction);
