@@ -141,6 +141,12 @@ for scene in ${SCENES:-t_specimen bridge_pier street_drive street_drive_stereo s
 done
 mkdir -p docs/benchmarks
 readonly kDoc="${DOC:-docs/benchmarks/uncertainty.md}"
-START="${START:-initial}" PIXEL_SAMPLES="$kPixelSamples" python3 scripts/uncertainty_table.py "$results" "$kVariant" \
-  "${JOINT_OPTIONS:-}" > "$kDoc"
+reference=""
+if [ -d "$kSample" ]; then  # the real sample's reference and its own uncertainty
+  reference="$work/reference.tsv"
+  python3 scripts/kitti_reference_uncertainty.py \
+    "$PWD/../shared/data/kitti_raw_2011_09_28_sample/calibration" "$kSample/calib.txt" > "$reference"
+fi
+START="${START:-initial}" PIXEL_SAMPLES="$kPixelSamples" REFERENCE_TSV="$reference" \
+  python3 scripts/uncertainty_table.py "$results" "$kVariant" "${JOINT_OPTIONS:-}" > "$kDoc"
 cat "$kDoc"

@@ -113,6 +113,28 @@ def print_summary():
                translation_ok, len(ok)))
 
 
+def print_reference_z():
+    """The real sample's z against the reference's own uncertainty (REFERENCE_TSV: the line of
+    kitti_reference_uncertainty.py, its pooled sigmas first)."""
+    real = [r for r in rows if r[0] == 'kitti_odometry' and r[2] != 'FAILED']
+    if not real or not os.environ.get('REFERENCE_TSV'):
+        return
+    reference = [float(v) for v in open(os.environ['REFERENCE_TSV']).read().split()]
+    sigma_reference = [reference[0]] * 3 + [reference[1]] * 3
+    print('\nThe real sample\'s reference is itself an estimate, with a sigma of about %.3f deg and '
+          '%.1f mm (KITTI\'s calibrations of two days, [kitti_extrinsic.md](kitti_extrinsic.md)). '
+          'z_ref = error / sqrt(sigma^2 + sigma_ref^2) is the test of the reported sigma that this '
+          'reference can make:\n' % (reference[0], reference[1]))
+    print('| scene | rig | ' + ' | '.join('z_ref ' + a for a in axes) + ' |')
+    print('|---|---|' + '---|' * 6)
+    for r in real:
+        z_ref = ['undet.' if math.isnan(number(s))
+                 else '%.2f' % (number(v) / math.hypot(number(s), sigma_reference[k]))
+                 for k, (v, s) in enumerate(zip(r[2:8], r[8:14]))]
+        print('| %s | %s | ' % (r[0], r[1]) + ' | '.join(z_ref) + ' |')
+
+
 print_header()
 print_runs()
 print_summary()
+print_reference_z()
