@@ -142,10 +142,10 @@ done
 mkdir -p docs/benchmarks
 readonly kDoc="${DOC:-docs/benchmarks/uncertainty.md}"
 reference=""
-if [ -d "$kSample" ]; then  # the real sample's reference and its own uncertainty
+readonly kOtherDay="$PWD/../shared/data/kitti_raw_2011_09_28_sample/calibration"
+if [ -d "$kSample" ] && [ -d "$kOtherDay" ]; then  # the real sample's reference's own uncertainty
   reference="$work/reference.tsv"
-  python3 scripts/kitti_reference_uncertainty.py \
-    "$PWD/../shared/data/kitti_raw_2011_09_28_sample/calibration" "$kSample/calib.txt" > "$reference"
+  python3 scripts/kitti_reference_uncertainty.py "$kOtherDay" "$kSample/calib.txt" > "$reference"
 fi
 START="${START:-initial}" PIXEL_SAMPLES="$kPixelSamples" REFERENCE_TSV="$reference" \
   python3 scripts/uncertainty_table.py "$results" "$kVariant" "${JOINT_OPTIONS:-}" > "$kDoc"
