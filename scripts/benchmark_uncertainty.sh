@@ -18,6 +18,9 @@
 #                              camera), imported by import_kitti with its seeded 1 deg / 5 cm guess
 #     kitti_odometry           the real sample ../shared/data/kitti_odometry_04_sample, stereo and
 #                              mono, no guess, against KITTI's calibration (one run per rig, no seeds)
+#     kitti_odometry_halves    its frames 0-9 and 10-19 as two drives (seeds stereo-1, stereo-2,
+#                              mono-1, mono-2): the difference of the halves' estimates tests the
+#                              sigmas without the reference
 #   SEEDS   seeds 1..SEEDS of the simulated families (default 10); DRIVE_SEEDS those of the drives
 #           (default SEEDS)
 #   VARIANT the joint adjuster's run is RUN/joint-VARIANT (default: default), with JOINT_OPTIONS
@@ -93,16 +96,18 @@ kitti_layout_front_end() {
     --calib_path "$run/kitti/calibration" --output_path "$dataset" --write_guess 1 \
     --guess_rotation_deg 1 --seed "$seed" && pipeline_front_end
 }
-kitti_odometry_front_end() {  # seed: stereo | mono
-  local use_right=1
-  [ "$seed" = mono ] && use_right=0
+kitti_odometry_front_end() {  # seed: stereo | mono, or with the half: stereo-1 | stereo-2 | ...
+  local use_right=1 frames=()
+  [ "${seed%-*}" = mono ] && use_right=0
+  [ "$seed" != "${seed%-1}" ] && frames=(--first 0 --last 9)
+  [ "$seed" != "${seed%-2}" ] && frames=(--first 10 --last 19)
   dataset="$run/dataset"
   step "$dataset" "$cli" import_kitti --format odometry --sequence_path "$kSample" \
-    --poses_path "$kSample/poses/04.txt" --output_path "$dataset" --use_right "$use_right" &&
-  pipeline_front_end
+    --poses_path "$kSample/poses/04.txt" --output_path "$dataset" --use_right "$use_right" \
+    "${frames[@]}" && pipeline_front_end
 }
 
-for scene in ${SCENES:-t_specimen bridge_pier street_drive street_drive_stereo straight_drive kitti_layout_drive kitti_odometry}; do
+for scene in ${SCENES:-t_specimen bridge_pier street_drive street_drive_stereo straight_drive kitti_layout_drive kitti_odometry kitti_odometry_halves}; do
   seeds=$(seq 1 "${SEEDS:-10}")
   case "$scene" in
     t_specimen | bridge_pier) front_end=stations_front_end ;;
@@ -111,9 +116,11 @@ for scene in ${SCENES:-t_specimen bridge_pier street_drive street_drive_stereo s
     kitti_layout_drive)
       front_end=kitti_layout_front_end seeds=$(seq 1 "${DRIVE_SEEDS:-${SEEDS:-10}}") ;;
     kitti_odometry) front_end=kitti_odometry_front_end seeds="stereo mono" ;;
+    kitti_odometry_halves)
+      front_end=kitti_odometry_front_end seeds="stereo-1 stereo-2 mono-1 mono-2" ;;
     *) echo "unknown scene $scene" >&2; exit 2 ;;
   esac
-  if [ "$scene" = kitti_odometry ] && [ ! -d "$kSample" ]; then
+  if [ "${scene%_halves}" = kitti_odometry ] && [ ! -d "$kSample" ]; then
     echo "[$scene] skipped: $kSample is missing"
     continue
   fi
