@@ -86,11 +86,13 @@ def main():
     print('# The joint adjuster with `%s` against its default, on the same front ends\n' % variant)
     how = os.environ.get('VARIANT_DESCRIPTION') or (
         'with its default options and with `%s`' % options.strip())
-    print('Written by `scripts/benchmark_estimator_variant.sh` on %s (%d cores), variant `%s`. The '
+    writer = ('scripts/variant_table.py' if os.environ.get('VARIANT_DESCRIPTION')
+              else 'scripts/benchmark_estimator_variant.sh')
+    print('Written by `%s` on %s (%d cores), variant `%s`. The '
           'front ends and families are those of [uncertainty.md](uncertainty.md) '
           '(`scripts/benchmark_uncertainty.sh`); per family and seed the joint adjuster runs twice '
           'on the same initial model, %s.\n' % (
-              datetime.date.today().isoformat(), os.cpu_count(), variant, how))
+              writer, datetime.date.today().isoformat(), os.cpu_count(), variant, how))
     print(kErrorsLegend + '\n')
     print_summary_header()
     for family in families:
