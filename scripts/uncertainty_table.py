@@ -147,8 +147,9 @@ def print_halves():
           'share no measurement and no reference, so z_12 = (estimate 1 - estimate 2) / '
           'sqrt(sigma_1^2 + sigma_2^2) tests the reported sigmas without KITTI\'s calibration. '
           'Errors common to both halves (the camera\'s and the LiDAR\'s own calibration) cancel '
-          'in the difference: the test covers the errors that change along the drive. chi2 sums z_12^2 over '
-          'the axes both halves determine (as if independent; 5 axes: 95 % below 11.1).\n')
+          'in the difference: the test covers the errors that change along the drive. chi2 sums '
+          'z_12^2 over the axes both halves determine (as if independent; 5 axes: 95 % below '
+          '11.1).\n')
     print('| rig | ' + ' | '.join('diff ' + a for a in axes) + ' | ' +
           ' | '.join('z_12 ' + a for a in axes) + ' | chi2 | axes |')
     print('|---|' + '---|' * 14)
