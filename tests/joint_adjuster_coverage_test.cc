@@ -4,10 +4,9 @@
 // the adjuster assumes for them, LiDAR with 1 cm range noise;
 // tests/testing/synthetic_joint_problem.h), the true error must lie within 2 reported sigma about
 // 95 % of the time on every axis (rotation about the camera axes, translation along them).
-// With 6 stations the two-way clustering's station sums are a noisy estimate, which puts the
-// coverage in the lower half of the bounds. The formal covariance (no clusters, no consider terms)
-// falls far below them on tz; the rotation axes fail while the manifold's tangent is read as a
-// rotation vector (half the angle).
+// Measured: 90-98 % per axis, rms error/sigma 0.88-1.2. The formal covariance (no clusters, no
+// consider terms) covers tz 34 % of the time; the rotation axes fail while the manifold's tangent
+// is read as a rotation vector (half the angle).
 #include "bridge/joint/joint_adjuster.h"
 #include "tests/testing/synthetic_joint_problem.h"
 

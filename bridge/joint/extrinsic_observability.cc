@@ -375,10 +375,9 @@ Eigen::MatrixXd GroupedSandwich(const std::vector<Eigen::VectorXd>& scores,
 // v_c = (J_c X)^T r_c over the data rows, and T_e's response to each of the stereo depth's
 // consider parameters s (its scale and disparity bias field), dx = -H^-1 J^T dr/ds. H includes the
 // regularisers (they keep it invertible); their rows add no score.
-// With group keys (two-way clustering, Cameron, Gelbach & Miller 2011): V = V_A + V_B - V_AB, with A
-// the clusters merged by their first group key (the landmark), B by their second (the station), AB
-// the clusters themselves, then negative eigenvalues clipped; errors shared by a landmark's
-// residuals and errors shared by a station's are then both covered.
+// With station groups (two-way clustering, Cameron, Gelbach & Miller 2011): V = V_A + V_B - V_AB, with A
+// the clusters merged by their first group key, B by their second, AB the clusters themselves, then
+// negative eigenvalues clipped; errors shared by every pair of one station are then covered.
 struct ClusterRobustCovariance {
   Eigen::MatrixXd sandwich;              // in the parameters' own units
   Eigen::MatrixXd consider_sensitivity;  // dT_e / d(consider parameters), one column each

@@ -2,10 +2,9 @@
 // - its 6x6 covariance from the joint problem's Gauss-Newton information H = J^T J (every other variable
 //   block marginalised). Two estimates: the formal one, H^-1 scaled by the a-posteriori variance factor,
 //   assumes independent residuals; the reported one is cluster-robust (a sandwich H^-1 (sum_c g_c g_c^T)
-//   H^-1 with g_c = J_c^T r_c summed per cluster), clustered two ways: by landmark and by station
-//   (Cameron, Gelbach & Miller 2011), because residuals of one landmark share errors (its texture,
-//   its surface) and so do those of one station (a stereo depth bias, its sweep's errors); the formal
-//   covariance is then several times too optimistic. Directions whose
+//   H^-1 with g_c = J_c^T r_c summed per cluster: a LiDAR station pair, an image's depth priors, a
+//   landmark's reprojections), because residuals of one cluster share errors (a stereo depth bias, a
+//   LiDAR surface) and the formal covariance is then several times too optimistic. Directions whose
 //   standard deviation exceeds a threshold are named in words;
 // - the uniqueness test of Zhen et al. 2019 on the relative motions: T_e is unique only with >= 3 stations whose
 //   relative rotation axes are not all parallel (hand-eye calibration, AX = XB).
@@ -41,6 +40,11 @@ struct ObservabilityOptions {
   // b f). The scale and the field are the stereo depth's errors common to every prior, which the
   // priors' scatter cannot reveal.
   double disparity_bias_sigma_px = 0.02;
+  // Two-way clustering of the LiDAR term: besides each directed pair, the pairs that share a target
+  // station and those that share a source station form clusters (a station's cloud errors, e.g. its
+  // normals near edges, enter every pair it is part of). Off by default: it lowered the coverage of
+  // the synthetic coverage test without explaining the end-to-end errors.
+  bool two_way_lidar_clusters = false;
   // relative rotations below this do not count as rotating
   double min_rotation_deg = 2.0;
   // axes closer than this are parallel
@@ -127,8 +131,8 @@ struct ExtrinsicUncertaintyInputs {
   Eigen::Matrix3d undetermined_translation = Eigen::Matrix3d::Zero();
   // Every data residual block of the problem, grouped (see above).
   std::vector<std::vector<ceres::ResidualBlockId>> clusters;
-  // Empty (one-way clustering), or per cluster two group keys for two-way clustering: its landmark
-  // and its station (-1: the cluster is a group of its own in that grouping).
+  // Empty, or per cluster two group keys (a LiDAR pair's target and source station; -1: the
+  // cluster is a group of its own) for two-way clustering.
   std::vector<std::array<int, 2>> cluster_groups;
   // Residual blocks that are not data (the weak extrinsic prior): they keep the information
   // invertible for the sandwich but never decide what is observable.
