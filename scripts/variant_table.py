@@ -2,8 +2,6 @@
 # Writes the page comparing two variants of the joint adjuster on the same front ends (Markdown, to
 # stdout) from two results files of benchmark_uncertainty.sh:
 #   variant_table.py BASE_TSV VARIANT_TSV VARIANT VARIANT_OPTIONS
-# (environment VARIANT_DESCRIPTION: how the two runs differ, when it is not the options, e.g. two
-# builds of the joint adjuster)
 # Only the runs present in both files (same scene and seed) are compared; failed runs are named.
 # Per family and variant: errors beyond 2 sigma per axis, rms z, the mean and rms error per axis
 # (determined axes only); then every run's errors and z with both variants.
@@ -84,15 +82,11 @@ def main():
     families = sorted({k[0] for k in keys})
     names = [('default', base), (variant, other)]
     print('# The joint adjuster with `%s` against its default, on the same front ends\n' % variant)
-    how = os.environ.get('VARIANT_DESCRIPTION') or (
-        'with its default options and with `%s`' % options.strip())
-    writer = ('scripts/variant_table.py' if os.environ.get('VARIANT_DESCRIPTION')
-              else 'scripts/benchmark_estimator_variant.sh')
-    print('Written by `%s` on %s (%d cores), variant `%s`. The '
+    print('Written by `scripts/benchmark_estimator_variant.sh` on %s (%d cores), variant `%s`. The '
           'front ends and families are those of [uncertainty.md](uncertainty.md) '
           '(`scripts/benchmark_uncertainty.sh`); per family and seed the joint adjuster runs twice '
-          'on the same initial model, %s.\n' % (
-              writer, datetime.date.today().isoformat(), os.cpu_count(), variant, how))
+          'on the same initial model, with its default options and with `%s`.\n' % (
+              datetime.date.today().isoformat(), os.cpu_count(), variant, options.strip()))
     print(kErrorsLegend + '\n')
     print_summary_header()
     for family in families:
