@@ -34,6 +34,8 @@ FAMILIES = {
     'kitti_odometry_halves': ('drive', 'the same sample\'s frames 0-9 (seed -1) and 10-19 (seed -2) '
                               'as two drives of their own, stereo and mono, no guess'),
 }
+# The 95 % quantile of chi-square with 0..6 degrees of freedom.
+CHI2_95 = [0.0, 3.84, 5.99, 7.81, 9.49, 11.07, 12.59]
 # The goals of a family: rotation error [deg], translation error on determined axes [mm].
 GOALS = {'tripod': (0.05, 2.0), 'drive': (0.1, 20.0)}
 
@@ -59,7 +61,8 @@ def print_header():
     for scene in sorted({r[0] for r in rows}):
         if scene in FAMILIES:
             print('- `%s`: %s.' % (scene, FAMILIES[scene][1]))
-    if any(FAMILIES.get(r[0], ('',))[0] == 'drive' and not r[0].startswith('kitti_odometry') for r in rows):
+    if any(FAMILIES.get(r[0], ('',))[0] == 'drive' and not r[0].startswith('kitti_odometry')
+           for r in rows):
         print('\nThe simulated drives\' images: %s rays per pixel axis (`simulate_dataset '
               '--pixel_samples`).' % os.environ.get('PIXEL_SAMPLES', '1'))
     print('\nErrors: the rotation vector of estimate * inverse(truth) about the camera axes [deg], the '
@@ -148,11 +151,11 @@ def print_halves():
           'sqrt(sigma_1^2 + sigma_2^2) tests the reported sigmas without KITTI\'s calibration. '
           'Errors common to both halves (the camera\'s and the LiDAR\'s own calibration) cancel '
           'in the difference: the test covers the errors that change along the drive. chi2 sums '
-          'z_12^2 over the axes both halves determine (as if independent; 5 axes: 95 % below '
-          '11.1).\n')
+          'z_12^2 over the axes both halves determine (as if independent); 95 % of chi2 draws '
+          'with that many axes lie below the bound.\n')
     print('| rig | ' + ' | '.join('diff ' + a for a in axes) + ' | ' +
-          ' | '.join('z_12 ' + a for a in axes) + ' | chi2 | axes |')
-    print('|---|' + '---|' * 14)
+          ' | '.join('z_12 ' + a for a in axes) + ' | chi2 | axes | 95 % bound |')
+    print('|---|' + '---|' * 15)
     for rig in rigs:
         first, second = halves[rig + '-1'], halves[rig + '-2']
         diffs, zs = [], []
@@ -163,9 +166,9 @@ def print_halves():
             diffs.append('undet.' if undetermined else ('%.4f' if k < 3 else '%.1f') % diff)
             zs.append(math.nan if undetermined else diff / math.hypot(s1, s2))
         determined = [z for z in zs if not math.isnan(z)]
-        print('| %s | %s | %s | %.1f | %d |' % (
+        print('| %s | %s | %s | %.1f | %d | %.1f |' % (
             rig, ' | '.join(diffs), ' | '.join('undet.' if math.isnan(z) else '%.2f' % z for z in zs),
-            sum(z * z for z in determined), len(determined)))
+            sum(z * z for z in determined), len(determined), CHI2_95[len(determined)]))
 
 
 print_header()
