@@ -4,7 +4,7 @@
 // the adjuster assumes for them, LiDAR with 1 cm range noise;
 // tests/testing/synthetic_joint_problem.h), the true error must lie within 2 reported sigma about
 // 95 % of the time on every axis (rotation about the camera axes, translation along them).
-// Measured: 90-98 % per axis, rms error/sigma 0.88-1.2. The formal covariance (no clusters, no
+// Measured: 90-98 % per axis, rms error/sigma 0.87-1.1. The formal covariance (no clusters, no
 // consider terms) covers tz 34 % of the time; the rotation axes fail while the manifold's tangent
 // is read as a rotation vector (half the angle).
 #include "bridge/joint/joint_adjuster.h"

@@ -375,9 +375,12 @@ Eigen::MatrixXd GroupedSandwich(const std::vector<Eigen::VectorXd>& scores,
 // v_c = (J_c X)^T r_c over the data rows, and T_e's response to each of the stereo depth's
 // consider parameters s (its scale and disparity bias field), dx = -H^-1 J^T dr/ds. H includes the
 // regularisers (they keep it invertible); their rows add no score.
-// With station groups (two-way clustering, Cameron, Gelbach & Miller 2011): V = V_A + V_B - V_AB, with A
-// the clusters merged by their first group key, B by their second, AB the clusters themselves, then
-// negative eigenvalues clipped; errors shared by every pair of one station are then covered.
+// With group keys (two-way clustering, Cameron, Gelbach & Miller 2011): V = V_A + [V_B - V_AB]+, with
+// A the clusters merged by their first group key (the landmark), B by their second (one sensor's
+// capture at one station), AB the clusters themselves. V_B - V_AB estimates the variance that
+// errors shared within the second groups add; [.]+ keeps its nonnegative eigenvalues, as a variance
+// component's estimate is truncated at zero: with few stations, the station sums (partly absorbed
+// by the stations' own poses) would otherwise take away from the landmark clusters' variance.
 struct ClusterRobustCovariance {
   Eigen::MatrixXd sandwich;              // in the parameters' own units
   Eigen::MatrixXd consider_sensitivity;  // dT_e / d(consider parameters), one column each
@@ -419,11 +422,11 @@ std::optional<ClusterRobustCovariance> ClusterRobust(
       first[c] = cluster_groups[c][0];
       second[c] = cluster_groups[c][1];
     }
-    const Eigen::MatrixXd two_way =
-        GroupedSandwich(scores, first) + GroupedSandwich(scores, second) - *sandwich;
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(two_way);
-    *sandwich = eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
-                eigen.eigenvectors().transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> shared(GroupedSandwich(scores, second) -
+                                                          *sandwich);
+    *sandwich = GroupedSandwich(scores, first) +
+                shared.eigenvectors() * shared.eigenvalues().cwiseMax(0.0).asDiagonal() *
+                    shared.eigenvectors().transpose();
   }
   *sandwich += known;
   if (!sandwich->allFinite()) return std::nullopt;

@@ -2,9 +2,11 @@
 // - its 6x6 covariance from the joint problem's Gauss-Newton information H = J^T J (every other variable
 //   block marginalised). Two estimates: the formal one, H^-1 scaled by the a-posteriori variance factor,
 //   assumes independent residuals; the reported one is cluster-robust (a sandwich H^-1 (sum_c g_c g_c^T)
-//   H^-1 with g_c = J_c^T r_c summed per cluster: a LiDAR station pair, an image's depth priors, a
-//   landmark's reprojections), because residuals of one cluster share errors (a stereo depth bias, a
-//   LiDAR surface) and the formal covariance is then several times too optimistic. Directions whose
+//   H^-1 with g_c = J_c^T r_c summed per cluster), clustered two ways (Cameron, Gelbach & Miller
+//   2011): by landmark, whose residuals share its texture's and its surface's errors, and by one
+//   sensor's capture at one station (an image's reprojections, its depth priors, the LiDAR pairs
+//   of one target sweep), whose residuals share that capture's errors; the formal covariance is
+//   then several times too optimistic. Directions whose
 //   standard deviation exceeds a threshold are named in words;
 // - the uniqueness test of Zhen et al. 2019 on the relative motions: T_e is unique only with >= 3 stations whose
 //   relative rotation axes are not all parallel (hand-eye calibration, AX = XB).
@@ -40,11 +42,12 @@ struct ObservabilityOptions {
   // b f). The scale and the field are the stereo depth's errors common to every prior, which the
   // priors' scatter cannot reveal.
   double disparity_bias_sigma_px = 0.02;
-  // Two-way clustering of the LiDAR term: besides each directed pair, the pairs that share a target
-  // station and those that share a source station form clusters (a station's cloud errors, e.g. its
-  // normals near edges, enter every pair it is part of). Off by default: it lowered the coverage of
-  // the synthetic coverage test without explaining the end-to-end errors.
-  bool two_way_lidar_clusters = false;
+  // How residuals are grouped for the cluster-robust covariance: by landmark and by one sensor's
+  // capture at one station (a real capture), or by landmark only (a simulated capture whose noise
+  // is independent between stations by construction, as the survey planner's: there the station
+  // sums of one draw of a few stations would only add that draw's sampling noise).
+  enum class ClusterGrouping { kLandmarkAndCapture, kLandmark };
+  ClusterGrouping cluster_grouping = ClusterGrouping::kLandmarkAndCapture;
   // relative rotations below this do not count as rotating
   double min_rotation_deg = 2.0;
   // axes closer than this are parallel
@@ -131,8 +134,8 @@ struct ExtrinsicUncertaintyInputs {
   Eigen::Matrix3d undetermined_translation = Eigen::Matrix3d::Zero();
   // Every data residual block of the problem, grouped (see above).
   std::vector<std::vector<ceres::ResidualBlockId>> clusters;
-  // Empty, or per cluster two group keys (a LiDAR pair's target and source station; -1: the
-  // cluster is a group of its own) for two-way clustering.
+  // Empty (one-way clustering), or per cluster two group keys for two-way clustering: its landmark
+  // and its station-and-sensor (-1: the cluster is a group of its own in that grouping).
   std::vector<std::array<int, 2>> cluster_groups;
   // Residual blocks that are not data (the weak extrinsic prior): they keep the information
   // invertible for the sandwich but never decide what is observable.

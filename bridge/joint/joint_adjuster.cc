@@ -971,55 +971,87 @@ std::vector<VarianceComponent> UpdateVarianceFactors(RunState* state,
   return components;
 }
 
-// Clusters of residuals that share errors: a landmark's reprojections and landmark-to-plane residuals,
-// an image's depth priors, a
-// directed LiDAR station pair; per cluster its station group keys (target, source image) for two-way
-// clustering of the LiDAR term ({-1, -1} otherwise). The weak extrinsic prior is not data and is left
-// out.
+// Clusters of residuals for the two-way cluster-robust covariance (Cameron, Gelbach & Miller 2011):
+// residuals share errors by landmark (its keypoints' texture, its surface) and by one sensor's
+// capture at one station (the image's errors shared by its reprojections, the depth map's by its
+// priors, the sweep's by the LiDAR pairs it is the target of). A cluster is one landmark's
+// residuals of one kind in one station, an image's depth priors, or a directed LiDAR pair; its
+// group keys are its landmark (-1: none) and its station-and-kind. The weak extrinsic prior is not
+// data and is left out.
+enum class ResidualKind { kReprojection = 0, kLandmarkLidar = 1, kDepthPrior = 2, kLidarPair = 3 };
+constexpr int kNumResidualKinds = 4;
+
 struct Clusters {
   std::vector<std::vector<ceres::ResidualBlockId>> blocks;
   std::vector<std::array<int, 2>> groups;
+  std::map<std::array<int, 3>, size_t> index;  // (kind, key, key) -> cluster
+
+  void Add(ceres::ResidualBlockId id, ResidualKind kind, int key, int landmark, int station) {
+    const int kind_index = static_cast<int>(kind);
+    const auto [it, inserted] =
+        index.emplace(std::array<int, 3>{kind_index, key, station}, blocks.size());
+    if (inserted) {
+      blocks.emplace_back();
+      groups.push_back({landmark, station * kNumResidualKinds + kind_index});
+    }
+    blocks[it->second].push_back(id);
+  }
 };
 
-Clusters ResidualClusters(const colmap::Reconstruction& reconstruction, const JointProblem& joint) {
-  std::unordered_map<const double*, size_t> landmark_cluster;
-  for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
-    landmark_cluster.emplace(point3D.xyz.data(), landmark_cluster.size());
+// The landmark and the station of a reprojection or landmark-to-plane residual, from its parameter
+// blocks: the landmark's position and the first camera pose among them; a residual without a pose
+// block (COLMAP's constant-pose reprojection) is the gauge image's.
+std::array<int, 2> LandmarkAndStation(const JointProblem& joint,
+                                      ceres::ResidualBlockId id,
+                                      const std::unordered_map<const double*, int>& landmark_keys,
+                                      const std::unordered_map<const double*, int>& station_keys,
+                                      int gauge_station) {
+  std::vector<double*> blocks;
+  joint.problem->GetParameterBlocksForResidualBlock(id, &blocks);
+  std::array<int, 2> keys = {-1, gauge_station};
+  for (const double* block : blocks) {
+    if (const auto it = landmark_keys.find(block); it != landmark_keys.end()) keys[0] = it->second;
+  }
+  for (const double* block : blocks) {
+    if (const auto it = station_keys.find(block); it != station_keys.end()) {
+      keys[1] = it->second;
+      break;
+    }
+  }
+  return keys;
+}
+
+Clusters ResidualClusters(const RunState& state, const JointProblem& joint) {
+  std::unordered_map<const double*, int> landmark_keys, station_keys;
+  for (const auto& [point3D_id, point3D] : state.reconstruction->Points3D()) {
+    landmark_keys.emplace(point3D.xyz.data(), static_cast<int>(landmark_keys.size()));
+  }
+  int gauge_station = -1;
+  for (const auto& [image_id, image] : state.reconstruction->Images()) {
+    station_keys.emplace(image.CamFromWorld().rotation.coeffs().data(), static_cast<int>(image_id));
+    if (state.config.HasConstantCamPose(image_id)) gauge_station = static_cast<int>(image_id);
   }
   Clusters clusters;
-  clusters.blocks.resize(landmark_cluster.size());
-  std::vector<double*> blocks;
-  for (const auto* ids : {&joint.reprojection_ids, &joint.landmark_ids}) {
-    for (const ceres::ResidualBlockId id : *ids) {
-      joint.problem->GetParameterBlocksForResidualBlock(id, &blocks);
-      for (const double* block : blocks) {
-        const auto it = landmark_cluster.find(block);
-        if (it != landmark_cluster.end()) {
-          clusters.blocks[it->second].push_back(id);
-          break;
-        }
-      }
+  for (const ResidualKind kind : {ResidualKind::kReprojection, ResidualKind::kLandmarkLidar}) {
+    const auto& ids =
+        kind == ResidualKind::kReprojection ? joint.reprojection_ids : joint.landmark_ids;
+    for (const ceres::ResidualBlockId id : ids) {
+      const auto [landmark, station] =
+          LandmarkAndStation(joint, id, landmark_keys, station_keys, gauge_station);
+      clusters.Add(id, kind, landmark, landmark, station);
     }
   }
-  std::map<colmap::image_t, std::vector<ceres::ResidualBlockId>> per_image;
   for (size_t k = 0; k < joint.depth_ids.size(); ++k) {
-    per_image[joint.depth_images[k]].push_back(joint.depth_ids[k]);
+    const int station = static_cast<int>(joint.depth_images[k]);
+    clusters.Add(joint.depth_ids[k], ResidualKind::kDepthPrior, -1, -1, station);
   }
-  for (auto& [image_id, ids] : per_image) clusters.blocks.push_back(std::move(ids));
-  clusters.groups.assign(clusters.blocks.size(), {-1, -1});
-  std::map<ImagePair, std::vector<ceres::ResidualBlockId>> per_pair;
   for (size_t k = 0; k < joint.lidar_ids.size(); ++k) {
-    per_pair[joint.lidar_pairs[k]].push_back(joint.lidar_ids[k]);
-  }
-  for (auto& [pair, ids] : per_pair) {
-    clusters.blocks.push_back(std::move(ids));
-    clusters.groups.push_back({static_cast<int>(pair.first), static_cast<int>(pair.second)});
-  }
-  for (size_t c = clusters.blocks.size(); c-- > 0;) {
-    if (clusters.blocks[c].empty()) {
-      clusters.blocks.erase(clusters.blocks.begin() + c);
-      clusters.groups.erase(clusters.groups.begin() + c);
-    }
+    const auto [target, source] = joint.lidar_pairs[k];
+    clusters.Add(joint.lidar_ids[k],
+                 ResidualKind::kLidarPair,
+                 static_cast<int>(source),
+                 -1,
+                 static_cast<int>(target));
   }
   return clusters;
 }
@@ -1038,11 +1070,13 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
   for (size_t k = 0; k < joint.depth_ids.size(); ++k) {
     inputs.depth_consider_derivative[joint.depth_ids[k]] = joint.depth_consider_derivatives[k];
   }
-  Clusters clusters = ResidualClusters(*state.reconstruction, joint);
+  Clusters clusters = ResidualClusters(state, joint);
   inputs.clusters = std::move(clusters.blocks);
-  if (state.options.observability.two_way_lidar_clusters) {
-    inputs.cluster_groups = std::move(clusters.groups);
+  if (state.options.observability.cluster_grouping ==
+      ObservabilityOptions::ClusterGrouping::kLandmark) {
+    for (std::array<int, 2>& keys : clusters.groups) keys[1] = -1;  // each its own capture group
   }
+  inputs.cluster_groups = std::move(clusters.groups);
   inputs.regularizers = joint.prior_ids;
   inputs.measurements = joint.measurement_ids;
   inputs.measurements.insert(

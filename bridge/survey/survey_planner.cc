@@ -81,6 +81,7 @@ JointAdjusterOptions SurveyPlanOptions::DefaultAdjusterOptions() {
   adjuster.num_association_rounds = 2;
   adjuster.association.num_samples = 500;
   adjuster.hold_unobservable = false;
+  adjuster.observability.cluster_grouping = ObservabilityOptions::ClusterGrouping::kLandmark;
   return adjuster;
 }
 

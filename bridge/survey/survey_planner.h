@@ -5,9 +5,10 @@
 // with pixel noise, depth priors with noise of their own sigma_d, LiDAR scans with range noise; no
 // images, no SIFT: bridge/survey/synthetic_joint_problem.h) and the joint problem is solved at the
 // true poses. What is reported is the joint adjuster's own uncertainty of T_e (its cluster-robust
-// covariance, whose 2-sigma coverage over seeded draws is 88-98 % per axis:
-// tests/joint_adjuster_coverage_test.cc), its unobservable directions in words, and the motion test
-// of Zhen et al. 2019 (stations must rotate about two non-parallel axes).
+// covariance with the residuals grouped by landmark only: the simulated noise is independent between
+// stations; its coverage over seeded draws: tests/joint_adjuster_coverage_test.cc), its unobservable
+// directions in words, and the motion test of Zhen et al. 2019 (stations must rotate about two
+// non-parallel axes).
 //
 // Candidates: stations on a ring around the structure at the plan's mean distance, each level (like
 // a tripod station) and tilted (low, looking up, rolled). Each candidate is added to the plan in turn
@@ -63,7 +64,8 @@ struct SurveyPlanOptions {
   double candidate_tilt_deg = 10.0;
   double tilted_height_m = 0.45;
   uint64_t seed = 1;
-  // The joint adjustment (hold_unobservable is turned off: the planner reports, it does not hold).
+  // The joint adjustment (hold_unobservable is turned off: the planner reports, it does not hold;
+  // the covariance's residuals grouped by landmark only).
   JointAdjusterOptions adjuster = DefaultAdjusterOptions();
 
   static JointAdjusterOptions DefaultAdjusterOptions();
