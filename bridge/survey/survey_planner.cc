@@ -1,8 +1,8 @@
 #include "bridge/survey/survey_planner.h"
 
-#include "colmap_ext/logging.h"
 #include "bridge/simulation/sensor_pod.h"
 #include "bridge/survey/surface_world.h"
+#include "colmap_ext/logging.h"
 
 #include <algorithm>
 #include <cmath>

@@ -18,9 +18,9 @@
 
 #include "bridge/joint/extrinsic_observability.h"
 #include "bridge/joint/joint_adjuster.h"
-#include "lidar/point_cloud.h"
 #include "bridge/simulation/scene.h"
 #include "bridge/survey/synthetic_joint_problem.h"
+#include "lidar/point_cloud.h"
 
 #include "colmap/geometry/rigid3.h"
 
