@@ -179,6 +179,11 @@ TEST(JointAdjusterTest, DefaultSceneWithNoise) {
   EXPECT_LT(joint.evaluation.mean_position_error_mm,
             precalibrated.evaluation.mean_position_error_mm);
   EXPECT_LT(joint.evaluation.mean_position_error_mm, stereo_only.evaluation.mean_position_error_mm);
+  // Each data term's pull, and no disagreement between them: the simulation has no sensor model
+  // error.
+  EXPECT_EQ(joint.report["uncertainty"]["term_pulls"].size(), 4u);
+  EXPECT_TRUE(joint.report["uncertainty"]["term_disagreements"].empty())
+      << joint.report["uncertainty"]["term_pulls"].dump(1);
   EXPECT_TRUE(fs::exists(dir.File("joint/perturbation_rotation.png")));
   EXPECT_TRUE(fs::exists(dir.File("joint/cost.png")));
   // The curves per term: the total less E_l, E_m and E_x is the rest, which does not depend on

@@ -381,17 +381,40 @@ Eigen::MatrixXd GroupedSandwich(const std::vector<Eigen::VectorXd>& scores,
 // errors shared within the second groups add; [.]+ keeps its nonnegative eigenvalues, as a variance
 // component's estimate is truncated at zero: with few stations, the station sums (partly absorbed
 // by the stations' own poses) would otherwise take away from the landmark clusters' variance.
+// Per data term, the sum of its clusters' scores and their scatter (sum of s s^T).
+struct TermScores {
+  std::vector<Eigen::VectorXd> sums;
+  std::vector<Eigen::MatrixXd> scatters;
+};
+
 struct ClusterRobustCovariance {
   Eigen::MatrixXd sandwich;              // in the parameters' own units
   Eigen::MatrixXd consider_sensitivity;  // dT_e / d(consider parameters), one column each
+  TermScores term_scores;
 };
 
-std::optional<ClusterRobustCovariance> ClusterRobust(
-    const JacobianRows& rows,
-    const Eigen::SparseMatrix<double>& information,
-    int num_other,
-    const std::vector<std::array<int, 2>>& cluster_groups,
-    size_t num_clusters) {
+// The scores summed per term (none without terms).
+TermScores SumScoresByTerm(const std::vector<Eigen::VectorXd>& scores,
+                           const ExtrinsicUncertaintyInputs& inputs) {
+  TermScores terms;
+  if (inputs.cluster_term.size() != scores.size() || scores.empty()) return terms;
+  const Eigen::Index n = scores.front().size();
+  terms.sums.assign(inputs.term_names.size(), Eigen::VectorXd::Zero(n));
+  terms.scatters.assign(inputs.term_names.size(), Eigen::MatrixXd::Zero(n, n));
+  for (size_t c = 0; c < scores.size(); ++c) {
+    const int term = inputs.cluster_term[c];
+    terms.sums.at(term) += scores[c];
+    terms.scatters.at(term) += scores[c] * scores[c].transpose();
+  }
+  return terms;
+}
+
+std::optional<ClusterRobustCovariance> ClusterRobust(const JacobianRows& rows,
+                                                     const Eigen::SparseMatrix<double>& information,
+                                                     int num_other,
+                                                     const ExtrinsicUncertaintyInputs& inputs) {
+  const std::vector<std::array<int, 2>>& cluster_groups = inputs.cluster_groups;
+  const size_t num_clusters = inputs.clusters.size();
   ClusterRobustCovariance robust;
   Eigen::MatrixXd* sandwich = &robust.sandwich;
   Eigen::MatrixXd* consider_sensitivity = &robust.consider_sensitivity;
@@ -415,6 +438,7 @@ std::optional<ClusterRobustCovariance> ClusterRobust(
     scores[rows.cluster[row]] += y.row(row).transpose() * rows.residuals[row];
     *consider_sensitivity -= y.row(row).transpose() * rows.consider_derivative[row].transpose();
   }
+  robust.term_scores = SumScoresByTerm(scores, inputs);
   *sandwich = GroupedSandwich(scores, {});
   if (!cluster_groups.empty()) {
     std::vector<int> first(num_clusters), second(num_clusters);
@@ -468,12 +492,24 @@ void AddClusterRobustCovariance(const JacobianRows& rows,
                                 const ExtrinsicUncertaintyInputs& inputs,
                                 const ObservabilityOptions& options,
                                 ExtrinsicUncertainty* result) {
-  const std::optional<ClusterRobustCovariance> cluster_robust = ClusterRobust(
-      rows, information, layout.num_other, inputs.cluster_groups, inputs.clusters.size());
+  const std::optional<ClusterRobustCovariance> cluster_robust =
+      ClusterRobust(rows, information, layout.num_other, inputs);
   if (!cluster_robust) return;
   const Eigen::MatrixXd& sandwich = cluster_robust->sandwich;
-  const Eigen::MatrixXd reported_sensitivity =
-      layout.directions * layout.scale.asDiagonal() * cluster_robust->consider_sensitivity;
+  const Eigen::MatrixXd to_reported = layout.directions * layout.scale.asDiagonal();
+  const Eigen::MatrixXd reported_sensitivity = to_reported * cluster_robust->consider_sensitivity;
+  const TermScores& terms = cluster_robust->term_scores;
+  for (size_t t = 0; t < terms.sums.size(); ++t) {
+    TermPull pull;
+    pull.term = inputs.term_names[t];
+    pull.pull = -to_reported * terms.sums[t];  // the term's presence moves T_e
+    const Eigen::VectorXd scatter =
+        (to_reported * terms.scatters[t] * to_reported.transpose()).diagonal().cwiseSqrt();
+    for (int k = 0; k < 6; ++k) {
+      pull.significance[k] = scatter[k] > 0 ? pull.pull[k] / scatter[k] : 0.0;
+    }
+    result->term_pulls.push_back(pull);
+  }
   result->stereo_scale_sensitivity = reported_sensitivity.col(0);
   result->disparity_bias_sensitivity = reported_sensitivity.rightCols<3>();
   Matrix6 robust = ToReported(ScaleTangent(sandwich, layout, 1), layout);
@@ -599,6 +635,8 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInput
   result.computed = true;
   result.unobservable = NameUnobservable(result, motion, options);
   NameUndetermined(inputs, motion, &result);
+  SetPullSigmas(result.covariance, result.undetermined, &result.term_pulls);
+  result.term_disagreements = DescribeTermDisagreements(result.term_pulls);
   return result;
 }
 

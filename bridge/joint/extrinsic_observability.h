@@ -15,6 +15,8 @@
 // millimetres along the camera axes.
 #pragma once
 
+#include "bridge/joint/term_pulls.h"
+
 #include "colmap/scene/reconstruction.h"
 
 #include <Eigen/Core>
@@ -79,6 +81,10 @@ struct ExtrinsicUncertainty {
   // Axes (rx ry rz tx ty tz about/along the camera axes) that lie mostly in directions held at
   // their start: they have no sigma (the covariance is zero in the held directions).
   std::array<bool, 6> undetermined = {false, false, false, false, false, false};
+  // Each data term's pull on cam_from_lidar (empty without the cluster-robust covariance), and one
+  // sentence per axis on which two terms pull apart (bridge/joint/term_pulls.h).
+  std::vector<TermPull> term_pulls;
+  std::vector<std::string> term_disagreements;
 };
 
 struct MotionAnalysis {
@@ -137,6 +143,9 @@ struct ExtrinsicUncertaintyInputs {
   // Empty (one-way clustering), or per cluster two group keys for two-way clustering: its landmark
   // and its station-and-sensor (-1: the cluster is a group of its own in that grouping).
   std::vector<std::array<int, 2>> cluster_groups;
+  // Per cluster, its data term (an index into term_names); empty: no term pulls.
+  std::vector<int> cluster_term;
+  std::vector<std::string> term_names;
   // Residual blocks that are not data (the weak extrinsic prior): they keep the information
   // invertible for the sandwich but never decide what is observable.
   std::vector<ceres::ResidualBlockId> regularizers;

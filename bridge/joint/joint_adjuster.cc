@@ -27,6 +27,7 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -980,10 +981,14 @@ std::vector<VarianceComponent> UpdateVarianceFactors(RunState* state,
 // data and is left out.
 enum class ResidualKind { kReprojection = 0, kLandmarkLidar = 1, kDepthPrior = 2, kLidarPair = 3 };
 constexpr int kNumResidualKinds = 4;
+// The kinds' names in report.json (those of the variance components).
+constexpr const char* kResidualKindNames[kNumResidualKinds] = {
+    "reprojection", "landmark_lidar", "depth_prior", "lidar"};
 
 struct Clusters {
   std::vector<std::vector<ceres::ResidualBlockId>> blocks;
   std::vector<std::array<int, 2>> groups;
+  std::vector<int> kinds;
   std::map<std::array<int, 3>, size_t> index;  // (kind, key, key) -> cluster
 
   void Add(ceres::ResidualBlockId id, ResidualKind kind, int key, int landmark, int station) {
@@ -993,6 +998,7 @@ struct Clusters {
     if (inserted) {
       blocks.emplace_back();
       groups.push_back({landmark, station * kNumResidualKinds + kind_index});
+      kinds.push_back(kind_index);
     }
     blocks[it->second].push_back(id);
   }
@@ -1077,6 +1083,8 @@ ExtrinsicUncertainty Uncertainty(const RunState& state,
     for (std::array<int, 2>& keys : clusters.groups) keys[1] = -1;  // each its own capture group
   }
   inputs.cluster_groups = std::move(clusters.groups);
+  inputs.cluster_term = std::move(clusters.kinds);
+  inputs.term_names.assign(std::begin(kResidualKindNames), std::end(kResidualKindNames));
   inputs.regularizers = joint.prior_ids;
   inputs.measurements = joint.measurement_ids;
   inputs.measurements.insert(

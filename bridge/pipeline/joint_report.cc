@@ -130,6 +130,18 @@ std::vector<std::string> PriorDeterminedAxes(
   return axes;
 }
 
+// Each data term's pull on cam_from_lidar, in deg / mm and in sigmas.
+nlohmann::json TermPullsJson(const std::vector<TermPull>& pulls) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const TermPull& pull : pulls) {
+    json.push_back({{"term", pull.term},
+                    {"pull_deg_mm", MatrixJson(pull.pull.transpose())},
+                    {"pull_sigmas", MatrixJson(pull.pull_sigmas.transpose())},
+                    {"significance", MatrixJson(pull.significance.transpose())}});
+  }
+  return json;
+}
+
 // report.json's "uncertainty": the cluster-robust and formal covariances of cam_from_lidar.
 // `caveat`: UncertaintyCaveat's sentence (empty: validated for this kind of capture).
 nlohmann::json UncertaintyJson(const ExtrinsicUncertainty& u,
@@ -166,6 +178,8 @@ nlohmann::json UncertaintyJson(const ExtrinsicUncertainty& u,
     uncertainty["undetermined_axes"] = UndeterminedAxes(u);
     uncertainty["eigen_std_devs"] = MatrixJson(u.eigenvalues.transpose());
     uncertainty["eigenvectors_columns"] = MatrixJson(u.eigenvectors);
+    uncertainty["term_pulls"] = TermPullsJson(u.term_pulls);
+    uncertainty["term_disagreements"] = u.term_disagreements;
   }
   return uncertainty;
 }
@@ -390,6 +404,30 @@ void WriteJointPlots(const std::string& directory,
   WriteLinePlotPng(directory + "/perturbation_rotation.png", rotation, plot);
 }
 
+namespace {
+
+// One line per data term: its pull on cam_from_lidar in sigmas; a WARNING per disagreement.
+void PrintTermPulls(const ExtrinsicUncertainty& u) {
+  if (u.term_pulls.empty()) return;
+  std::cout << "Each term's pull on cam_from_lidar (rx ry rz tx ty tz: in sigmas of "
+               "cam_from_lidar, then as t, in its own clusters' scatter):"
+            << std::endl;
+  for (const TermPull& pull : u.term_pulls) {
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(1) << "  " << std::left << std::setw(15) << pull.term
+         << std::right;
+    for (int k = 0; k < 6; ++k) line << " " << std::setw(6) << pull.pull_sigmas[k];
+    line << "   t";
+    for (int k = 0; k < 6; ++k) line << " " << std::setw(6) << pull.significance[k];
+    std::cout << line.str() << std::endl;
+  }
+  for (const std::string& sentence : u.term_disagreements) {
+    std::cout << "WARNING: " << sentence << std::endl;
+  }
+}
+
+}  // namespace
+
 void PrintJointUncertainty(const JointAdjustmentSummary& summary, const std::string& caveat) {
   std::cout << "Motion alone (the rotations between stations, without the structure's terms): "
             << summary.motion.verdict << std::endl;
@@ -407,6 +445,7 @@ void PrintJointUncertainty(const JointAdjustmentSummary& summary, const std::str
     }
     std::cout << line.str() << std::endl;
     if (!caveat.empty()) std::cout << "cam_from_lidar sigma " << caveat << std::endl;
+    PrintTermPulls(summary.uncertainty);
   }
   for (const std::string& sentence : summary.uncertainty.unobservable) {
     std::cout << "UNOBSERVABLE: " << sentence << std::endl;
