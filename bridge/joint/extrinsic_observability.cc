@@ -602,10 +602,8 @@ ExtrinsicUncertainty ComputeExtrinsicUncertainty(const ExtrinsicUncertaintyInput
                                          inputs.measurements,
                                          inputs.depth_consider_derivative);
   const Eigen::SparseMatrix<double> data_jacobian = rows.jacobian.topRows(rows.num_data_rows);
-  const Eigen::SparseMatrix<double> data_information =
-      (data_jacobian.transpose() * data_jacobian).pruned();
-  const Eigen::SparseMatrix<double> information =
-      (rows.jacobian.transpose() * rows.jacobian).pruned();
+  const Eigen::SparseMatrix<double> data_information = NormalMatrix(data_jacobian);
+  const Eigen::SparseMatrix<double> information = NormalMatrix(rows.jacobian);
   Eigen::MatrixXd marginal;
   if (!MarginalInformation(data_information, layout.num_other, &marginal)) {
     result.message =

@@ -32,4 +32,10 @@ Eigen::SparseMatrix<double> SparseJacobian(const ceres::CRSMatrix& jacobian) {
   return sparse;
 }
 
+Eigen::SparseMatrix<double> NormalMatrix(const Eigen::SparseMatrix<double>& jacobian) {
+  Eigen::SparseMatrix<double> normal = jacobian.transpose() * jacobian;
+  normal.prune([](Eigen::Index, Eigen::Index, double value) { return value != 0.0; });
+  return normal;
+}
+
 }  // namespace colmap_lidar

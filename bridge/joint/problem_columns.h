@@ -1,5 +1,6 @@
 // The columns of a Ceres problem's Jacobian: its free parameter blocks in the problem's order, each
-// with its tangent coordinates, and the Jacobian Ceres evaluates as an Eigen sparse matrix.
+// with its tangent coordinates, the Jacobian Ceres evaluates as an Eigen sparse matrix, and its
+// normal matrix.
 #pragma once
 
 #include <Eigen/SparseCore>
@@ -22,5 +23,11 @@ ProblemColumns FreeColumns(ceres::Problem* problem);
 
 // `jacobian` (as ceres::Problem::Evaluate gives it) as an Eigen sparse matrix.
 Eigen::SparseMatrix<double> SparseJacobian(const ceres::CRSMatrix& jacobian);
+
+// Jᵀ J without stored zeros: Eigen's plain sparse product, pruned in place. Not Eigen 3.4's pruning
+// product (`(A * B).pruned()`): its sparse work list for a result column has no capacity check when
+// an entry arrives ahead of all it holds, so a column with many entries arriving in descending order
+// (T_e's columns, coupled to every station) is written past its buffer and the heap is corrupted.
+Eigen::SparseMatrix<double> NormalMatrix(const Eigen::SparseMatrix<double>& jacobian);
 
 }  // namespace colmap_lidar

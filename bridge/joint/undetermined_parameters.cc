@@ -35,14 +35,14 @@ std::vector<int> DependentColumns(const Eigen::SparseMatrix<double>& normal_matr
 namespace {
 
 // JᵀJ of `problem` over the tangent coordinates of `columns`.
-Eigen::SparseMatrix<double> NormalMatrix(ceres::Problem* problem, const ProblemColumns& columns) {
+Eigen::SparseMatrix<double> EvaluatedNormalMatrix(ceres::Problem* problem,
+                                                  const ProblemColumns& columns) {
   ceres::Problem::EvaluateOptions options;
   options.parameter_blocks = columns.blocks;
   double cost = 0;
   ceres::CRSMatrix crs;
   problem->Evaluate(options, &cost, nullptr, nullptr, &crs);
-  const Eigen::SparseMatrix<double> jacobian = SparseJacobian(crs);
-  return (jacobian.transpose() * jacobian).pruned();
+  return NormalMatrix(SparseJacobian(crs));
 }
 
 std::string BlockName(const std::map<const double*, std::string>& names,
@@ -58,7 +58,7 @@ std::vector<UndeterminedBlock> UndeterminedBlocks(ceres::Problem* problem) {
   const ProblemColumns columns = FreeColumns(problem);
   if (columns.blocks.empty()) return {};
   std::vector<UndeterminedBlock> blocks;
-  for (const int column : DependentColumns(NormalMatrix(problem, columns))) {  // ascending
+  for (const int column : DependentColumns(EvaluatedNormalMatrix(problem, columns))) {  // ascending
     const int block = columns.block_of_column[column];
     if (blocks.empty() || blocks.back().index != block) {
       blocks.push_back({columns.blocks[block], block, columns.size[block], {}});
