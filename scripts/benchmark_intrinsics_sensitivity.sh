@@ -54,9 +54,12 @@ change() {
       --output_type BIN >/dev/null
     cp "$run/ws/sparse/initial/"*.json "$run/ws/sparse/initial/cam_from_lidar.txt" "$model/"
     echo "[$name, frames of half $half] joint adjuster ..."
-    (cd "$run" && "$cli" joint_adjuster --database_path ws/database.db --input_path "$model" \
-      --dataset_path dataset --registration_path ws/lidar --output_path "$model-joint" \
-      > "$model-joint.log" 2>&1)
+    if ! (cd "$run" && "$cli" joint_adjuster --database_path ws/database.db --input_path "$model" \
+        --dataset_path dataset --registration_path ws/lidar --output_path "$model-joint" \
+        > "$model-joint.log" 2>&1); then
+      echo "joint_adjuster failed on $model (see $model-joint.log)" >&2
+      exit 1
+    fi
     python3 scripts/extrinsic_error.py "$run/dataset/ground_truth/cam_from_lidar.txt" \
       "$model-joint/cam_from_lidar.txt" "$model-joint/report.json" "$name" "$half" >> "$results"
   done
