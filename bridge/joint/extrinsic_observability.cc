@@ -226,9 +226,7 @@ ColumnLayout MakeColumnLayout(const ExtrinsicUncertaintyInputs& inputs,
                               bool translation_free) {
   ColumnLayout layout;
   ceres::Problem* problem = inputs.problem;
-  std::vector<double*> blocks;
-  problem->GetParameterBlocks(&blocks);
-  for (double* block : blocks) {
+  for (double* block : ParameterBlocksInResidualOrder(*problem)) {
     if (block == inputs.cam_from_lidar_rotation || block == inputs.cam_from_lidar_translation ||
         problem->IsParameterBlockConstant(block)) {
       continue;

@@ -1,12 +1,32 @@
 #include "bridge/joint/problem_columns.h"
 
+#include <unordered_set>
+
 namespace colmap_lidar {
+
+std::vector<double*> ParameterBlocksInResidualOrder(const ceres::Problem& problem) {
+  std::vector<double*> ordered;
+  ordered.reserve(problem.NumParameterBlocks());
+  std::unordered_set<const double*> seen;
+  std::vector<ceres::ResidualBlockId> residual_blocks;
+  problem.GetResidualBlocks(&residual_blocks);
+  std::vector<double*> blocks;
+  for (const ceres::ResidualBlockId id : residual_blocks) {
+    problem.GetParameterBlocksForResidualBlock(id, &blocks);
+    for (double* block : blocks) {
+      if (seen.insert(block).second) ordered.push_back(block);
+    }
+  }
+  problem.GetParameterBlocks(&blocks);  // those without a residual block, by address
+  for (double* block : blocks) {
+    if (seen.insert(block).second) ordered.push_back(block);
+  }
+  return ordered;
+}
 
 ProblemColumns FreeColumns(ceres::Problem* problem) {
   ProblemColumns columns;
-  std::vector<double*> blocks;
-  problem->GetParameterBlocks(&blocks);
-  for (double* block : blocks) {
+  for (double* block : ParameterBlocksInResidualOrder(*problem)) {
     if (problem->IsParameterBlockConstant(block)) continue;
     const int size = problem->ParameterBlockTangentSize(block);
     if (size == 0) continue;

@@ -1,4 +1,4 @@
-// The columns of a Ceres problem's Jacobian: its free parameter blocks in the problem's order, each
+// The columns of a Ceres problem's Jacobian: its free parameter blocks in a reproducible order, each
 // with its tangent coordinates, the Jacobian Ceres evaluates as an Eigen sparse matrix, and its
 // normal matrix.
 #pragma once
@@ -19,6 +19,14 @@ struct ProblemColumns {
   std::vector<int> size;          // per block (tangent size)
 };
 
+// The problem's parameter blocks in the order its residual blocks (in the order they were added)
+// first use them, then those no residual block uses. Not ceres::Problem::GetParameterBlocks, which
+// lists them by address: addresses change from run to run with the heap (threads allocate from their
+// own arenas), and sums and sparse orderings over columns in that order would change in their last
+// digits.
+std::vector<double*> ParameterBlocksInResidualOrder(const ceres::Problem& problem);
+
+// The free blocks of ParameterBlocksInResidualOrder with their columns.
 ProblemColumns FreeColumns(ceres::Problem* problem);
 
 // `jacobian` (as ceres::Problem::Evaluate gives it) as an Eigen sparse matrix.

@@ -1,7 +1,9 @@
 #include "bridge/joint/problem_columns.h"
 
+#include <ceres/autodiff_cost_function.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <vector>
 
 namespace colmap_lidar {
@@ -40,6 +42,36 @@ TEST(NormalMatrix, StoresNoEntryThatCancelsToZero) {
   EXPECT_EQ(normal.nonZeros(), 2);
   EXPECT_EQ(normal.coeff(0, 0), 2.0);
   EXPECT_EQ(normal.coeff(1, 1), 2.0);
+}
+
+// r = a - b: a residual between two one-dimensional blocks.
+struct DifferenceCost {
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* residual) const {
+    residual[0] = a[0] - b[0];
+    return true;
+  }
+  static ceres::CostFunction* Create() {
+    return new ceres::AutoDiffCostFunction<DifferenceCost, 1, 1, 1>(new DifferenceCost);
+  }
+};
+
+TEST(ParameterBlocksInResidualOrder, FollowsTheResidualsNotTheAddresses) {
+  std::array<double, 5> values = {0, 1, 2, 3, 4};
+  ceres::Problem problem;
+  // Residuals chain the blocks from the highest address down; block 0 has no residual.
+  for (int k = 4; k > 1; --k) {
+    problem.AddResidualBlock(DifferenceCost::Create(), nullptr, &values[k], &values[k - 1]);
+  }
+  problem.AddParameterBlock(&values[0], 1);
+  problem.SetParameterBlockConstant(&values[2]);
+  const std::vector<double*> expected = {
+      &values[4], &values[3], &values[2], &values[1], &values[0]};
+  EXPECT_EQ(ParameterBlocksInResidualOrder(problem), expected);
+  const ProblemColumns columns = FreeColumns(&problem);
+  const std::vector<double*> free = {&values[4], &values[3], &values[1], &values[0]};
+  EXPECT_EQ(columns.blocks, free);
+  EXPECT_EQ(columns.first_column, (std::vector<int>{0, 1, 2, 3}));
 }
 
 }  // namespace
