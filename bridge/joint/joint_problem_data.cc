@@ -1,10 +1,10 @@
 #include "bridge/joint/joint_problem_data.h"
 
+#include "colmap_ext/colmap_tables.h"
+#include "colmap_ext/extension_database.h"
 #include "colmap_ext/logging.h"
 #include "lidar/cloud_io.h"
 #include "lidar/kd_tree.h"
-
-#include "colmap/scene/database.h"
 
 #include <filesystem>
 #include <iostream>
@@ -58,13 +58,14 @@ std::map<colmap::image_t, size_t> StationOfImage(const StationDataset& dataset,
 }
 
 // The model's image ids must be the database's (depth priors and matches are keyed by them).
-void CheckModelIsFromDatabase(const colmap::Database& database,
-                              const std::string& database_path,
+void CheckModelIsFromDatabase(const std::string& database_path,
                               const colmap::Reconstruction& reconstruction,
                               const std::vector<colmap::image_t>& image_ids) {
+  const std::map<colmap::image_t, std::string> names = ReadImageNames(database_path);
   for (const colmap::image_t image_id : image_ids) {
     const std::string& name = reconstruction.Image(image_id).Name();
-    if (!database.ExistsImage(image_id) || database.ReadImage(image_id).Name() != name) {
+    const auto it = names.find(image_id);
+    if (it == names.end() || it->second != name) {
       throw std::runtime_error("image " + std::to_string(image_id) + " ('" + name +
                                "') of the model is not the same image in " + database_path +
                                ": the model was not made from this database");
@@ -89,18 +90,15 @@ void ReadDepthPriors(const std::string& database_path,
 }
 
 // A_c: COLMAP's verified pairs between registered images with enough inliers.
-ImagePairSet VerifiedImagePairs(const colmap::Database& database,
+ImagePairSet VerifiedImagePairs(const std::string& database_path,
                                 const std::map<colmap::image_t, size_t>& station_of_image,
                                 int min_inliers) {
-  std::vector<std::pair<colmap::image_t, colmap::image_t>> image_pairs;
-  std::vector<int> num_inliers;
-  database.ReadTwoViewGeometryNumInliers(&image_pairs, &num_inliers);
   ImagePairSet pairs;
-  for (size_t k = 0; k < image_pairs.size(); ++k) {
-    const auto [a, b] = image_pairs[k];
-    if (!station_of_image.count(a) || !station_of_image.count(b)) continue;
-    if (num_inliers[k] < min_inliers) continue;
-    pairs.insert({std::min(a, b), std::max(a, b)});
+  for (const VerifiedPairInliers& pair : ReadVerifiedPairInliers(database_path)) {
+    if (!station_of_image.count(pair.image_id1) || !station_of_image.count(pair.image_id2))
+      continue;
+    if (pair.num_inliers < min_inliers) continue;
+    pairs.insert({pair.image_id1, pair.image_id2});
   }
   return pairs;
 }
@@ -201,12 +199,9 @@ std::unique_ptr<LoadedJointData> LoadJointProblemData(const std::string& databas
   std::sort(image_ids.begin(), image_ids.end());
   loaded->station_of_image = StationOfImage(dataset, reconstruction, image_ids);
   const std::map<colmap::image_t, size_t>& station_of_image = loaded->station_of_image;
-  ImagePairSet pairs;
-  {
-    const colmap::Database database(database_path);
-    CheckModelIsFromDatabase(database, database_path, reconstruction, image_ids);
-    pairs = VerifiedImagePairs(database, station_of_image, options.min_image_pair_inliers);
-  }
+  CheckModelIsFromDatabase(database_path, reconstruction, image_ids);
+  ImagePairSet pairs =
+      VerifiedImagePairs(database_path, station_of_image, options.min_image_pair_inliers);
   ReadDepthPriors(database_path, image_ids, &loaded->data);
   loaded->data.stereo_baseline_focal = dataset.rig.BaselineFocal();
   loaded->num_image_pairs = pairs.size();
