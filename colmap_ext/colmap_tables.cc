@@ -4,6 +4,8 @@
 
 #include "colmap/scene/database.h"
 
+#include <algorithm>
+
 namespace colmap_lidar {
 namespace {
 
